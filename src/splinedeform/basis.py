@@ -1,0 +1,329 @@
+"""One-dimensional B-spline bases on a parameter interval ``[0, L]``.
+
+Three knot layouts are supported, all with ``m`` equal cells of width ``h = L/m``:
+
+``"uniform"``
+    Höllig's scaled and translated uniform B-splines ``b^n_{k,h}(x) = b^n(x/h - k)``
+    for ``k = -n, ..., m-1`` (``m + n`` functions), evaluated by the recurrence
+
+    .. math:: b^n(x) = \\frac{x}{n} b^{n-1}(x) + \\frac{n+1-x}{n} b^{n-1}(x-1).
+
+``"open"``
+    Clamped knot vector (end knots repeated ``n+1`` times, uniform interior),
+    ``m + n`` functions; the spline interpolates its end coefficients.
+
+``"periodic"``
+    Uniform B-splines wrapped around the interval, ``m`` functions; the spline
+    and its first ``n-1`` derivatives are continuous across ``x = L ≡ 0``.
+
+Function index ``j`` (0-based) of a uniform basis is Höllig's ``k = j - n``.
+On cell ``i`` the non-zero functions are ``j = i, ..., i + n`` (modulo ``m`` when
+periodic), so every evaluation returns ``n + 1`` values per parameter.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from math import comb
+from typing import Literal
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import ArrayLike, NDArray
+
+from .errors import InputError
+
+KnotKind = Literal["uniform", "open", "periodic"]
+KNOT_KINDS: tuple[str, ...] = ("uniform", "open", "periodic")
+
+
+def cardinal_bspline(x: ArrayLike, degree: int) -> NDArray[np.float64]:
+    """Höllig's uniform B-spline ``b^n(x)`` of degree ``n`` at any ``x``.
+
+    Uses the recurrence ``b^n(x) = x/n b^{n-1}(x) + (n+1-x)/n b^{n-1}(x-1)``
+    starting from ``b^0 = 1`` on ``[0, 1)``. Support ``[0, n+1]``.
+    """
+    _check_degree(degree)
+    x = np.asarray(x, dtype=float)
+    cell = np.floor(x)
+    s = x - cell
+    table = _hollig_table(s, degree, 0)[0]  # (N..., n+1): b^n(s + q), q = 0..n
+    q = cell.astype(int)
+    inside = (q >= 0) & (q <= degree)
+    out = np.take_along_axis(table, np.clip(q, 0, degree)[..., None], axis=-1)[..., 0]
+    return np.where(inside, out, 0.0)
+
+
+def _hollig_table(s: NDArray[np.float64], degree: int, max_derivative: int
+                  ) -> list[NDArray[np.float64]]:
+    """Values ``D^j b^n(s + q)`` for ``q = 0..n`` and ``j = 0..max_derivative``.
+
+    ``s`` in ``[0, 1]``. Derivatives from ``D^j b^n(y) = Σ_i (-1)^i C(j,i) b^{n-j}(y-i)``
+    (DESIGN.md §1.1, unscaled: ``h = 1``). Returns a list indexed by ``j`` of
+    arrays of shape ``s.shape + (n+1,)``.
+    """
+    levels = [np.ones(s.shape + (1,))]  # levels[d][..., q] = b^d(s + q)
+    for d in range(1, degree + 1):
+        prev = levels[-1]
+        q = np.arange(d + 1)
+        y = s[..., None] + q
+        left = np.concatenate([prev, np.zeros(s.shape + (1,))], axis=-1)   # b^{d-1}(s+q)
+        right = np.concatenate([np.zeros(s.shape + (1,)), prev], axis=-1)  # b^{d-1}(s+q-1)
+        levels.append((y * left + (d + 1 - y) * right) / d)
+    out = []
+    for j in range(max_derivative + 1):
+        low = levels[degree - j]  # b^{n-j}(s + q), q = 0..n-j
+        acc = np.zeros(s.shape + (degree + 1,))
+        for i in range(j + 1):
+            # b^{n-j}(s + q - i) sits at q = i .. i + n - j
+            acc[..., i:i + degree - j + 1] += (-1) ** i * comb(j, i) * low
+        out.append(acc)
+    return out
+
+
+def _check_degree(degree: int) -> None:
+    if not isinstance(degree, (int, np.integer)) or isinstance(degree, bool) or degree < 1:
+        raise InputError(f"degree must be an integer >= 1, got {degree!r}")
+
+
+@dataclass(frozen=True)
+class BSplineBasis:
+    """A B-spline basis of degree ``n`` on ``[0, length]`` with ``cells`` equal cells.
+
+    Parameters
+    ----------
+    degree : int
+        Polynomial degree ``n >= 1``.
+    cells : int
+        Number of equal knot spans ``m`` on the interval; at least 1 (``n+1`` if periodic).
+    length : float
+        Length ``L`` of the parameter interval.
+    kind : {"uniform", "open", "periodic"}
+        Knot layout, see the module docstring.
+
+    Examples
+    --------
+    >>> b = BSplineBasis(3, 4, 1.0, "open")
+    >>> b.size
+    7
+    >>> float(b.matrix([0.3]).sum())
+    1.0
+    """
+
+    degree: int
+    cells: int
+    length: float = 1.0
+    kind: KnotKind = "open"
+    knots: NDArray[np.float64] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        _check_degree(self.degree)
+        if self.kind not in KNOT_KINDS:
+            raise InputError(f"knot kind must be one of {KNOT_KINDS}, got {self.kind!r}")
+        if not isinstance(self.cells, (int, np.integer)) or isinstance(self.cells, bool):
+            raise InputError(f"cells must be an integer, got {self.cells!r}")
+        minimum = self.degree + 1 if self.kind == "periodic" else 1
+        if self.cells < minimum:
+            raise InputError(
+                f"a {self.kind} basis of degree {self.degree} needs at least {minimum} cell(s), "
+                f"got {self.cells}" + (" (a periodic direction needs cells >= degree + 1)"
+                                       if self.kind == "periodic" else ""))
+        if not np.isfinite(self.length) or self.length <= 0:
+            raise InputError(f"parameter length must be finite and > 0, got {self.length!r}")
+        object.__setattr__(self, "length", float(self.length))
+        object.__setattr__(self, "knots", self._knot_vector())
+
+    # -- layout -------------------------------------------------------------
+    @property
+    def h(self) -> float:
+        """Cell width ``h = L / m``."""
+        return self.length / self.cells
+
+    @property
+    def size(self) -> int:
+        """Number of basis functions (control points in this direction)."""
+        return self.cells if self.kind == "periodic" else self.cells + self.degree
+
+    @property
+    def periodic(self) -> bool:
+        return self.kind == "periodic"
+
+    def _knot_vector(self) -> NDArray[np.float64]:
+        n, m, h = self.degree, self.cells, self.h
+        if self.kind == "open":
+            return np.concatenate([np.zeros(n), np.arange(m + 1) * h, np.full(n, self.length)])
+        # uniform and periodic: the bi-infinite grid hZ, restricted to the functions used
+        return np.arange(-n, m + n + 1) * h
+
+    def greville(self) -> NDArray[np.float64]:
+        """Greville abscissae ``ξ_j = (t_{j+1} + … + t_{j+n}) / n`` inside ``[0, L]``.
+
+        For uniform (Höllig) knots the abscissae of the outer functions fall
+        outside the interval; ``size`` equally spaced points of ``[0, L]`` are used
+        instead, which satisfy the Schoenberg–Whitney condition. For periodic knots
+        they are the support centres ``(j + (n+1)/2) h`` modulo ``L``.
+        """
+        n, h = self.degree, self.h
+        if self.kind == "periodic":
+            return np.mod((np.arange(self.size) + (n + 1) / 2) * h, self.length)
+        if self.kind == "uniform":
+            return np.linspace(0.0, self.length, self.size)
+        t = self.knots
+        window = np.lib.stride_tricks.sliding_window_view(t[1:-1], n)[: self.size]
+        return window.mean(axis=1)
+
+    # -- evaluation ---------------------------------------------------------
+    def _check_points(self, x: ArrayLike) -> NDArray[np.float64]:
+        x = np.asarray(x, dtype=float)
+        if not np.all(np.isfinite(x)):
+            raise InputError("parameters must be finite numbers")
+        if self.kind == "periodic":
+            return np.mod(x, self.length)
+        tol = 1e-12 * self.length
+        if x.size and (x.min() < -tol or x.max() > self.length + tol):
+            raise InputError(
+                f"parameter outside the domain [0, {self.length:g}]: "
+                f"got values in [{x.min():g}, {x.max():g}]")
+        return np.clip(x, 0.0, self.length)
+
+    def span(self, x: ArrayLike) -> NDArray[np.int64]:
+        """Index ``i`` of the cell ``[i h, (i+1) h)`` holding each parameter (last cell closed)."""
+        x = self._check_points(x)
+        return np.clip(np.floor(x / self.h).astype(np.int64), 0, self.cells - 1)
+
+    def nonzero(self, x: ArrayLike, derivative: int = 0
+                ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+        """Indices and values of the ``n+1`` functions not vanishing at each parameter.
+
+        Parameters
+        ----------
+        x : array_like
+            Parameters in ``[0, L]`` (any shape ``S``; any real number when periodic).
+        derivative : int
+            Order ``j`` of the derivative, ``0 <= j``; orders above ``n`` give zeros.
+
+        Returns
+        -------
+        index : ndarray of int, shape ``S + (n+1,)``
+        value : ndarray of float, shape ``S + (n+1,)``
+            ``D^j b_index(x)``.
+        """
+        index, values = self.nonzero_derivatives(x, derivative)
+        return index, values[derivative]
+
+    def nonzero_derivatives(self, x: ArrayLike, max_derivative: int = 0
+                            ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+        """Like :meth:`nonzero` but for all orders ``0..max_derivative`` at once.
+
+        Returns ``index`` of shape ``S + (n+1,)`` and ``values`` of shape
+        ``(max_derivative+1,) + S + (n+1,)``.
+        """
+        if not isinstance(max_derivative, (int, np.integer)) or max_derivative < 0:
+            raise InputError(f"derivative order must be an integer >= 0, got {max_derivative!r}")
+        x = self._check_points(x)
+        n, h = self.degree, self.h
+        cell = np.clip(np.floor(x / h).astype(np.int64), 0, self.cells - 1)
+        index = cell[..., None] + np.arange(n + 1)
+        if self.kind == "periodic":
+            index = np.mod(index - n, self.cells)
+        jmax = min(max_derivative, n)
+        if self.kind == "open":
+            values = _cox_de_boor(self.knots, n, cell + n, x, jmax)
+        else:
+            s = x / h - cell
+            table = _hollig_table(s, n, jmax)
+            # function r (0..n) on the cell is b^n(s + n - r): reverse the q axis
+            values = np.stack([table[j][..., ::-1] * h ** (-j) for j in range(jmax + 1)])
+        if max_derivative > jmax:
+            pad = np.zeros((max_derivative - jmax,) + values.shape[1:])
+            values = np.concatenate([values, pad])
+        return index, values
+
+    def matrix(self, x: ArrayLike, derivative: int = 0) -> sp.csr_matrix:
+        """Sparse collocation matrix ``A_{ij} = D^derivative b_j(x_i)``, shape ``(len(x), size)``."""
+        x = np.atleast_1d(np.asarray(x, dtype=float)).ravel()
+        index, values = self.nonzero_derivatives(x, derivative)
+        rows = np.repeat(np.arange(x.size), self.degree + 1)
+        return sp.csr_matrix((values[derivative].ravel(), (rows, index.ravel())),
+                             shape=(x.size, self.size))
+
+    def __call__(self, x: ArrayLike, derivative: int = 0) -> NDArray[np.float64]:
+        """Dense collocation matrix; convenient for small problems and tests."""
+        return self.matrix(x, derivative).toarray()
+
+
+def _cox_de_boor(knots: NDArray[np.float64], degree: int, span: NDArray[np.int64],
+                 x: NDArray[np.float64], max_derivative: int) -> NDArray[np.float64]:
+    """Non-zero B-splines and derivatives over a general knot vector (Cox–de Boor).
+
+    Vectorised form of Piegl & Tiller's algorithms A2.2/A2.3: ``span`` is the knot
+    index ``μ`` with ``t_μ <= x < t_{μ+1}``; returns ``D^j N_{μ-n+r, n}(x)`` for
+    ``r = 0..n`` and ``j = 0..max_derivative``, shape ``(max_derivative+1,) + x.shape + (n+1,)``.
+    Derivatives use ``D N_{i,p} = p/(t_{i+p}-t_i) N_{i,p-1} - p/(t_{i+p+1}-t_{i+1}) N_{i+1,p-1}``.
+    """
+    n = degree
+    # levels[p][..., r] = N_{span-p+r, p}(x), r = 0..p
+    levels = [np.ones(x.shape + (1,))]
+    for p in range(1, n + 1):
+        prev = levels[-1]
+        out = np.zeros(x.shape + (p + 1,))
+        for r in range(p):
+            i = span - p + 1 + r  # N_{i, p-1} = prev[..., r]
+            left_den = knots[i + p] - knots[i]
+            right_den = knots[i + p] - knots[i]
+            # contribution of N_{i,p-1} to N_{i-1,p} (right part) and N_{i,p} (left part)
+            w_left = _safe_div(x - knots[i], left_den)
+            w_right = _safe_div(knots[i + p] - x, right_den)
+            out[..., r + 1] += w_left * prev[..., r]
+            out[..., r] += w_right * prev[..., r]
+        levels.append(out)
+    result = np.zeros((max_derivative + 1,) + x.shape + (n + 1,))
+    result[0] = levels[n]
+    for j in range(1, max_derivative + 1):
+        # D^j N_{i,n} = Σ_q coeff[r, q] N_{i+q, n-j} with i = span - n + r
+        coeff = _derivative_coefficients(knots, n, span, j)
+        low = levels[n - j]  # low[..., r''] = N_{span-(n-j)+r'', n-j}, so r'' = r + q - j
+        acc = np.zeros(x.shape + (n + 1,))
+        for r in range(n + 1):
+            for q in range(j + 1):
+                if 0 <= r + q - j <= n - j:
+                    acc[..., r] += coeff[..., r, q] * low[..., r + q - j]
+        result[j] = acc
+    return result
+
+
+def _derivative_coefficients(knots: NDArray[np.float64], n: int, span: NDArray[np.int64],
+                             j: int) -> NDArray[np.float64]:
+    """Coefficients ``a_{r,q}`` with ``D^j N_{i,n} = n!/(n-j)! Σ_q a_{r,q} N_{i+q, n-j}``.
+
+    ``i = span - n + r``. Recurrence (Piegl & Tiller eq. 2.10):
+    ``a_{0,0}=1``, ``a_{k,0} = a_{k-1,0}/(t_{i+n-k+1} - t_i)``,
+    ``a_{k,q} = (a_{k-1,q} - a_{k-1,q-1})/(t_{i+n+q-k+1} - t_{i+q})``,
+    ``a_{k,k} = -a_{k-1,k-1}/(t_{i+n+1} - t_{i+k})``.
+    """
+    shape = span.shape
+    out = np.zeros(shape + (n + 1, j + 1))
+    scale = 1.0
+    for k in range(j):
+        scale *= n - k
+    for r in range(n + 1):
+        i = span - n + r
+        a = np.zeros(shape + (j + 1,))
+        a[..., 0] = 1.0
+        for k in range(1, j + 1):
+            new = np.zeros_like(a)
+            for q in range(k + 1):
+                prev_q = a[..., q] if q <= k - 1 else 0.0
+                prev_q1 = a[..., q - 1] if q >= 1 else 0.0
+                den = knots[i + n + q - k + 1] - knots[i + q]
+                new[..., q] = _safe_div(prev_q - prev_q1, den)
+            a = new
+        out[..., r, :] = scale * a
+    return out
+
+
+def _safe_div(num: NDArray[np.float64] | float, den: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``num/den`` with the B-spline convention ``0/0 = 0`` (repeated knots)."""
+    den = np.asarray(den, dtype=float)
+    safe = np.where(den == 0.0, 1.0, den)
+    return np.where(den == 0.0, 0.0, np.asarray(num) / safe)

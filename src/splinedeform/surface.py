@@ -1,0 +1,157 @@
+"""Tensor-product B-spline surfaces ``x(u,v) = Σ_k Σ_l p_kl b_k(u) b_l(v)``.
+
+A :class:`Surface` composes two :class:`~splinedeform.basis.BSplineBasis` objects; all
+evaluation goes through them (no second evaluator). The control net is stored as an
+array ``(n_u, n_v, 3)`` and flattened row-major (``k`` over u, ``l`` over v), so a
+tensor-product operator on the flattened net is ``A_u ⊗ A_v``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import ArrayLike, NDArray
+
+from .basis import BSplineBasis
+from .errors import InputError
+
+
+@dataclass(frozen=True)
+class Surface:
+    """A B-spline surface on the parameter rectangle ``[0, L_u] × [0, L_v]``.
+
+    Parameters
+    ----------
+    control_points : array_like, shape ``(n_u, n_v, 3)``
+        The control net; ``n_u = basis_u.size`` and ``n_v = basis_v.size``.
+    basis_u, basis_v : BSplineBasis
+        The bases in the two parameter directions.
+    fit_error : float or None
+        Maximum distance to the map the net was fitted to (set by :mod:`splinedeform.shapes`).
+    name : str
+        A label used in reports.
+    """
+
+    control_points: NDArray[np.float64]
+    basis_u: BSplineBasis
+    basis_v: BSplineBasis
+    fit_error: float | None = None
+    name: str = "surface"
+    _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        P = np.array(self.control_points, dtype=float)
+        expected = (self.basis_u.size, self.basis_v.size, 3)
+        if P.shape != expected:
+            raise InputError(f"control net must have shape {expected} (n_u, n_v, 3) for these "
+                             f"bases, got {P.shape}")
+        if not np.all(np.isfinite(P)):
+            bad = np.argwhere(~np.isfinite(P))[0]
+            raise InputError(f"control points must be finite; control point {tuple(bad[:2])} "
+                             f"is {P[tuple(bad)]}")
+        P.setflags(write=False)
+        object.__setattr__(self, "control_points", P)
+
+    # -- layout ---------------------------------------------------------------
+    @property
+    def shape(self) -> tuple[int, int]:
+        """Control net size ``(n_u, n_v)``."""
+        return self.basis_u.size, self.basis_v.size
+
+    @property
+    def domain(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        """Parameter rectangle ``((0, L_u), (0, L_v))``."""
+        return (0.0, self.basis_u.length), (0.0, self.basis_v.length)
+
+    def with_control_points(self, control_points: ArrayLike, name: str | None = None) -> Surface:
+        """The same bases with another control net (``fit_error`` dropped)."""
+        return replace(self, control_points=control_points, fit_error=None,
+                       name=self.name if name is None else name)
+
+    # -- evaluation -------------------------------------------------------------
+    def evaluation_matrix(self, u: ArrayLike, v: ArrayLike, du: int = 0, dv: int = 0
+                          ) -> sp.csr_matrix:
+        """Sparse ``E`` with ``∂^{du+dv} x / ∂u^du ∂v^dv (u_i, v_i) = (E @ P.reshape(-1, 3))_i``.
+
+        ``E_{i, k n_v + l} = D^{du} b_k(u_i) D^{dv} b_l(v_i)``; ``u`` and ``v`` are
+        flattened after broadcasting to a common shape.
+        """
+        u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
+        u, v = u.ravel(), v.ravel()
+        iu, bu = self.basis_u.nonzero(u, du)
+        iv, bv = self.basis_v.nonzero(v, dv)
+        values = bu[:, :, None] * bv[:, None, :]
+        cols = iu[:, :, None] * self.basis_v.size + iv[:, None, :]
+        rows = np.broadcast_to(np.arange(u.size)[:, None, None], values.shape)
+        return sp.csr_matrix((values.ravel(), (rows.ravel(), cols.ravel())),
+                             shape=(u.size, self.basis_u.size * self.basis_v.size))
+
+    def derivative(self, u: ArrayLike, v: ArrayLike, du: int = 0, dv: int = 0,
+                   control_points: ArrayLike | None = None) -> NDArray[np.float64]:
+        """Partial derivative ``∂^{du+dv} x / ∂u^du ∂v^dv`` at parameters ``(u, v)``.
+
+        ``u`` and ``v`` broadcast to a common shape ``S``; returns ``S + (3,)``.
+        ``control_points`` evaluates another net (e.g. a displacement) on the same bases.
+        """
+        u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
+        P = self.control_points if control_points is None else np.asarray(control_points, float)
+        E = self.evaluation_matrix(u, v, du, dv)
+        return np.asarray(E @ P.reshape(E.shape[1], -1)).reshape(u.shape + P.shape[2:])
+
+    def evaluate(self, u: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
+        """Points ``x(u, v)``; ``u`` and ``v`` broadcast to ``S``, result ``S + (3,)``."""
+        return self.derivative(u, v)
+
+    def evaluate_grid(self, u: ArrayLike, v: ArrayLike, du: int = 0, dv: int = 0,
+                      control_points: ArrayLike | None = None) -> NDArray[np.float64]:
+        """Tensor grid evaluation ``X[i, j] = Σ_kl p_kl D^du b_k(u_i) D^dv b_l(v_j)``.
+
+        Two sparse products ``B_u P B_vᵀ`` per coordinate; result ``(len(u), len(v), 3)``.
+        """
+        P = self.control_points if control_points is None else np.asarray(control_points, float)
+        Bu = self.basis_u.matrix(u, du)
+        Bv = self.basis_v.matrix(v, dv)
+        n_u, n_v = self.shape
+        tmp = (Bu @ P.reshape(n_u, -1)).reshape(Bu.shape[0], n_v, -1)   # (Nu, n_v, c)
+        out = Bv @ tmp.transpose(1, 0, 2).reshape(n_v, -1)               # (Nv, Nu*c)
+        return np.asarray(out).reshape(Bv.shape[0], Bu.shape[0], -1).transpose(1, 0, 2)
+
+    def normal(self, u: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
+        """Unit normal ``n = x_u × x_v / |x_u × x_v|``; raises where the surface is degenerate."""
+        cross = np.cross(self.derivative(u, v, 1, 0), self.derivative(u, v, 0, 1))
+        length = np.linalg.norm(cross, axis=-1, keepdims=True)
+        if np.any(length <= 1e-14 * max(1.0, float(np.abs(self.control_points).max()))):
+            raise InputError("the surface is degenerate (x_u × x_v = 0) at some of the given "
+                             "parameters; its normal is undefined there")
+        return cross / length
+
+    def sample_parameters(self, resolution: int | tuple[int, int]
+                          ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Evenly spaced parameters covering the domain (periodic directions include the seam twice)."""
+        ru, rv = (resolution, resolution) if np.isscalar(resolution) else resolution
+        if int(ru) < 2 or int(rv) < 2:
+            raise InputError(f"tessellation resolution must be >= 2 per direction, got {resolution}")
+        return (np.linspace(0.0, self.basis_u.length, int(ru)),
+                np.linspace(0.0, self.basis_v.length, int(rv)))
+
+    def tessellate(self, resolution: int | tuple[int, int] = 32,
+                   control_points: ArrayLike | None = None
+                   ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+        """Triangle mesh of the surface on a ``ru × rv`` parameter grid.
+
+        Returns ``vertices (ru*rv, 3)`` and ``faces (2 (ru-1)(rv-1), 3)`` (counter-clockwise
+        in parameter space, so face normals follow ``x_u × x_v``).
+        """
+        u, v = self.sample_parameters(resolution)
+        vertices = self.evaluate_grid(u, v, control_points=control_points).reshape(-1, 3)
+        return vertices, grid_faces(u.size, v.size)
+
+
+def grid_faces(ru: int, rv: int) -> NDArray[np.int64]:
+    """Two triangles per quad of a row-major ``ru × rv`` vertex grid."""
+    i, j = np.meshgrid(np.arange(ru - 1), np.arange(rv - 1), indexing="ij")
+    a = (i * rv + j).ravel()
+    b, c, d = a + rv, a + rv + 1, a + 1
+    return np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)]).astype(np.int64)
