@@ -1,10 +1,28 @@
-"""splinedeform: physical deformation of B-spline surfaces, solved analytically."""
+"""splinedeform: physical deformation of B-spline surfaces, solved analytically.
 
+>>> import splinedeform as sd
+>>> surf = sd.shapes.plane(size=(1.0, 1.0), cells=(8, 8))
+>>> model = sd.Model(surf, sd.Material(w20=1, w11=1, w02=1), boundary="clamped")
+>>> st = model.static(sd.loads.Uniform((0, 0, -1.0)))
+"""
+
+from . import loads
 from .basis import BSplineBasis
 from .errors import InputError, ScenarioError, SingularSystemError
+from .loads import Constant, Function, Harmonic, Piecewise, Point, Pressure, Step, Uniform
+from .material import Material
+from .model import Model
+from .solution import Energy, Solution, StaticSolution
 from .surface import Surface
+
+try:  # built-in shapes and fitting
+    from . import shapes
+except ImportError:  # pragma: no cover - during development only
+    shapes = None  # type: ignore[assignment]
 
 __version__ = "0.1.0"
 
-__all__ = ["BSplineBasis", "InputError", "ScenarioError", "SingularSystemError", "Surface",
-           "__version__"]
+__all__ = ["BSplineBasis", "Constant", "Energy", "Function", "Harmonic", "InputError",
+           "Material", "Model", "Piecewise", "Point", "Pressure", "ScenarioError",
+           "SingularSystemError", "Solution", "StaticSolution", "Step", "Surface", "Uniform",
+           "loads", "shapes", "__version__"]

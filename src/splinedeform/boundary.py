@@ -1,0 +1,176 @@
+"""Boundary conditions as a sparse constraint map ``d = T d_free`` (DESIGN.md §1.6).
+
+Per edge a preset: ``free``, ``pinned`` (``d = 0`` on the edge) or ``clamped`` (``d = 0``
+and ``∂_n d = 0``). In one direction the end conditions are linear constraints
+``C c = 0`` on the coefficients ``c`` of the 1-D basis, ``C`` made of rows ``b(x_e)`` and
+``b'(x_e)`` at the ends. For open knots these are ``c_0 = 0`` (and ``c_1 = 0``); for
+Höllig's uniform knots they couple the ``n`` outer coefficients. Each end's constraints are
+solved for as many of its outermost coefficients (pivoted), giving a sparse ``T_1d``
+whose columns are the kept coefficients. Per-edge conditions give ``T = T_u ⊗ T_v``.
+A mask of fixed control points removes further columns (the paper's reduced set of moving
+control points); when the free region is a rectangle of the net the Kronecker form survives.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Mapping
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+from numpy.typing import NDArray
+
+from .basis import BSplineBasis
+from .errors import InputError
+
+PRESETS = ("free", "pinned", "clamped")
+EDGES = ("u0", "u1", "v0", "v1")
+
+
+def edge_conditions(boundary: str | Mapping[str, str]) -> dict[str, str]:
+    """Normalise ``"clamped"`` or ``{"u0": ..., ...}`` to a preset for each of the four edges."""
+    if isinstance(boundary, str):
+        if boundary not in PRESETS:
+            raise InputError(f"boundary preset must be one of {PRESETS}, got {boundary!r}")
+        return {e: boundary for e in EDGES}
+    if not isinstance(boundary, Mapping):
+        raise InputError(f"boundary must be a preset name or a mapping edge -> preset, got "
+                         f"{type(boundary).__name__}")
+    unknown = set(boundary) - set(EDGES)
+    if unknown:
+        raise InputError(f"unknown boundary edge(s) {sorted(unknown)}; edges are {EDGES}")
+    out = {e: boundary.get(e, "free") for e in EDGES}
+    for e, preset in out.items():
+        if preset not in PRESETS:
+            raise InputError(f"boundary.{e} must be one of {PRESETS}, got {preset!r}")
+    return out
+
+
+def end_constraints(basis: BSplineBasis, end: int, preset: str) -> sp.csr_matrix:
+    """Rows ``D^j b(x_e)``, ``j < r``, with ``r = 0, 1, 2`` for free, pinned, clamped."""
+    order = PRESETS.index(preset)
+    if order == 0:
+        return sp.csr_matrix((0, basis.size))
+    x = np.array([0.0 if end == 0 else basis.length])
+    return sp.vstack([basis.matrix(x, j) for j in range(order)]).tocsr()
+
+
+def constraint_map(basis: BSplineBasis, start: str, end: str
+                   ) -> tuple[sp.csr_matrix, NDArray[np.int64]]:
+    """1-D constraint map ``T`` (size × kept) and the indices of the kept coefficients.
+
+    The constrained coefficients of each end are eliminated: with the end's rows split into
+    the eliminated columns ``E`` and the rest ``R``, ``c_E = -C_E^{-1} C_R c_R``.
+    """
+    if basis.periodic and (start, end) != ("free", "free"):
+        raise InputError(f"a periodic direction has no edges; its boundary presets must be "
+                         f"'free', got {start!r} and {end!r}")
+    size = basis.size
+    eliminated: dict[int, NDArray[np.float64]] = {}   # coefficient -> row over all columns
+    for which, preset in ((0, start), (1, end)):
+        C = end_constraints(basis, which, preset).toarray()
+        if C.shape[0] == 0:
+            continue
+        support = np.flatnonzero(np.any(C != 0, axis=0))
+        order = support if which == 0 else support[::-1]   # outermost first
+        r = C.shape[0]
+        chosen = np.arange(r)                       # the outermost coefficients, if possible
+        if np.linalg.cond(C[:, order[:r]]) > 1e8:   # otherwise the best-conditioned pivots
+            chosen = np.sort(sla.qr(C[:, order], pivoting=True)[2][:r])
+        E = order[chosen]
+        R = np.setdiff1d(support, E)
+        CE = C[:, E]
+        if abs(np.linalg.det(CE)) < 1e-12 * np.abs(C).max() ** C.shape[0]:
+            raise InputError(f"cannot impose a {preset} edge with degree {basis.degree} "
+                             f"and {basis.cells} cell(s); refine the net")
+        coupling = -np.linalg.solve(CE, C[:, R])
+        for row, e in enumerate(E):
+            if e in eliminated:
+                raise InputError(f"the two edge conditions of a {basis.kind} basis with "
+                                 f"{basis.cells} cell(s) overlap; use more cells")
+            full = np.zeros(size)
+            full[R] = coupling[row]
+            eliminated[e] = full
+    kept = np.array([j for j in range(size) if j not in eliminated], dtype=np.int64)
+    T = np.zeros((size, kept.size))
+    T[kept, np.arange(kept.size)] = 1.0
+    for e, row in eliminated.items():
+        T[e] = row[kept]
+        if np.any(row[list(eliminated)] != 0):
+            raise InputError("edge conditions couple eliminated coefficients; use more cells")
+    return sp.csr_matrix(T), kept
+
+
+@dataclass(frozen=True)
+class Constraints:
+    """The map ``d = T d_free`` from free coordinates to all control points.
+
+    Attributes
+    ----------
+    T : scipy.sparse.csr_matrix, shape ``(n_u n_v, n_free)``
+    T_u, T_v : sparse 1-D maps, or ``None`` when a mask broke the tensor structure
+    free_index : ndarray of int
+        Flat index of the control point each free coordinate stands for.
+    edges : dict
+        The edge presets.
+    """
+
+    T: sp.csr_matrix
+    T_u: sp.csr_matrix | None
+    T_v: sp.csr_matrix | None
+    free_index: NDArray[np.int64]
+    edges: dict[str, str]
+    has_fixed_points: bool
+
+    @property
+    def n_free(self) -> int:
+        return self.T.shape[1]
+
+    @property
+    def unconstrained(self) -> bool:
+        """No edge condition and no fixed control point: rigid motions are free."""
+        return all(p == "free" for p in self.edges.values()) and not self.has_fixed_points
+
+
+def build_constraints(basis_u: BSplineBasis, basis_v: BSplineBasis,
+                      boundary: str | Mapping[str, str] = "free",
+                      fixed: NDArray[np.bool_] | None = None) -> Constraints:
+    """Assemble ``T`` from edge presets and an optional mask of fixed control points.
+
+    Parameters
+    ----------
+    boundary : str or mapping
+        A preset for all edges or ``{"u0": ..., "u1": ..., "v0": ..., "v1": ...}``
+        (missing edges are free). ``u0`` is the edge ``u = 0``.
+    fixed : bool array ``(n_u, n_v)``, optional
+        ``True`` marks control points that do not move. A control point already
+        determined by an edge condition follows that condition.
+    """
+    edges = edge_conditions(boundary)
+    T_u, keep_u = constraint_map(basis_u, edges["u0"], edges["u1"])
+    T_v, keep_v = constraint_map(basis_v, edges["v0"], edges["v1"])
+    n_v = basis_v.size
+    free_index = (keep_u[:, None] * n_v + keep_v[None, :]).ravel()
+    if fixed is None:
+        T = sp.kron(T_u, T_v, format="csr")
+        return Constraints(T, T_u, T_v, free_index, edges, False)
+    mask = np.asarray(fixed)
+    if mask.shape != (basis_u.size, basis_v.size):
+        raise InputError(f"fixed mask must have shape (n_u, n_v) = "
+                         f"{(basis_u.size, basis_v.size)}, got {mask.shape}")
+    if mask.dtype != bool:
+        raise InputError(f"fixed mask must be boolean, got dtype {mask.dtype}")
+    moving = ~mask[np.ix_(keep_u, keep_v)]
+    rows_u, rows_v = np.any(moving, axis=1), np.any(moving, axis=0)
+    rectangle = np.array_equal(moving, np.outer(rows_u, rows_v))
+    if not moving.any():
+        raise InputError("every control point is fixed: nothing can move")
+    if rectangle:
+        T_u, T_v = T_u[:, rows_u], T_v[:, rows_v]
+        T = sp.kron(T_u, T_v, format="csr")
+        free_index = (keep_u[rows_u][:, None] * n_v + keep_v[rows_v][None, :]).ravel()
+        return Constraints(T, T_u, T_v, free_index, edges, bool(mask.any()))
+    T = sp.kron(T_u, T_v, format="csr")[:, moving.ravel()]
+    return Constraints(T.tocsr(), None, None, free_index[moving.ravel()], edges,
+                       bool(mask.any()))

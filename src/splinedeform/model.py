@@ -1,0 +1,289 @@
+"""The deformation model: Galerkin matrices by Kronecker products, reduction, solves.
+
+For every coordinate alike (DESIGN.md §1.5)::
+
+    M = μ G0u⊗G0v                    (or its row-sum lumped diagonal)
+    C = (γ/μ) M + β K
+    K = w10 G1u⊗G0v + w01 G0u⊗G1v + w20 G2u⊗G0v + 2 w11 G1u⊗G1v + w02 G0u⊗G2v
+
+with exact 1-D Gram matrices ``G_a``; constraints ``d = T d_free`` reduce them to
+``M_r = Tᵀ M T`` etc. Data flows one way: surface + material + boundary → model →
+static / modes / dynamic solutions.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any, Mapping
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from numpy.typing import ArrayLike, NDArray
+
+from .boundary import Constraints, build_constraints
+from .errors import InputError, SingularSystemError
+from .loads import Load, as_load
+from .material import Material
+from .quadrature import gram_matrix
+from .solution import ModalSolution, SampledSolution, StaticSolution
+from .solvers.analytic import ModalResponse
+from .surface import Surface
+
+Array = NDArray[np.float64]
+METHODS = ("analytic", "newmark", "rk45", "dop853", "radau", "bdf")
+
+
+def stiffness(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], material: Material
+              ) -> sp.csr_matrix:
+    """``K = w10 G1u⊗G0v + w01 G0u⊗G1v + w20 G2u⊗G0v + 2 w11 G1u⊗G1v + w02 G0u⊗G2v``."""
+    terms = [(material.w10, 1, 0), (material.w01, 0, 1), (material.w20, 2, 0),
+             (2 * material.w11, 1, 1), (material.w02, 0, 2)]
+    K = sp.csr_matrix((gram_u[0].shape[0] * gram_v[0].shape[0],) * 2)
+    for weight, a, b in terms:
+        if weight:
+            K = K + weight * sp.kron(gram_u[a], gram_v[b], format="csr")
+    return K.tocsr()
+
+
+def mass(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], density: float,
+         lumped: bool = False) -> sp.csr_matrix:
+    """``M = μ G0u⊗G0v``, or lumped: ``μ diag(rowsum G0u ⊗ rowsum G0v)``."""
+    if lumped:
+        rows = np.kron(np.asarray(gram_u[0].sum(axis=1)).ravel(),
+                       np.asarray(gram_v[0].sum(axis=1)).ravel())
+        return sp.diags(density * rows, format="csr")
+    return (density * sp.kron(gram_u[0], gram_v[0], format="csr")).tocsr()
+
+
+class Model:
+    """A B-spline surface with a material and boundary conditions.
+
+    Parameters
+    ----------
+    surface : Surface
+        The initial (and, by default, rest) surface.
+    material : Material
+    boundary : str or mapping, default "free"
+        ``"free" | "pinned" | "clamped"`` for all edges, or per edge
+        ``{"u0": ..., "u1": ..., "v0": ..., "v1": ...}`` (missing edges are free).
+    fixed : bool array ``(n_u, n_v)``, optional
+        Control points that do not move (the paper's reduced set of moving points).
+    mass_matrix : {"consistent", "lumped"}
+        Consistent ``μ G0⊗G0`` (accurate) or row-sum lumped (diagonal, cheaper).
+    rest : {"initial", "none"}
+        Rest shape: the initial surface (an unloaded surface stays put), or none (the
+        energy of the position itself, i.e. the extra load ``-K p0``).
+
+    Examples
+    --------
+    >>> import splinedeform as sd
+    >>> surf = sd.shapes.plane(cells=(4, 4))
+    >>> model = sd.Model(surf, sd.Material(w10=1, w01=1), boundary="clamped")
+    >>> model.n_free
+    9
+    """
+
+    def __init__(self, surface: Surface, material: Material,
+                 boundary: str | Mapping[str, str] = "free", fixed: ArrayLike | None = None,
+                 mass_matrix: str = "consistent", rest: str = "initial"):
+        start = time.perf_counter()
+        if not isinstance(surface, Surface):
+            raise InputError(f"surface must be a splinedeform.Surface, got {type(surface).__name__}")
+        if not isinstance(material, Material):
+            raise InputError(f"material must be a splinedeform.Material, got "
+                             f"{type(material).__name__}")
+        if mass_matrix not in ("consistent", "lumped"):
+            raise InputError(f"mass_matrix must be 'consistent' or 'lumped', got {mass_matrix!r}")
+        if rest not in ("initial", "none"):
+            raise InputError(f"rest must be 'initial' or 'none', got {rest!r}")
+        for name, basis, weight in (("u", surface.basis_u, material.w20),
+                                    ("v", surface.basis_v, material.w02)):
+            if weight and basis.degree < 2:
+                raise InputError(f"bending weight w{'20' if name == 'u' else '02'} needs degree "
+                                 f">= 2 in {name} (second derivatives), got {basis.degree}")
+        self.surface = surface
+        self.material = material
+        self.mass_matrix = mass_matrix
+        self.rest = rest
+        self.constraints: Constraints = build_constraints(
+            surface.basis_u, surface.basis_v, boundary,
+            None if fixed is None else np.asarray(fixed))
+        top = lambda b: min(2, b.degree)  # noqa: E731
+        self.gram_u = [gram_matrix(surface.basis_u, a) for a in range(top(surface.basis_u) + 1)]
+        self.gram_v = [gram_matrix(surface.basis_v, a) for a in range(top(surface.basis_v) + 1)]
+        K = stiffness(self.gram_u, self.gram_v, material)
+        M = mass(self.gram_u, self.gram_v, material.mass, mass_matrix == "lumped")
+        T = self.constraints.T
+        self.K_full, self.M_full = K, M
+        self._K = (T.T @ K @ T).tocsc()
+        self._M = (T.T @ M @ T).tocsc()
+        self._C = ((material.damping / material.mass) * self._M
+                   + material.rayleigh * self._K).tocsc()
+        self._eigen: tuple[Array, Array] | None = None
+        self.timings: dict[str, float] = {"assembly": time.perf_counter() - start}
+
+    # -- layout --------------------------------------------------------------------
+    @property
+    def n_free(self) -> int:
+        """Number of free coordinates (moving control points per coordinate)."""
+        return self.constraints.n_free
+
+    def matrices(self) -> tuple[sp.csc_matrix, sp.csc_matrix, sp.csc_matrix]:
+        """Reduced ``(M_r, C_r, K_r)``, each ``(n_free, n_free)``, shared by x, y and z."""
+        return self._M, self._C, self._K
+
+    def to_full(self, d_free: Array) -> Array:
+        """Full displacement net ``T d_free`` as ``(n_u, n_v, 3)`` (or ``(n_u, n_v)`` for a scalar field)."""
+        full = self.constraints.T @ d_free
+        return np.asarray(full).reshape(self.surface.shape + np.shape(d_free)[1:])
+
+    def load_vector(self, load: Load, t: float = 0.0) -> Array:
+        """Reduced generalised force ``Tᵀ (F(t) [- K p0 when rest='none'])``, shape ``(n_free, 3)``."""
+        F = as_load(load).vector(self.surface, t)
+        return self._reduce_force(F)
+
+    def _reduce_force(self, F_full: Array) -> Array:
+        if self.rest == "none":
+            F_full = F_full - self.K_full @ self.surface.control_points.reshape(-1, 3)
+        return np.asarray(self.constraints.T.T @ F_full)
+
+    # -- static ----------------------------------------------------------------------
+    def static(self, load: Load | None) -> StaticSolution:
+        """Equilibrium ``K_r d = Tᵀ F`` by a sparse direct solve.
+
+        Raises
+        ------
+        SingularSystemError
+            When the surface is unconstrained (rigid motions have no stiffness) or the
+            weights leave some deformation without energy.
+        """
+        start = time.perf_counter()
+        if self.constraints.unconstrained:
+            raise SingularSystemError(
+                "static solve of an unconstrained surface: every edge is free and no control "
+                "point is fixed, so rigid translations cost no energy and K is singular. "
+                "Fix an edge (boundary='clamped' or e.g. {'u0': 'pinned'}) or some control "
+                "points (fixed=mask)")
+        F = self.load_vector(as_load(load))
+        d = self._solve_stiffness(F)
+        return StaticSolution(self, d, F, {"static": time.perf_counter() - start})
+
+    def _solve_stiffness(self, F: Array) -> Array:
+        message = ("the stiffness matrix is singular for these boundary conditions and weights "
+                   f"(edges {self.constraints.edges}, weights w10..w02 = "
+                   f"{[self.material.w10, self.material.w01, self.material.w20, self.material.w11, self.material.w02]}): "
+                   "some deformation has no energy. Constrain the edges the weights do not "
+                   "reach (e.g. tension only in u needs pinned u0/u1 edges), or add weights")
+        try:
+            d = spla.splu(self._K).solve(F)
+        except RuntimeError:
+            raise SingularSystemError(message) from None
+        residual = np.linalg.norm(self._K @ d - F)
+        if not np.all(np.isfinite(d)) or residual > 1e-8 * max(np.linalg.norm(F), 1e-300):
+            raise SingularSystemError(message)
+        return d
+
+    # -- modes -------------------------------------------------------------------------
+    def eigen(self, k: int | None = None) -> tuple[Array, Array]:
+        """Lowest ``k`` (default all) eigenpairs of ``K_r φ = λ M_r φ`` with ``Φᵀ M_r Φ = I``.
+
+        Dense ``eigh`` of the reduced system (the reference path); cached.
+        """
+        if self._eigen is None:
+            start = time.perf_counter()
+            lam, phi = sla.eigh(self._K.toarray(), self._M.toarray(), check_finite=False)
+            self._eigen = (np.maximum(lam, 0.0), phi)
+            self.timings["eigen"] = time.perf_counter() - start
+        lam, phi = self._eigen
+        k = lam.size if k is None else _check_count(k, lam.size)
+        return lam[:k], phi[:, :k]
+
+    def frequencies(self, k: int = 6) -> Array:
+        """Lowest ``k`` undamped angular frequencies ``ω_i = √λ_i``, ascending."""
+        return np.sqrt(self.eigen(k)[0])
+
+    def modes(self, k: int = 6) -> tuple[Array, Array]:
+        """Lowest ``k`` frequencies and mode shapes as scalar fields on the net ``(k, n_u, n_v)``."""
+        lam, phi = self.eigen(k)
+        shapes = np.asarray(self.constraints.T @ phi).T.reshape((phi.shape[1],) + self.surface.shape)
+        return np.sqrt(lam), shapes
+
+    # -- dynamics ------------------------------------------------------------------------
+    def initial_state(self, displacement: ArrayLike | None, velocity: ArrayLike | None
+                      ) -> tuple[Array, Array]:
+        """Free coordinates of an initial displacement/velocity of the control net."""
+        return (self._to_free(displacement, "initial_displacement"),
+                self._to_free(velocity, "initial_velocity"))
+
+    def _to_free(self, net: ArrayLike | None, what: str) -> Array:
+        if net is None:
+            return np.zeros((self.n_free, 3))
+        arr = np.asarray(net, dtype=float)
+        if arr.shape != self.surface.shape + (3,):
+            raise InputError(f"{what} must have shape (n_u, n_v, 3) = "
+                             f"{self.surface.shape + (3,)}, got {arr.shape}")
+        if not np.all(np.isfinite(arr)):
+            raise InputError(f"{what} must be finite")
+        T = self.constraints.T
+        flat = arr.reshape(-1, 3)
+        free = spla.spsolve((T.T @ T).tocsc(), T.T @ flat).reshape(-1, 3)
+        if np.linalg.norm(T @ free - flat) > 1e-9 * max(np.linalg.norm(flat), 1e-300):
+            raise InputError(f"{what} moves control points that the boundary conditions fix")
+        return free
+
+    def dynamic(self, load: Load | None, t_end: float, method: str = "analytic",
+                times: ArrayLike | None = None, initial_displacement: ArrayLike | None = None,
+                initial_velocity: ArrayLike | None = None, **options: Any) -> Any:
+        """Motion under ``load`` on ``[0, t_end]``.
+
+        Parameters
+        ----------
+        method : {"analytic", "newmark", "rk45", "dop853", "radau", "bdf"}
+            ``analytic`` is the closed-form modal solution, valid at any ``t``.
+            Numerical methods integrate to the output ``times``.
+        times : array, optional
+            Output times for numerical methods (default 201 evenly spaced on ``[0, t_end]``).
+        options
+            ``analytic``: ``function_samples`` (piecewise-constant sampling of time-dependent
+            ``Function`` loads, default 400). ``newmark``: ``dt``. ``solve_ivp`` methods:
+            ``rtol``, ``atol``, ``max_step``.
+        """
+        from .solvers import numeric
+
+        if method not in METHODS:
+            raise InputError(f"unknown method {method!r}; choose one of {METHODS}")
+        try:
+            t_end = float(t_end)
+        except (TypeError, ValueError):
+            raise InputError(f"t_end must be a number, got {t_end!r}") from None
+        if not np.isfinite(t_end) or t_end <= 0:
+            raise InputError(f"t_end must be finite and > 0, got {t_end}")
+        load = as_load(load)
+        d0, v0 = self.initial_state(initial_displacement, initial_velocity)
+        forcing = numeric.ReducedForcing(self, load)
+        if method == "analytic":
+            return self._analytic(forcing, t_end, d0, v0, **options)
+        return numeric.integrate(self, forcing, method, t_end, times, d0, v0, **options)
+
+    def _analytic(self, forcing: Any, t_end: float, d0: Array, v0: Array,
+                  function_samples: int = 400) -> ModalSolution:
+        lam, phi = self.eigen()
+        start = time.perf_counter()
+        M = self._M
+        c = self.material.damping / self.material.mass + self.material.rayleigh * lam
+        jumps, harmonics = forcing.modal_terms(phi, t_end, function_samples)
+        response = ModalResponse(lam, c, phi.T @ (M @ d0), phi.T @ (M @ v0), jumps, harmonics)
+        timings = dict(self.timings)
+        timings["modal setup"] = time.perf_counter() - start
+        return ModalSolution(self, t_end, forcing, timings, phi, response, {})
+
+
+def _check_count(k: int, available: int) -> int:
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
+        raise InputError(f"number of modes must be an integer >= 1, got {k!r}")
+    if k > available:
+        raise InputError(f"asked for {k} modes but the model has only {available} free "
+                         "coordinates")
+    return int(k)

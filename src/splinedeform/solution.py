@@ -1,0 +1,225 @@
+"""Solutions: the deformed control net, surface and energies at any requested time.
+
+A solution holds its state in the reduced (free) coordinates ``d_free`` of the constraint
+map ``d = T d_free``; control points are ``p(t) = p_rest + T d_free(t)`` (three coordinates
+share ``T``). Energies follow DESIGN.md §1.4: kinetic ``½ Σ_c v_cᵀ M v_c``, strain
+``½ Σ_c d_cᵀ K d_c``, work of the current load ``Σ_c F_c(t)ᵀ d_c`` and
+``total = kinetic + strain - work`` (conserved for a constant load without damping).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Callable
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import ArrayLike, NDArray
+
+from .errors import InputError
+from .surface import Surface
+
+if TYPE_CHECKING:
+    from .model import Model
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Energy:
+    """Energies at the requested times (arrays of the times' shape)."""
+
+    kinetic: Array
+    strain: Array
+    work: Array
+
+    @property
+    def total(self) -> Array:
+        """``kinetic + strain - work``."""
+        return self.kinetic + self.strain - self.work
+
+
+def _check_times(t: ArrayLike, t_end: float | None = None) -> tuple[Array, bool]:
+    arr = np.asarray(t, dtype=float)
+    if arr.ndim > 1:
+        raise InputError(f"times must be a number or a 1-D array, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise InputError("times must be finite")
+    if np.any(arr < 0):
+        raise InputError(f"times must be >= 0, got {arr.min():g}")
+    if t_end is not None and np.any(arr > t_end * (1 + 1e-12)):
+        raise InputError(f"this numerical solution covers [0, {t_end:g}]; got t = {arr.max():g}")
+    return np.atleast_1d(arr), arr.ndim == 0
+
+
+class _Displaced:
+    """Shared read-out of a state in free coordinates."""
+
+    model: Model
+
+    def _full(self, d_free: Array) -> Array:
+        """``p_rest + T d_free`` for ``d_free`` of shape ``(..., n_free, 3)`` → ``(..., n_u, n_v, 3)``."""
+        m = self.model
+        T = m.constraints.T
+        lead = d_free.shape[:-2]
+        flat = np.moveaxis(d_free, -2, 0).reshape(T.shape[1], -1)
+        full = np.moveaxis((T @ flat).reshape((T.shape[0],) + lead + (3,)), 0, -2)
+        return m.surface.control_points + full.reshape(lead + m.surface.shape + (3,))
+
+
+class StaticSolution(_Displaced):
+    """Equilibrium ``K d = F`` of a model under a load (see :meth:`Model.static`)."""
+
+    def __init__(self, model: Model, d_free: Array, force_free: Array, timings: dict[str, float]):
+        self.model = model
+        self.d_free = d_free
+        self.force_free = force_free
+        self.timings = timings
+
+    def control_points(self) -> Array:
+        """Deformed control net ``(n_u, n_v, 3)``."""
+        return self._full(self.d_free)
+
+    def surface(self) -> Surface:
+        """The deformed surface."""
+        return self.model.surface.with_control_points(self.control_points(), name="static")
+
+    def displacement(self, u: ArrayLike, v: ArrayLike) -> Array:
+        """Displacement ``d(u, v)`` of surface points, shape ``S + (3,)``."""
+        net = self.control_points() - self.model.surface.control_points
+        return self.model.surface.derivative(u, v, control_points=net)
+
+    def energy(self) -> Energy:
+        K = self.model.matrices()[2]
+        strain = 0.5 * np.sum(self.d_free * (K @ self.d_free))
+        work = np.sum(self.force_free * self.d_free)
+        return Energy(np.array(0.0), np.array(strain), np.array(work))
+
+
+class Solution(_Displaced):
+    """Motion of the control net; subclasses provide the state in free coordinates.
+
+    Attributes
+    ----------
+    method : str
+    t_end : float
+    timings : dict
+        Seconds spent per stage (``assembly``, ``eigen``, ``integration``, …).
+    """
+
+    exact_between_frames = True
+
+    def __init__(self, model: Model, method: str, t_end: float,
+                 force_free: Callable[[float], Array], timings: dict[str, float]):
+        self.model = model
+        self.method = method
+        self.t_end = float(t_end)
+        self._force_free = force_free
+        self.timings = timings
+
+    def state(self, t: ArrayLike) -> tuple[Array, Array]:
+        """Free displacements and velocities at times ``t`` (F,), each ``(F, n_free, 3)``."""
+        raise NotImplementedError
+
+    def control_points(self, t: ArrayLike) -> Array:
+        """Control net at ``t``: ``(n_u, n_v, 3)`` for a number, ``(F, n_u, n_v, 3)`` for an array."""
+        times, scalar = _check_times(t)
+        nets = self._full(self.state(times)[0])
+        return nets[0] if scalar else nets
+
+    def velocities(self, t: ArrayLike) -> Array:
+        """Control point velocities, same shapes as :meth:`control_points`."""
+        times, scalar = _check_times(t)
+        vel = self._full(self.state(times)[1]) - self.model.surface.control_points
+        return vel[0] if scalar else vel
+
+    def surface(self, t: float) -> Surface:
+        """The deformed surface at time ``t``."""
+        return self.model.surface.with_control_points(self.control_points(float(t)),
+                                                      name=f"t={float(t):g}")
+
+    def displacement(self, t: ArrayLike, u: ArrayLike, v: ArrayLike) -> Array:
+        """Displacement of surface points: ``S + (3,)`` for scalar ``t``, ``(F,) + S + (3,)`` else."""
+        times, scalar = _check_times(t)
+        nets = self.control_points(times) - self.model.surface.control_points
+        u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
+        E = self.model.surface.evaluation_matrix(u, v)
+        flat = np.moveaxis(nets.reshape(times.size, -1, 3), 0, 1).reshape(E.shape[1], -1)
+        out = np.moveaxis((E @ flat).reshape(E.shape[0], times.size, 3), 1, 0)
+        out = out.reshape((times.size,) + u.shape + (3,))
+        return out[0] if scalar else out
+
+    def energy(self, t: ArrayLike) -> Energy:
+        """Kinetic, strain and load-work energies at ``t`` (see the module docstring)."""
+        times, scalar = _check_times(t)
+        M, _, K = self.model.matrices()
+        d, v = self.state(times)
+        kinetic = 0.5 * _quadratic(M, v)
+        strain = 0.5 * _quadratic(K, d)
+        work = np.array([np.sum(self._force_free(ti) * di) for ti, di in zip(times, d)])
+        if scalar:
+            return Energy(kinetic[0], strain[0], work[0])
+        return Energy(kinetic, strain, work)
+
+
+def _quadratic(A: sp.spmatrix, x: Array) -> Array:
+    """``Σ_c x_cᵀ A x_c`` for each frame of ``x`` (F, n, 3)."""
+    F, n, _ = x.shape
+    flat = np.moveaxis(x, 1, 0).reshape(n, -1)
+    return np.sum(flat * (A @ flat), axis=0).reshape(F, 3).sum(axis=1)
+
+
+class ModalSolution(Solution):
+    """Analytic solution: ``d_free(t) = Φ Q(t)`` with closed-form modal coordinates."""
+
+    def __init__(self, model: Model, t_end: float, force_free: Callable[[float], Array],
+                 timings: dict[str, float], phi: Array, response: Callable, omitted: dict):
+        super().__init__(model, "analytic", t_end, force_free, timings)
+        self.phi = phi
+        self.response = response
+        self.truncation = omitted
+        self._full_phi: Array | None = None
+
+    def state(self, t: ArrayLike) -> tuple[Array, Array]:
+        times, _ = _check_times(t)
+        Q, V = self.response(times)
+        d = np.einsum("nk,fkc->fnc", self.phi, Q, optimize=True)
+        v = np.einsum("nk,fkc->fnc", self.phi, V, optimize=True)
+        static = getattr(self.response, "static_correction", None)
+        if static is not None:
+            d = d + static(times)
+        return d, v
+
+    def modal(self, t: ArrayLike) -> tuple[Array, Array]:
+        """Modal coordinates ``Q(t), Q'(t)``, each ``(F, N, 3)``."""
+        return self.response(_check_times(t)[0])
+
+
+class SampledSolution(Solution):
+    """Numerical solution stored at output times; cubic Hermite in between."""
+
+    exact_between_frames = False
+
+    def __init__(self, model: Model, method: str, t_end: float,
+                 force_free: Callable[[float], Array], timings: dict[str, float],
+                 times: Array, d: Array, v: Array, stats: dict):
+        super().__init__(model, method, t_end, force_free, timings)
+        self.times, self.d, self.v = times, d, v
+        self.stats = stats
+
+    def state(self, t: ArrayLike) -> tuple[Array, Array]:
+        times, _ = _check_times(t, self.t_end)
+        i = np.clip(np.searchsorted(self.times, times, side="right") - 1, 0,
+                    max(len(self.times) - 2, 0))
+        if len(self.times) == 1:
+            return self.d[[0] * times.size], self.v[[0] * times.size]
+        t0, t1 = self.times[i], self.times[i + 1]
+        h = (t1 - t0)[:, None, None]
+        s = ((times - t0) / (t1 - t0))[:, None, None]
+        d0, d1, v0, v1 = self.d[i], self.d[i + 1], self.v[i], self.v[i + 1]
+        h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
+        h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
+        d = h00 * d0 + h10 * h * v0 + h01 * d1 + h11 * h * v1
+        dv = ((6 * s**2 - 6 * s) * d0 + (3 * s**2 - 4 * s + 1) * h * v0
+              + (-6 * s**2 + 6 * s) * d1 + (3 * s**2 - 2 * s) * h * v1) / h
+        return d, dv

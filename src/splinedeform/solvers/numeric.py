@@ -1,0 +1,226 @@
+"""Numerical reference integrators for ``M p'' + C p' + K p = F(t)`` (DESIGN.md §1.8).
+
+* Newmark-β, average acceleration (β = ¼, γ = ½): unconditionally stable, second order;
+  ``K_eff = K + (2/Δt) C + (4/Δt²) M`` factorised once per distinct step.
+* ``scipy.integrate.solve_ivp`` (RK45, DOP853, Radau, BDF) on the first-order form
+  ``y = (d, v)``, ``v' = M⁻¹ (F - C v - K d)`` with a sparse LU of ``M``; the stiff methods get
+  the exact Jacobian.
+
+Both restart at the load's breakpoints (steps and switches), so discontinuities do not cost
+accuracy, and return a :class:`~splinedeform.solution.SampledSolution` at the output times.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from numpy.typing import ArrayLike, NDArray
+from scipy.integrate import solve_ivp
+
+from ..errors import InputError
+from ..loads import Harmonic, Load
+from ..solution import SampledSolution
+
+if TYPE_CHECKING:
+    from ..model import Model
+
+Array = NDArray[np.float64]
+IVP_METHODS = {"rk45": "RK45", "dop853": "DOP853", "radau": "Radau", "bdf": "BDF"}
+
+
+class ReducedForcing:
+    """The reduced load ``F_r(t) = Σ_terms s(t) Tᵀ F_term(t)`` of a model.
+
+    Spatial vectors of loads whose field does not change in time are computed once.
+    Callable: ``forcing(t) -> (n_free, 3)``.
+    """
+
+    def __init__(self, model: Model, load: Load):
+        self.model = model
+        self.terms = load.terms()
+        self._fixed = [None if term.time_dependent_field
+                       else np.asarray(model.constraints.T.T @ term.field_vector(model.surface))
+                       for term in self.terms]
+        self._rest = (model._reduce_force(np.zeros((model.constraints.T.shape[0], 3)))
+                      if model.rest == "none" else None)
+        self.breakpoints = load.breakpoints()
+
+    def _field(self, i: int, t: float) -> Array:
+        fixed = self._fixed[i]
+        if fixed is not None:
+            return fixed
+        full = self.terms[i].field_vector(self.model.surface, t)
+        return np.asarray(self.model.constraints.T.T @ full)
+
+    def __call__(self, t: float) -> Array:
+        out = np.zeros((self.model.n_free, 3)) if self._rest is None else self._rest.copy()
+        for i, term in enumerate(self.terms):
+            scale = float(term.profile(t))
+            if scale:
+                out += scale * self._field(i, t)
+        return out
+
+    def modal_terms(self, phi: Array, t_end: float, samples: int
+                    ) -> tuple[list[tuple[float, Array]], list[tuple[float, float, Array]]]:
+        """Modal jumps ``(t_j, Φᵀ ΔF_j)`` and harmonic terms ``(Ω, φ, Φᵀ F)``.
+
+        Time-dependent fields are sampled at ``samples`` interval midpoints on ``[0, t_end]``
+        (piecewise constant in time, first-order accurate in the interval width).
+        """
+        jumps: list[tuple[float, Array]] = []
+        harmonics: list[tuple[float, float, Array]] = []
+        if self._rest is not None:
+            jumps.append((0.0, phi.T @ self._rest))
+        edges = np.linspace(0.0, t_end, int(samples) + 1)
+        for i, term in enumerate(self.terms):
+            jumps_of_profile = term.profile.jumps()
+            if self._fixed[i] is not None and jumps_of_profile is not None:
+                g = phi.T @ self._fixed[i]
+                jumps += [(t_j, ds * g) for t_j, ds in jumps_of_profile]
+            elif self._fixed[i] is not None and isinstance(term.profile, Harmonic):
+                harmonics.append((term.profile.omega, term.profile.phase, phi.T @ self._fixed[i]))
+            else:
+                mids = 0.5 * (edges[:-1] + edges[1:])
+                values = [phi.T @ (float(term.profile(tm)) * self._field(i, tm)) for tm in mids]
+                previous = np.zeros_like(values[0])
+                for t_j, value in zip(edges[:-1], values):
+                    jumps.append((float(t_j), value - previous))
+                    previous = value
+        return jumps, harmonics
+
+
+def _output_times(times: ArrayLike | None, t_end: float) -> Array:
+    if times is None:
+        return np.linspace(0.0, t_end, 201)
+    out = np.asarray(times, dtype=float).ravel()
+    if out.size == 0 or not np.all(np.isfinite(out)):
+        raise InputError("output times must be a non-empty array of finite numbers")
+    if np.any(np.diff(out) <= 0) or out[0] < 0 or out[-1] > t_end:
+        raise InputError(f"output times must increase within [0, t_end={t_end:g}]")
+    return out
+
+
+def _segments(breakpoints: list[float], t_end: float) -> list[tuple[float, float]]:
+    cuts = sorted({0.0, t_end, *[b for b in breakpoints if 0.0 < b < t_end]})
+    return list(zip(cuts[:-1], cuts[1:]))
+
+
+def _left_limit(a: float, b: float) -> float:
+    return b - 1e-12 * (b - a)
+
+
+def integrate(model: Model, forcing: ReducedForcing, method: str, t_end: float,
+              times: ArrayLike | None, d0: Array, v0: Array, **options: Any) -> SampledSolution:
+    """Run a numerical method and return its solution at the output times."""
+    out_times = _output_times(times, t_end)
+    start = time.perf_counter()
+    if method == "newmark":
+        d, v, stats = newmark(model, forcing, t_end, out_times, d0, v0, **options)
+    else:
+        d, v, stats = ivp(model, forcing, IVP_METHODS[method], t_end, out_times, d0, v0, **options)
+    timings = dict(model.timings)
+    timings["integration"] = time.perf_counter() - start
+    return SampledSolution(model, method, t_end, forcing, timings, out_times, d, v, stats)
+
+
+def newmark(model: Model, forcing: ReducedForcing, t_end: float, out_times: Array,
+            d0: Array, v0: Array, dt: float | None = None) -> tuple[Array, Array, dict]:
+    """Average-acceleration Newmark with steps of at most ``dt`` hitting every output time.
+
+    Update: ``K_eff d₊ = F₊ + M (4/Δt² d + 4/Δt v + a) + C (2/Δt d + v)``, then
+    ``a₊ = 4/Δt² (d₊ - d) - 4/Δt v - a`` and ``v₊ = v + Δt/2 (a + a₊)``.
+    """
+    if dt is None:
+        dt = t_end / 2000
+    dt = float(dt)
+    if not np.isfinite(dt) or dt <= 0:
+        raise InputError(f"Newmark step dt must be finite and > 0, got {dt}")
+    M, C, K = model.matrices()
+    mass_lu = spla.splu(M)
+    factors: dict[float, Any] = {}
+    stops = np.union1d(out_times, [t for seg in _segments(forcing.breakpoints, t_end) for t in seg])
+    stops = stops[np.concatenate([[True], np.diff(stops) > 1e-9 * t_end])]   # merge near-equal
+    d, v = d0.copy(), v0.copy()
+    acc = lambda t, d, v: mass_lu.solve(forcing(t) - C @ v - K @ d)  # noqa: E731
+    a = acc(0.0, d, v)
+    d_out, v_out = np.empty((out_times.size,) + d0.shape), np.empty((out_times.size,) + d0.shape)
+    steps = 0
+    k_out = 0
+    if out_times[0] == 0.0:
+        d_out[0], v_out[0], k_out = d, v, 1
+    for ta, tb in zip(stops[:-1], stops[1:]):
+        n_sub = max(1, int(np.ceil((tb - ta) / dt - 1e-9)))
+        h = (tb - ta) / n_sub
+        key = round(h, 15)
+        if key not in factors:
+            factors[key] = spla.splu((K + (2 / h) * C + (4 / h**2) * M).tocsc())
+        lu = factors[key]
+        a = acc(ta, d, v)                       # restart with the right-hand limit of F
+        for j in range(1, n_sub + 1):
+            t1 = ta + j * h
+            F1 = forcing(_left_limit(ta, tb) if j == n_sub else t1)
+            rhs = F1 + M @ ((4 / h**2) * d + (4 / h) * v + a) + C @ ((2 / h) * d + v)
+            d1 = lu.solve(rhs)
+            a1 = (4 / h**2) * (d1 - d) - (4 / h) * v - a
+            v = v + 0.5 * h * (a + a1)
+            d, a = d1, a1
+        steps += n_sub
+        while k_out < out_times.size and np.isclose(out_times[k_out], tb, rtol=0, atol=1e-12 * t_end):
+            d_out[k_out], v_out[k_out] = d, v
+            k_out += 1
+    return d_out, v_out, {"steps": steps, "factorisations": len(factors)}
+
+
+def ivp(model: Model, forcing: ReducedForcing, method: str, t_end: float, out_times: Array,
+        d0: Array, v0: Array, rtol: float = 1e-8, atol: float = 1e-12,
+        max_step: float = np.inf) -> tuple[Array, Array, dict]:
+    """``solve_ivp`` on ``y = (d_x, v_x, d_y, v_y, d_z, v_z)``, restarted at breakpoints."""
+    for name, value in (("rtol", rtol), ("atol", atol)):
+        if not np.isfinite(value) or value <= 0:
+            raise InputError(f"{name} must be finite and > 0, got {value}")
+    M, C, K = model.matrices()
+    n = model.n_free
+    mass_lu = spla.splu(M)
+
+    def rhs(t: float, y: Array) -> Array:
+        state = y.reshape(3, 2, n)
+        d, v = state[:, 0].T, state[:, 1].T
+        a = mass_lu.solve(forcing(t) - C @ v - K @ d)
+        return np.stack([v.T, a.T], axis=1).ravel()
+
+    options: dict[str, Any] = {"rtol": rtol, "atol": atol, "max_step": max_step}
+    if method in ("Radau", "BDF"):
+        options["jac"] = _jacobian(M, C, K, mass_lu)
+    y = np.stack([d0.T, v0.T], axis=1).ravel()
+    d_out, v_out = np.empty((out_times.size, n, 3)), np.empty((out_times.size, n, 3))
+    stats = {"nfev": 0, "njev": 0, "nlu": 0}
+    filled = 0
+    for ta, tb in _segments(forcing.breakpoints, t_end):
+        last = tb == t_end
+        inside = out_times[(out_times >= ta) & ((out_times <= tb) if last else (out_times < tb))]
+        seg_rhs = lambda t, y, ta=ta, tb=tb: rhs(min(t, _left_limit(ta, tb)), y)  # noqa: E731
+        sol = solve_ivp(seg_rhs, (ta, tb), y, method=method,
+                        t_eval=np.union1d(inside, [tb]), **options)
+        if not sol.success:
+            raise InputError(f"{method} failed: {sol.message}")
+        for key in stats:
+            stats[key] += int(getattr(sol, key))
+        states = sol.y[:, : inside.size].T.reshape(-1, 3, 2, n)
+        d_out[filled:filled + inside.size] = states[:, :, 0].transpose(0, 2, 1)
+        v_out[filled:filled + inside.size] = states[:, :, 1].transpose(0, 2, 1)
+        filled += inside.size
+        y = sol.y[:, -1]
+    return d_out, v_out, stats
+
+
+def _jacobian(M: sp.spmatrix, C: sp.spmatrix, K: sp.spmatrix, mass_lu: Any) -> sp.csr_matrix:
+    """Exact Jacobian ``[[0, I], [-M⁻¹K, -M⁻¹C]]`` for the three coordinates."""
+    n = M.shape[0]
+    minv_k = sp.csr_matrix(mass_lu.solve(K.toarray()))
+    minv_c = sp.csr_matrix(mass_lu.solve(C.toarray()))
+    block = sp.bmat([[None, sp.identity(n)], [-minv_k, -minv_c]], format="csr")
+    return sp.block_diag([block] * 3, format="csr")
