@@ -1,0 +1,244 @@
+"""The ``splinedeform`` command: run, demo, validate, info (and bench when available).
+
+A thin layer over :mod:`splinedeform.scenario`: it reads the scenario, forwards the
+command-line overrides, draws progress bars (stderr) and prints a closing summary
+(stdout). Bad input (:class:`~splinedeform.errors.InputError`, which includes
+:class:`~splinedeform.errors.ScenarioError`) prints its message on stderr and exits with
+code 2, without a traceback unless ``--debug``; any other failure exits with code 1.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import platform
+import sys
+from contextlib import contextmanager
+from importlib import metadata, resources
+from pathlib import Path
+from typing import Any, Iterator, Optional
+
+import typer
+
+from . import __version__
+from .errors import InputError
+
+EXIT_INPUT_ERROR = 2
+EXIT_INTERNAL_ERROR = 1
+
+#: optional modules reported by ``splinedeform info``: import name -> (distribution, use)
+OPTIONAL = {
+    "typer": ("typer", "command line"),
+    "rich": ("rich", "progress bars and tables"),
+    "meshio": ("meshio", "OBJ / STL / PLY / VTU meshes"),
+    "matplotlib": ("matplotlib", "pictures and GIF animation frames"),
+    "imageio": ("imageio", "GIF animation"),
+    "PIL": ("pillow", "GIF encoding"),
+    "imageio_ffmpeg": ("imageio-ffmpeg", "MP4 animation (extra: video)"),
+    "pyvista": ("pyvista", "offscreen 3-D rendering (extra: render3d)"),
+    "playwright": ("playwright", "viewer test in a headless browser"),
+}
+
+app = typer.Typer(name="splinedeform", no_args_is_help=True, add_completion=False,
+                  pretty_exceptions_enable=False,
+                  help="Physical deformation of B-spline surfaces, solved analytically.")
+
+SCENARIO_ARG = typer.Argument(..., help="Scenario file (TOML), see docs/scenario.md.",
+                              show_default=False)
+OUTDIR_OPT = typer.Option(None, "-o", "--outdir", help="Output folder (created if missing). "
+                                                       "[default: <scenario name>-output]")
+QUIET_OPT = typer.Option(False, "--quiet", "-q", help="Print nothing but errors.")
+DEBUG_OPT = typer.Option(False, "--debug", help="Show the full traceback of an error.")
+
+
+def _consoles() -> tuple[Any, Any]:
+    """(stdout, stderr) rich consoles; wide when not a terminal, so paths are never cut."""
+    from rich.console import Console
+
+    out_width = None if sys.stdout.isatty() else 250
+    err_width = None if sys.stderr.isatty() else 120
+    return Console(width=out_width), Console(stderr=True, width=err_width)
+
+
+@contextmanager
+def _reported_errors(debug: bool) -> Iterator[None]:
+    """Turn errors into a message on stderr and an exit code (a traceback only with --debug)."""
+    try:
+        yield
+    except (typer.Exit, typer.Abort, KeyboardInterrupt):
+        raise
+    except InputError as exc:
+        if debug:
+            raise
+        _print_error(str(exc))
+        raise typer.Exit(EXIT_INPUT_ERROR) from None
+    except Exception as exc:  # noqa: BLE001  (any other failure: short message, exit 1)
+        if debug:
+            raise
+        _print_error(f"internal error: {type(exc).__name__}: {exc}\n"
+                     "(run again with --debug for the traceback)")
+        raise typer.Exit(EXIT_INTERNAL_ERROR) from None
+
+
+def _print_error(message: str) -> None:
+    _, err = _consoles()
+    err.print(f"[bold red]error:[/] {_escape(message)}", highlight=False, soft_wrap=True)
+
+
+def _escape(text: str) -> str:
+    from rich.markup import escape
+
+    return escape(text)
+
+
+def _table(title: str, rows: list[tuple[str, str]]) -> Any:
+    from rich.table import Table
+
+    table = Table(title=title, show_header=False, title_justify="left")
+    table.add_column("what", style="bold")
+    table.add_column("value", overflow="fold")
+    for label, value in rows:
+        table.add_row(_escape(label), _escape(value))
+    return table
+
+
+def _run(scenario: Any, outdir: Path, quiet: bool) -> None:
+    """Run a validated scenario with progress bars and print the summary table."""
+    from ._progress import StageProgress
+    from .scenario import run, summary_rows
+
+    out, err = _consoles()
+    with StageProgress(err, enabled=not quiet) as progress:
+        result = run(scenario, outdir, progress=progress)
+    if not quiet:
+        out.print(_table(f"splinedeform: {scenario.title or scenario.name}",
+                         summary_rows(result)))
+
+
+@app.command("run")
+def run_command(scenario: Path = SCENARIO_ARG, outdir: Optional[Path] = OUTDIR_OPT,
+                method: Optional[str] = typer.Option(
+                    None, "--method", help="Override solve.method: analytic, newmark, rk45, "
+                                           "dop853, radau, bdf."),
+                frames: Optional[int] = typer.Option(
+                    None, "--frames", help="Override solve.frames (replaces solve.times)."),
+                quiet: bool = QUIET_OPT, debug: bool = DEBUG_OPT) -> None:
+    """Run a scenario file: build, solve, sample frames and write its outputs."""
+    from .scenario import load_scenario, with_overrides
+
+    with _reported_errors(debug):
+        loaded = load_scenario(scenario)
+        if method is not None:
+            loaded = with_overrides(loaded, {"solve.method": method}, origin="--method")
+        if frames is not None:
+            loaded = with_overrides(loaded, {"solve.frames": frames, "solve.times": None},
+                                    origin="--frames")
+        _run(loaded, outdir or Path(f"{loaded.name}-output"), quiet)
+
+
+def demo_scenario() -> Any:
+    """The built-in demo (package data ``splinedeform/data/demo.toml``) as a Scenario."""
+    from .scenario import parse_scenario
+
+    text = resources.files("splinedeform").joinpath("data/demo.toml").read_text("utf-8")
+    return parse_scenario(text, source="demo.toml")
+
+
+@app.command("demo")
+def demo_command(outdir: Path = typer.Option(Path("demo-output"), "-o", "--outdir",
+                                             help="Output folder (created if missing)."),
+                 quiet: bool = QUIET_OPT, debug: bool = DEBUG_OPT) -> None:
+    """Run the built-in demo: a clamped half sphere pushed in at the pole, every output."""
+    with _reported_errors(debug):
+        _run(demo_scenario(), outdir, quiet)
+
+
+@app.command("validate")
+def validate_command(scenario: Path = SCENARIO_ARG, debug: bool = DEBUG_OPT) -> None:
+    """Check a scenario file and print what it would run (with every default filled in)."""
+    from .scenario import build, describe, load_scenario, scenario_to_toml
+
+    with _reported_errors(debug):
+        loaded = load_scenario(scenario)
+        built = build(loaded)
+        out, _ = _consoles()
+        out.print(_table(f"{scenario}: valid", describe(loaded, built)))
+        out.print(scenario_to_toml(loaded), markup=False, highlight=False)
+
+
+def examples_directory() -> Path | None:
+    """The ``examples/`` folder of a source checkout, if there is one."""
+    candidate = Path(__file__).resolve().parents[2] / "examples"
+    return candidate if candidate.is_dir() else None
+
+
+def _optional_rows() -> list[tuple[str, str]]:
+    rows = []
+    for module, (dist, use) in OPTIONAL.items():
+        if importlib.util.find_spec(module) is None:
+            rows.append((dist, f"missing  ({use})"))
+            continue
+        try:
+            version = metadata.version(dist)
+        except metadata.PackageNotFoundError:
+            version = "?"
+        rows.append((dist, f"{version}  ({use})"))
+    return rows
+
+
+@app.command("info")
+def info_command() -> None:
+    """Version, optional extras that import, and where the examples live."""
+    out, _ = _consoles()
+    examples = examples_directory()
+    rows = [("splinedeform", __version__),
+            ("python", f"{platform.python_version()} ({sys.executable})"),
+            ("package", str(Path(__file__).resolve().parent)),
+            ("examples", str(examples) if examples is not None
+             else "not installed (see examples/ in the source repository)"),
+            ("demo scenario", str(resources.files("splinedeform").joinpath("data/demo.toml")))]
+    if examples is not None:
+        rows.append(("example files", ", ".join(sorted(p.name for p in examples.glob("*.toml")))))
+    out.print(_table("splinedeform info", rows))
+    out.print(_table("optional packages", _optional_rows()))
+
+
+def _register_bench() -> None:
+    """Add ``splinedeform bench`` when the cost study module is installed."""
+    try:
+        available = importlib.util.find_spec("splinedeform.bench") is not None
+    except (ImportError, ValueError):
+        available = False
+    if not available:
+        return
+
+    @app.command("bench")
+    def bench_command(sizes: Optional[str] = typer.Option(
+                          None, "--sizes", help="Comma-separated net sizes, e.g. 8,16,32."),
+                      quick: bool = typer.Option(False, "--quick", help="A short run."),
+                      outdir: Path = typer.Option(Path("bench-output"), "-o", "--outdir",
+                                                  help="Output folder."),
+                      quiet: bool = QUIET_OPT, debug: bool = DEBUG_OPT) -> None:
+        """Cost study: analytic against numerical solvers, cost against net size."""
+        from . import bench
+
+        with _reported_errors(debug):
+            parsed = None
+            if sizes is not None:
+                try:
+                    parsed = [int(s) for s in sizes.split(",") if s.strip()]
+                except ValueError:
+                    raise InputError(f"--sizes must be comma-separated integers, got "
+                                     f"{sizes!r}") from None
+            bench.main(parsed, quick, outdir, quiet)
+
+
+_register_bench()
+
+
+def main() -> None:
+    """Entry point of the ``splinedeform`` script."""
+    app()
+
+
+if __name__ == "__main__":
+    main()
