@@ -1,0 +1,241 @@
+"""Pictures and animations: sizes, content, the colour scale, the PyVista fallback."""
+
+from __future__ import annotations
+
+import base64
+import warnings
+
+import numpy as np
+import pytest
+
+from splinedeform import BSplineBasis, InputError, Surface
+from splinedeform import viz
+
+matplotlib = pytest.importorskip("matplotlib")
+iio = pytest.importorskip("imageio.v3")
+
+
+def plane(cells: int = 4) -> Surface:
+    """The unit square z = 0 with open cubic knots (control points at Greville abscissae)."""
+    b = BSplineBasis(3, cells, 1.0, "open")
+    gu, gv = np.meshgrid(b.greville(), b.greville(), indexing="ij")
+    return Surface(np.stack([gu, gv, 0 * gu], -1), b, b, name="plane")
+
+
+def bump(surface: Surface) -> np.ndarray:
+    """A control-net bump field that vanishes on the boundary rows."""
+    g = surface.control_points
+    return np.sin(np.pi * g[..., 0]) * np.sin(np.pi * g[..., 1])
+
+
+def motion(surface: Surface, frames: int = 5) -> tuple[np.ndarray, np.ndarray]:
+    times = np.linspace(0.0, 1.0, frames)
+    lift = np.zeros_like(surface.control_points)
+    lift[..., 2] = 0.4 * bump(surface)
+    return times, surface.control_points[None] + np.sin(np.pi * times / 2)[:, None, None, None] * lift
+
+
+def read_png(path) -> np.ndarray:
+    image = iio.imread(path)
+    return image[..., :3].astype(int)
+
+
+def distinct_colours(image: np.ndarray) -> int:
+    return len(np.unique(image.reshape(-1, 3), axis=0))
+
+
+def luminance(rgb: np.ndarray) -> np.ndarray:
+    return rgb @ np.array([0.2126, 0.7152, 0.0722])
+
+
+# -- colour scale ------------------------------------------------------------------------
+def test_displacement_colours_are_monotone_from_cool_to_hot():
+    m = np.linspace(0.0, 2.0, 50)
+    rgba = viz.displacement_colors(m, vmax=2.0)
+    cmap = matplotlib.colormaps[viz.COLORMAP]
+    np.testing.assert_allclose(rgba[0], cmap(0.0))
+    np.testing.assert_allclose(rgba[-1], cmap(1.0))
+    # plasma: lightness rises monotonically, and the hot end is bright yellow
+    assert np.all(np.diff(luminance(rgba[:, :3])) > 0)
+    assert rgba[-1, 0] > 0.9 and rgba[-1, 2] < 0.2 and rgba[0, 2] > 0.5
+
+
+def test_larger_displacement_gets_the_hot_end():
+    small, large = viz.displacement_colors(np.array([0.1, 0.9]))   # vmax = 0.9
+    np.testing.assert_allclose(large, matplotlib.colormaps[viz.COLORMAP](1.0))
+    assert luminance(large[:3]) > luminance(small[:3])
+    # values above vmax saturate at the hot end, and vmax = 0 gives the cool end
+    np.testing.assert_allclose(viz.displacement_colors([5.0], vmax=1.0)[0], large)
+    np.testing.assert_allclose(viz.displacement_colors([0.0, 0.0])[1],
+                               matplotlib.colormaps[viz.COLORMAP](0.0))
+
+
+def test_displacement_colours_reject_bad_values():
+    with pytest.raises(InputError, match=">= 0"):
+        viz.displacement_colors([-1.0])
+    with pytest.raises(InputError, match="finite"):
+        viz.displacement_colors([np.nan])
+
+
+def test_shading_follows_lambert():
+    rgba = np.array([[1.0, 0.5, 0.2, 1.0]] * 2)
+    normals = np.array([viz.LIGHT, [viz.LIGHT[1], -viz.LIGHT[0], 0.0]])   # along / across light
+    shaded = viz.shade(rgba, normals * 3.0)
+    np.testing.assert_allclose(shaded[0, :3], rgba[0, :3])
+    np.testing.assert_allclose(shaded[1, :3], 0.55 * rgba[1, :3])
+    assert np.all(shaded[:, 3] == 1.0)
+
+
+# -- render_surfaces ----------------------------------------------------------------------------
+def hot_pixels(image: np.ndarray) -> int:
+    """Pixels near plasma's yellow end (allowing for the shading factor 0.55..1)."""
+    r, g, b = image[..., 0], image[..., 1], image[..., 2]
+    return int(np.sum((r > 130) & (g > 100) & (b < 70) & (r > 1.1 * g)))
+
+
+def test_render_surfaces_size_and_hot_region(tmp_path, monkeypatch):
+    monkeypatch.setattr(viz, "_pyvista", lambda: None)
+    s = plane()
+    _, nets = motion(s)
+    path = viz.render_surfaces(tmp_path / "initial_final.png", s, s.control_points,
+                               [nets[0], nets[-1]], ["initial", "final"], resolution=24)
+    image = read_png(path)
+    assert image.shape == (400, 2 * 400 + 100, 3)
+    assert distinct_colours(image) > 200
+    # the rest state has no displacement: no hot pixel; the bumped state has a hot top
+    assert hot_pixels(image[:, :400]) == 0
+    assert hot_pixels(image[:, 400:800]) > 200
+
+
+def test_render_surfaces_falls_back_to_matplotlib_silently(tmp_path, monkeypatch, capsys):
+    class BrokenPyVista:
+        """Importable, but it cannot open an off-screen context."""
+
+        @staticmethod
+        def Plotter(*args, **kwargs):
+            raise RuntimeError("cannot open display")
+
+    monkeypatch.setattr(viz, "_pyvista", lambda: BrokenPyVista)
+    s = plane(3)
+    _, nets = motion(s, 2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        path = viz.render_surfaces(tmp_path / "r.png", s, s.control_points, [nets[-1]], ["t=1"],
+                                   resolution=12)
+    assert read_png(path).shape == (400, 500, 3)
+    assert capsys.readouterr() == ("", "")
+    assert [p.name for p in tmp_path.iterdir()] == ["r.png"]
+
+
+def test_render_surfaces_rejects_bad_input(tmp_path):
+    s = plane(3)
+    with pytest.raises(InputError, match="title"):
+        viz.render_surfaces(tmp_path / "r.png", s, s.control_points, [s.control_points], [])
+    with pytest.raises(InputError, match="PNG"):
+        viz.render_surfaces(tmp_path / "r.jpg", s, s.control_points, [s.control_points], ["a"])
+    with pytest.raises(InputError, match=r"nets\[0\]"):
+        viz.render_surfaces(tmp_path / "r.png", s, s.control_points, [np.zeros((2, 2, 3))], ["a"])
+    assert list(tmp_path.iterdir()) == []
+
+
+# -- probes and modes -------------------------------------------------------------------------
+def test_plot_probes_size_and_content(tmp_path):
+    t = np.linspace(0, 2, 40)
+    d = np.column_stack([np.sin(t), 0 * t, -np.cos(t)])
+    path = viz.plot_probes(tmp_path / "probes.png", t, {"centre": d, "edge": 0.5 * d})
+    image = read_png(path)
+    assert image.shape == (500, 800, 3)
+    assert distinct_colours(image) > 20
+    with pytest.raises(InputError, match="probe 'edge'"):
+        viz.plot_probes(tmp_path / "p.png", t, {"edge": d[:, :2]})
+    with pytest.raises(InputError, match="non-empty"):
+        viz.plot_probes(tmp_path / "p.png", t, {})
+
+
+def test_mode_geometry_displaces_along_the_normal():
+    s = plane(4)
+    phi = bump(s) - 0.2
+    y, values, faces = viz.mode_geometry(s, phi, resolution=9, scale=0.2)
+    u = np.linspace(0, 1, 9)
+    uu, vv = np.meshgrid(u, u, indexing="ij")
+    expected = s.with_control_points(np.repeat(phi[..., None], 3, -1)).evaluate(uu, vv)[..., 0]
+    np.testing.assert_allclose(values, expected.ravel(), atol=1e-14)
+    # plane z = 0 with normal +z: x, y unchanged, z = s φ with s = 0.2 · diameter / max|φ|
+    np.testing.assert_allclose(y[:, :2], s.evaluate(uu, vv)[..., :2].reshape(-1, 2), atol=1e-14)
+    np.testing.assert_allclose(y[:, 2], 0.2 * 1.0 * values / np.abs(values).max(), atol=1e-14)
+    assert faces.shape == (2 * 8 * 8, 3)
+
+
+def test_plot_modes_size_and_checks(tmp_path):
+    s = plane(4)
+    shapes = np.stack([bump(s), bump(s) * (s.control_points[..., 0] - 0.5)])
+    path = viz.plot_modes(tmp_path / "modes.png", s, [3.2, 7.9], shapes, resolution=16)
+    image = read_png(path)
+    assert image.shape == (400, 800, 3)
+    assert distinct_colours(image) > 100
+    with pytest.raises(InputError, match="shapes"):
+        viz.plot_modes(tmp_path / "m.png", s, [1.0], shapes)
+
+
+# -- animation ----------------------------------------------------------------------------------
+def test_gif_has_one_distinct_frame_per_time(tmp_path):
+    s = plane(3)
+    times, nets = motion(s, 4)
+    calls = []
+    path = viz.write_animation(tmp_path / "motion.gif", s, s.control_points, times, nets,
+                               resolution=10, progress=lambda done, total: calls.append((done, total)))
+    frames = iio.imread(path, index=None)
+    assert frames.shape[:3] == (4, 480, 640)
+    for a, b in zip(frames[:-1], frames[1:]):
+        assert np.mean(np.any(a != b, axis=-1)) > 0.005
+    assert calls == [(1, 4), (2, 4), (3, 4), (4, 4)]
+    assert [p.name for p in tmp_path.iterdir()] == ["motion.gif"]
+
+
+def test_mp4_when_an_encoder_is_available(tmp_path):
+    if not viz.mp4_available():
+        pytest.skip("imageio-ffmpeg (the `video` extra) is not installed")
+    s = plane(3)
+    times, nets = motion(s, 6)
+    path = viz.write_animation(tmp_path / "motion.mp4", s, s.control_points, times, nets,
+                               resolution=10)
+    frames = iio.imread(path, index=None, plugin="FFMPEG")
+    assert frames.shape[:3] == (6, 480, 640)
+    assert np.abs(frames[0].astype(int) - frames[-1].astype(int)).mean() > 0.5
+
+
+def test_mp4_without_encoder_names_the_extra(tmp_path, monkeypatch):
+    monkeypatch.setattr(viz, "mp4_available", lambda: False)
+    s = plane(3)
+    times, nets = motion(s, 2)
+    with pytest.raises(InputError, match="video"):
+        viz.write_animation(tmp_path / "m.mp4", s, s.control_points, times, nets)
+    with pytest.raises(InputError, match=".gif or .mp4"):
+        viz.write_animation(tmp_path / "m.avi", s, s.control_points, times, nets)
+    assert list(tmp_path.iterdir()) == []
+
+
+# -- viewer data -----------------------------------------------------------------------------------
+def test_viewer_data_holds_float32_frames_and_nets():
+    s = plane(3)
+    times, nets = motion(s, 3)
+    data = viz.viewer_data(s, s.control_points, times, nets, resolution=7)
+    frames = np.frombuffer(base64.b64decode(data["frames"]), "<f4").reshape(3, 49, 3)
+    for f in range(3):
+        V, F = s.tessellate(7, control_points=nets[f])
+        np.testing.assert_array_equal(frames[f], V.astype(np.float32))
+    faces = np.frombuffer(base64.b64decode(data["faces"]), "<u4").reshape(-1, 3)
+    np.testing.assert_array_equal(faces, F)
+    np.testing.assert_array_equal(np.frombuffer(base64.b64decode(data["nets"]), "<f4"),
+                                  nets.astype(np.float32).ravel())
+    rest, _ = s.tessellate(7)
+    top = max(np.linalg.norm(s.tessellate(7, control_points=n)[0] - rest, axis=1).max()
+              for n in nets)
+    assert data["vmax"] == pytest.approx(top, rel=1e-12)
+    assert data["times"] == times.tolist() and data["netShape"] == [6, 6]
+
+
+def test_vertex_checksum_weights():
+    x = np.array([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0], [7.0, 8.0, 9.0]])
+    w = np.array([1, 2, 3, 4, 5, 6, 7, 1, 2])
+    assert viz.vertex_checksum(x) == float(np.sum(w * x.ravel()))
