@@ -127,6 +127,55 @@ def test_render_surfaces_falls_back_to_matplotlib_silently(tmp_path, monkeypatch
     assert [p.name for p in tmp_path.iterdir()] == ["r.png"]
 
 
+def test_render_surfaces_uses_pyvista_when_it_can_render(tmp_path, monkeypatch):
+    """A stand-in for PyVista records the calls; its screenshot becomes the target file."""
+    calls: list[str] = []
+
+    class FakePlotter:
+        def __init__(self, off_screen, shape, window_size, border):
+            assert off_screen and shape == (1, 2) and window_size == (900, 400)
+            calls.append("open")
+
+        def subplot(self, row, col):
+            calls.append(f"panel {col}")
+
+        def add_mesh(self, mesh, scalars, cmap, clim, show_scalar_bar):
+            assert cmap == viz.COLORMAP and clim[0] == 0.0
+            np.testing.assert_array_equal(mesh.point_data[scalars] >= 0, True)
+
+        def add_text(self, text, font_size):
+            calls.append(text)
+
+        def view_isometric(self):
+            pass
+
+        def link_views(self):
+            pass
+
+        def screenshot(self, filename):
+            iio.imwrite(filename, np.full((400, 900, 3), 200, np.uint8), extension=".png")
+
+        def close(self):
+            calls.append("close")
+
+    class FakeMesh:
+        def __init__(self, points, cells):
+            assert cells.reshape(-1, 4)[:, 0].tolist() == [3] * (cells.size // 4)
+            self.point_data: dict = {}
+
+    class FakePyVista:
+        Plotter = FakePlotter
+        PolyData = FakeMesh
+
+    monkeypatch.setattr(viz, "_pyvista", lambda: FakePyVista)
+    s = plane(3)
+    _, nets = motion(s, 2)
+    path = viz.render_surfaces(tmp_path / "r.png", s, s.control_points, list(nets), ["a", "b"],
+                               resolution=8)
+    assert calls == ["open", "panel 0", "a", "panel 1", "b", "close"]
+    assert np.all(read_png(path) == 200)
+
+
 def test_render_surfaces_rejects_bad_input(tmp_path):
     s = plane(3)
     with pytest.raises(InputError, match="title"):

@@ -267,7 +267,7 @@ def plot_probes(path: str | os.PathLike[str], times: ArrayLike,
         ax.set_title(name, fontsize=10)
         ax.set_ylabel("displacement")
         ax.grid(alpha=0.3)
-        ax.legend(loc="upper right", fontsize=8, ncols=4)
+        ax.legend(loc="best", fontsize=8, ncols=2, framealpha=0.8)
     axes[-1].set_xlabel("time")
     fig.tight_layout()
     return _save_png(fig, path)
