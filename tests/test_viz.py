@@ -100,7 +100,7 @@ def test_render_surfaces_size_and_hot_region(tmp_path, monkeypatch):
     path = viz.render_surfaces(tmp_path / "initial_final.png", s, s.control_points,
                                [nets[0], nets[-1]], ["initial", "final"], resolution=24)
     image = read_png(path)
-    assert image.shape == (400, 2 * 400 + 100, 3)
+    assert image.shape == (400, 2 * 400 + 120, 3)
     assert distinct_colours(image) > 200
     # the rest state has no displacement: no hot pixel; the bumped state has a hot top
     assert hot_pixels(image[:, :400]) == 0
@@ -122,7 +122,7 @@ def test_render_surfaces_falls_back_to_matplotlib_silently(tmp_path, monkeypatch
         warnings.simplefilter("error")
         path = viz.render_surfaces(tmp_path / "r.png", s, s.control_points, [nets[-1]], ["t=1"],
                                    resolution=12)
-    assert read_png(path).shape == (400, 500, 3)
+    assert read_png(path).shape == (400, 520, 3)
     assert capsys.readouterr() == ("", "")
     assert [p.name for p in tmp_path.iterdir()] == ["r.png"]
 
@@ -133,7 +133,7 @@ def test_render_surfaces_uses_pyvista_when_it_can_render(tmp_path, monkeypatch):
 
     class FakePlotter:
         def __init__(self, off_screen, shape, window_size, border):
-            assert off_screen and shape == (1, 2) and window_size == (900, 400)
+            assert off_screen and shape == (1, 2) and window_size == (920, 400)
             calls.append("open")
 
         def subplot(self, row, col):
@@ -153,7 +153,7 @@ def test_render_surfaces_uses_pyvista_when_it_can_render(tmp_path, monkeypatch):
             pass
 
         def screenshot(self, filename):
-            iio.imwrite(filename, np.full((400, 900, 3), 200, np.uint8), extension=".png")
+            iio.imwrite(filename, np.full((400, 920, 3), 200, np.uint8), extension=".png")
 
         def close(self):
             calls.append("close")

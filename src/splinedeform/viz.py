@@ -32,7 +32,7 @@ COLORMAP = "plasma"
 MODE_COLORMAP = "coolwarm"
 DPI = 100
 PANEL_INCHES = 4.0          # each surface panel is 400 × 400 px
-COLORBAR_INCHES = 1.0
+COLORBAR_INCHES = 1.2
 ANIMATION_PIXELS = (640, 480)  # divisible by 16 for video encoders
 LIGHT = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
 
@@ -206,7 +206,7 @@ def _render_matplotlib(path: Path, X: NDArray[np.float64], mag: NDArray[np.float
         ax.add_collection3d(_collection(X[i], faces, _face_colors(mag[i], faces, vmax)))
         _box(ax, X)
         ax.set_title(titles[i], fontsize=10)
-    _colorbar(fig, [(n * PANEL_INCHES + 0.15) / width, 0.12, 0.2 / width, 0.72], vmax)
+    _colorbar(fig, [(n * PANEL_INCHES + 0.1) / width, 0.12, 0.18 / width, 0.72], vmax)
     return _save_png(fig, path)
 
 
@@ -217,7 +217,7 @@ def render_surfaces(path: str | os.PathLike[str], surface: Surface, rest_net: Ar
 
     All panels share the colour scale ``[0, max |d|]`` and the same equal-aspect box, so
     sizes and colours compare across panels. With matplotlib the picture is
-    ``(400 n + 100) × 400`` pixels for ``n`` panels.
+    ``(400 n + 120) × 400`` pixels for ``n`` panels.
     """
     target = Path(path)
     if target.suffix.lower() != ".png":
