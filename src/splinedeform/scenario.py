@@ -963,8 +963,10 @@ def _validate_load(table: Any, path: str, problems: _Problems) -> LoadSpec | Non
                                       f"{values['t_off']:g}")
     if "points" in values:
         times = [t for t, _ in values["points"]]
-        if any(t < 0 for t in times) or any(b <= a for a, b in zip(times, times[1:])):
-            problems.add(f"{path}.points", f"times must be >= 0 and increasing, got {times}")
+        bad = _first_not_increasing(times)
+        if bad is not None:
+            problems.add(f"{path}.points[{bad}]", f"times must be >= 0 and increasing, got "
+                                                  f"{times}")
     if "at" in values:
         if any(x < 0 for x in values["at"]):
             problems.add(f"{path}.at", f"parameters must be >= 0, got {list(values['at'])}")
@@ -974,6 +976,16 @@ def _validate_load(table: Any, path: str, problems: _Problems) -> LoadSpec | Non
                      "non-zero value")
     given = [k for k in LOAD_KEYS if k != "kind"]
     return LoadSpec(kind=kind, **_with_defaults(LOAD_KEYS, values, given))
+
+
+def _first_not_increasing(times: Iterable[float]) -> int | None:
+    """Index (from 1) of the first time that is negative or not above the one before."""
+    previous = -math.inf
+    for i, t in enumerate(times, start=1):
+        if t < 0 or t <= previous:
+            return i
+        previous = t
+    return None
 
 
 def _validate_solve(raw: Mapping[str, Any], problems: _Problems) -> SolveSpec | None:
@@ -1007,8 +1019,9 @@ def _check_dynamic(table: Mapping[str, Any], values: dict[str, Any], problems: _
                                     f"{SOLVE_KEYS['t_end'].allowed}")
     times = values.get("times")
     if times is not None:
-        if any(b <= a for a, b in zip(times, times[1:])):
-            problems.add("solve.times", f"times must be increasing, got {list(times)}")
+        bad = _first_not_increasing(times)
+        if bad is not None:
+            problems.add(f"solve.times[{bad}]", f"times must be increasing, got {list(times)}")
         if "t_end" in values and times[-1] > values["t_end"]:
             problems.add("solve.times", f"times must be <= t_end = {values['t_end']:g}, "
                                         f"got {times[-1]:g}")
