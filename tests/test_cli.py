@@ -1,0 +1,215 @@
+"""The ``splinedeform`` command line, driven in-process by typer's CliRunner."""
+
+from __future__ import annotations
+
+import importlib
+import importlib.machinery
+import json
+import sys
+import types
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from splinedeform import BSplineBasis, Surface, __version__
+from splinedeform import cli
+from splinedeform.export import write_control_nets
+
+runner = CliRunner()
+
+SCENARIO = """
+title = "tiny membrane"
+
+[surface]
+shape = "file"
+path = "square.json"
+
+[material]
+w10 = 1.0
+w01 = 1.0
+damping = 1.0
+
+[boundary]
+u0 = "pinned"
+u1 = "pinned"
+v0 = "pinned"
+v1 = "pinned"
+
+[[load]]
+kind = "uniform"
+force = [0.0, 0.0, -1.0]
+
+[solve]
+kind = "dynamic"
+t_end = 1.0
+frames = 4
+modes = 2
+
+[output]
+formats = ["obj", "ply", "vtu", "json", "report"]
+resolution = 6
+"""
+
+
+@pytest.fixture
+def scenario(tmp_path: Path) -> Path:
+    """A 5 x 5 net of the unit square (open knots, degree 2) and a scenario using it."""
+    basis = BSplineBasis(2, 3, 1.0, "open")
+    g = basis.greville()
+    P = np.stack(np.broadcast_arrays(g[:, None], g[None, :], 0.0 * g[:, None]), -1)
+    write_control_nets(tmp_path, "square", Surface(P, basis, basis), [0.0], P[None])
+    path = tmp_path / "tiny.toml"
+    path.write_text(SCENARIO)
+    return path
+
+
+def summary_paths(output: str) -> dict[str, Path]:
+    """Rows of the summary table whose value is an existing-looking file path."""
+    rows = {}
+    for line in output.splitlines():
+        cells = [c.strip() for c in line.strip("│┃ ").split("│")]
+        if len(cells) == 2 and cells[1].startswith("/"):
+            rows[cells[0]] = Path(cells[1])
+    return rows
+
+
+def test_run_writes_the_files_listed_in_the_summary(scenario, tmp_path):
+    out = tmp_path / "out"
+    result = runner.invoke(cli.app, ["run", str(scenario), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    listed = summary_paths(result.stdout)
+    assert set(listed) == {"mesh .obj", "mesh .ply", "time series .pvd", "control nets .json",
+                           "report .json", "report .md"}
+    for path in listed.values():
+        assert path.is_file() and path.parent == out
+    written = {p.name for p in out.iterdir()}
+    assert written == {p.name for p in listed.values()} | {f"tiny_000{i}.vtu" for i in range(4)}
+    report = json.loads((out / "report.json").read_text())
+    assert report["solver"]["frames"] == 4 and report["surface"]["net"] == "5 x 5"
+    assert report["surface"]["free control points"] == 9     # pinned: the 3 x 3 inner points
+    assert "free control points" in result.stdout and "max displacement" in result.stdout
+
+
+def test_frames_and_method_override_the_file(scenario, tmp_path):
+    out = tmp_path / "out"
+    result = runner.invoke(cli.app, ["run", str(scenario), "-o", str(out), "--frames", "3",
+                                     "--method", "newmark", "--quiet"])
+    assert result.exit_code == 0, result.output
+    report = json.loads((out / "report.json").read_text())
+    assert report["solver"]["frames"] == 3 and report["solver"]["method"] == "newmark"
+
+
+def test_quiet_prints_nothing(scenario, tmp_path):
+    result = runner.invoke(cli.app, ["run", str(scenario), "-o", str(tmp_path / "o"), "-q"])
+    assert result.exit_code == 0
+    assert result.stdout == "" and result.stderr == ""
+
+
+def test_input_errors_exit_2_with_the_message_and_no_traceback(scenario, tmp_path):
+    scenario.write_text(SCENARIO.replace("t_end = 1.0", "t_end = -1.0"))
+    result = runner.invoke(cli.app, ["run", str(scenario), "-o", str(tmp_path / "o"), "-q"])
+    assert result.exit_code == 2
+    line = SCENARIO.splitlines().index("t_end = 1.0") + 1
+    assert f"tiny.toml:{line}: solve.t_end: expected a number > 0" in result.stderr
+    assert "Traceback" not in result.output and result.stdout == ""
+
+
+def test_override_errors_name_the_option(scenario, tmp_path):
+    result = runner.invoke(cli.app, ["run", str(scenario), "--method", "euler", "-q"])
+    assert result.exit_code == 2
+    assert "tiny.toml (--method): solve.method: expected one of" in result.stderr
+
+
+def test_debug_lets_the_exception_through(scenario):
+    result = runner.invoke(cli.app, ["run", str(scenario), "--method", "euler", "--debug"])
+    assert result.exit_code == 1
+    assert type(result.exception).__name__ == "ScenarioError"
+
+
+def test_missing_file_is_an_input_error(tmp_path):
+    result = runner.invoke(cli.app, ["validate", str(tmp_path / "nope.toml")])
+    assert result.exit_code == 2 and "scenario file not found" in result.stderr
+
+
+def test_unexpected_errors_exit_1_without_traceback(scenario, tmp_path, monkeypatch):
+    import splinedeform.scenario as sc
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("disk on fire")
+    monkeypatch.setattr(sc, "run", broken)
+    result = runner.invoke(cli.app, ["run", str(scenario), "-o", str(tmp_path / "o")])
+    assert result.exit_code == 1
+    assert "internal error: RuntimeError: disk on fire" in result.stderr
+    assert "--debug" in result.stderr and "Traceback" not in result.output
+
+
+def test_validate_prints_the_effective_scenario(scenario):
+    result = runner.invoke(cli.app, ["validate", str(scenario)])
+    assert result.exit_code == 0, result.output
+    assert "valid" in result.stdout and "5 x 5 (25 points)" in result.stdout
+    toml_part = result.stdout[result.stdout.index('title = "tiny membrane"'):]
+    import tomllib
+
+    effective = tomllib.loads(toml_part)
+    assert effective["material"]["mass"] == 1.0              # default filled in
+    assert effective["solve"]["method"] == "analytic"
+    assert effective["boundary"]["u0"] == "pinned"
+
+
+def test_validate_reports_every_problem(scenario):
+    scenario.write_text(SCENARIO.replace("frames = 4", "frames = 1")
+                        .replace('kind = "uniform"', 'kind = "gravity"'))
+    result = runner.invoke(cli.app, ["validate", str(scenario)])
+    assert result.exit_code == 2
+    assert "2 problems" in result.stderr
+    assert "load[1].kind" in result.stderr and "solve.frames" in result.stderr
+
+
+def test_info_names_version_extras_and_examples():
+    result = runner.invoke(cli.app, ["info"])
+    assert result.exit_code == 0
+    assert __version__ in result.stdout
+    for dist in ("meshio", "matplotlib", "imageio-ffmpeg", "pyvista"):
+        assert dist in result.stdout
+    examples = cli.examples_directory()
+    assert examples is not None and str(examples) in result.stdout
+
+
+def test_bench_is_forwarded_when_the_module_exists(monkeypatch, tmp_path):
+    calls = []
+    fake = types.ModuleType("splinedeform.bench")
+    fake.__spec__ = importlib.machinery.ModuleSpec("splinedeform.bench", None)
+    fake.main = lambda sizes, quick, outdir, quiet: calls.append((sizes, quick, outdir, quiet))
+    monkeypatch.setitem(sys.modules, "splinedeform.bench", fake)
+    import splinedeform
+
+    monkeypatch.setattr(splinedeform, "bench", fake, raising=False)
+    fresh = importlib.reload(cli)
+    try:
+        result = runner.invoke(fresh.app, ["bench", "--sizes", "4,8", "--quick", "-o",
+                                           str(tmp_path), "--quiet"])
+        assert result.exit_code == 0, result.output
+        assert calls == [([4, 8], True, tmp_path, True)]
+        bad = runner.invoke(fresh.app, ["bench", "--sizes", "4,x"])
+        assert bad.exit_code == 2 and "--sizes must be comma-separated integers" in bad.stderr
+    finally:
+        monkeypatch.undo()
+        importlib.reload(cli)
+
+
+def test_demo_runs_the_built_in_half_sphere(tmp_path):
+    pytest.importorskip("splinedeform.shapes")
+    out = tmp_path / "demo"
+    result = runner.invoke(cli.app, ["demo", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    listed = summary_paths(result.stdout)
+    assert all(path.is_file() for path in listed.values())
+    names = {p.name for p in listed.values()}
+    assert {"report.json", "viewer.html", "surfaces.png", "modes.png", "demo.gif",
+            "demo.pvd", "demo_nets.json", "demo.obj"} <= names
+    report = json.loads((out / "report.json").read_text())
+    assert report["inputs"]["surface"]["shape"] == "half_sphere"
+    assert report["solver"]["kind"] == "dynamic" and report["solver"]["method"] == "analytic"
+    assert report["inputs"]["load"][0]["kind"] == "point"
