@@ -158,16 +158,19 @@ class BSplineBasis:
     def greville(self) -> NDArray[np.float64]:
         """Greville abscissae ``ξ_j = (t_{j+1} + … + t_{j+n}) / n`` inside ``[0, L]``.
 
-        For uniform (Höllig) knots the abscissae of the outer functions fall
-        outside the interval; ``size`` equally spaced points of ``[0, L]`` are used
-        instead, which satisfy the Schoenberg–Whitney condition. For periodic knots
-        they are the support centres ``(j + (n+1)/2) h`` modulo ``L``.
+        For uniform (Höllig) knots the knot averages of the outer functions fall
+        outside the interval; the abscissae of the open layout on the same cells are
+        used instead. On ``[0, L]`` both layouts span the same splines, so these points
+        satisfy the Schoenberg–Whitney condition, and the collocation matrix stays well
+        conditioned as ``m`` grows (equally spaced points do not: its condition number
+        grows exponentially with ``m`` for ``n >= 3``). For periodic knots they are the
+        support centres ``(j + (n+1)/2) h`` modulo ``L``.
         """
         n, h = self.degree, self.h
         if self.kind == "periodic":
             return np.mod((np.arange(self.size) + (n + 1) / 2) * h, self.length)
         if self.kind == "uniform":
-            return np.linspace(0.0, self.length, self.size)
+            return BSplineBasis(n, self.cells, self.length, "open").greville()
         t = self.knots
         window = np.lib.stride_tricks.sliding_window_view(t[1:-1], n)[: self.size]
         return window.mean(axis=1)
