@@ -49,8 +49,8 @@ class Surface:
                              f"bases, got {P.shape}")
         if not np.all(np.isfinite(P)):
             bad = np.argwhere(~np.isfinite(P))[0]
-            raise InputError(f"control points must be finite; control point {tuple(bad[:2])} "
-                             f"is {P[tuple(bad)]}")
+            raise InputError(f"control points must be finite; control point "
+                             f"{tuple(int(i) for i in bad[:2])} is {P[tuple(bad[:2])]}")
         P.setflags(write=False)
         object.__setattr__(self, "control_points", P)
 
