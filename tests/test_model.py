@@ -253,3 +253,20 @@ def test_model_errors_say_what_is_wrong():
         sd.Model(sd.shapes.cylinder(cells=(8, 4)), mat, boundary="clamped")
     with pytest.raises(InputError, match="modes"):
         model.frequencies(10_000)
+
+
+def test_pole_edge_moves_as_one_point():
+    """A half sphere's pole row of control points coincides; with the 'pole' preset it stays
+    a single point under any load, and the model is the one obtained by merging those
+    coordinates by hand."""
+    surf = sd.shapes.half_sphere(cells=(8, 4))
+    mat = sd.Material(w10=1, w01=1, w20=0.05, w11=0.05, w02=0.05)
+    model = sd.Model(surf, mat, boundary={"v0": "clamped", "v1": "pole"})
+    torn = sd.Model(surf, mat, boundary={"v0": "clamped"})
+    assert model.n_free == torn.n_free - surf.shape[0] + 1
+    net = model.static(sd.Point(0.3, 1.2, (0.2, -0.1, -1.0))).control_points()
+    assert np.ptp(net[:, -1, :], axis=0).max() < 1e-12        # the pole stays one point
+    free_torn = torn.static(sd.Point(0.3, 1.2, (0.2, -0.1, -1.0))).control_points()
+    assert np.ptp(free_torn[:, -1, :], axis=0).max() > 1e-4   # without it the pole tears
+    with pytest.raises(InputError, match="open knots"):
+        sd.Model(sd.shapes.plane(cells=(4, 4), knots="uniform"), mat, boundary={"u0": "pole"})

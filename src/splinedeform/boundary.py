@@ -1,7 +1,8 @@
 """Boundary conditions as a sparse constraint map ``d = T d_free`` (DESIGN.md §1.6).
 
-Per edge a preset: ``free``, ``pinned`` (``d = 0`` on the edge) or ``clamped`` (``d = 0``
-and ``∂_n d = 0``). In one direction the end conditions are linear constraints
+Per edge a preset: ``free``, ``pinned`` (``d = 0`` on the edge), ``clamped`` (``d = 0``
+and ``∂_n d = 0``) or ``pole`` (a degenerate edge, such as the pole of a sphere, whose
+control points coincide: they move as one point, so the surface does not tear there). In one direction the end conditions are linear constraints
 ``C c = 0`` on the coefficients ``c`` of the 1-D basis, ``C`` made of rows ``b(x_e)`` and
 ``b'(x_e)`` at the ends. For open knots these are ``c_0 = 0`` (and ``c_1 = 0``); for
 Höllig's uniform knots they couple the ``n`` outer coefficients. Each end's constraints are
@@ -24,7 +25,7 @@ from numpy.typing import NDArray
 from .basis import BSplineBasis
 from .errors import InputError
 
-PRESETS = ("free", "pinned", "clamped")
+PRESETS = ("free", "pinned", "clamped", "pole")
 EDGES = ("u0", "u1", "v0", "v1")
 
 
@@ -49,7 +50,7 @@ def edge_conditions(boundary: str | Mapping[str, str]) -> dict[str, str]:
 
 def end_constraints(basis: BSplineBasis, end: int, preset: str) -> sp.csr_matrix:
     """Rows ``D^j b(x_e)``, ``j < r``, with ``r = 0, 1, 2`` for free, pinned, clamped."""
-    order = PRESETS.index(preset)
+    order = {"free": 0, "pole": 0, "pinned": 1, "clamped": 2}[preset]
     if order == 0:
         return sp.csr_matrix((0, basis.size))
     x = np.array([0.0 if end == 0 else basis.length])
@@ -130,7 +131,8 @@ class Constraints:
     @property
     def unconstrained(self) -> bool:
         """No edge condition and no fixed control point: rigid motions are free."""
-        return all(p == "free" for p in self.edges.values()) and not self.has_fixed_points
+        return (all(p in ("free", "pole") for p in self.edges.values())
+                and not self.has_fixed_points)
 
 
 def build_constraints(basis_u: BSplineBasis, basis_v: BSplineBasis,
@@ -152,15 +154,13 @@ def build_constraints(basis_u: BSplineBasis, basis_v: BSplineBasis,
     T_v, keep_v = constraint_map(basis_v, edges["v0"], edges["v1"])
     n_v = basis_v.size
     free_index = (keep_u[:, None] * n_v + keep_v[None, :]).ravel()
-    if fixed is None:
+    mask = None if fixed is None else _check_mask(fixed, basis_u, basis_v)
+    poles = [e for e, preset in edges.items() if preset == "pole"]
+    if poles:
+        return _with_poles(basis_u, basis_v, edges, poles, T_u, T_v, keep_u, keep_v, mask)
+    if mask is None:
         T = sp.kron(T_u, T_v, format="csr")
         return Constraints(T, T_u, T_v, free_index, edges, False)
-    mask = np.asarray(fixed)
-    if mask.shape != (basis_u.size, basis_v.size):
-        raise InputError(f"fixed mask must have shape (n_u, n_v) = "
-                         f"{(basis_u.size, basis_v.size)}, got {mask.shape}")
-    if mask.dtype != bool:
-        raise InputError(f"fixed mask must be boolean, got dtype {mask.dtype}")
     moving = ~mask[np.ix_(keep_u, keep_v)]
     rows_u, rows_v = np.any(moving, axis=1), np.any(moving, axis=0)
     rectangle = np.array_equal(moving, np.outer(rows_u, rows_v))
@@ -174,3 +174,57 @@ def build_constraints(basis_u: BSplineBasis, basis_v: BSplineBasis,
     T = sp.kron(T_u, T_v, format="csr")[:, moving.ravel()]
     return Constraints(T.tocsr(), None, None, free_index[moving.ravel()], edges,
                        bool(mask.any()))
+
+
+def _check_mask(fixed: NDArray[np.bool_], basis_u: BSplineBasis, basis_v: BSplineBasis
+                ) -> NDArray[np.bool_]:
+    mask = np.asarray(fixed)
+    if mask.shape != (basis_u.size, basis_v.size):
+        raise InputError(f"fixed mask must have shape (n_u, n_v) = "
+                         f"{(basis_u.size, basis_v.size)}, got {mask.shape}")
+    if mask.dtype != bool:
+        raise InputError(f"fixed mask must be boolean, got dtype {mask.dtype}")
+    return mask
+
+
+def _pole_rows(edge: str, basis_u: BSplineBasis, basis_v: BSplineBasis) -> NDArray[np.int64]:
+    """Flat indices of the control points on a degenerate edge (open knots only)."""
+    basis = basis_u if edge[0] == "u" else basis_v
+    if basis.kind != "open":
+        raise InputError(f"a pole edge ({edge}) needs open knots in {edge[0]} (its control "
+                         f"points must lie on the edge), got {basis.kind!r}")
+    n_u, n_v = basis_u.size, basis_v.size
+    line = 0 if edge[1] == "0" else (n_u if edge[0] == "u" else n_v) - 1
+    if edge[0] == "u":
+        return line * n_v + np.arange(n_v)
+    return np.arange(n_u) * n_v + line
+
+
+def _with_poles(basis_u: BSplineBasis, basis_v: BSplineBasis, edges: dict[str, str],
+                poles: list[str], T_u: sp.csr_matrix, T_v: sp.csr_matrix,
+                keep_u: NDArray[np.int64], keep_v: NDArray[np.int64],
+                mask: NDArray[np.bool_] | None) -> Constraints:
+    """Merge the coordinates of each pole edge into one: ``T ← T S`` (tensor form is lost)."""
+    n_v = basis_v.size
+    T = sp.kron(T_u, T_v, format="csr")
+    points = (keep_u[:, None] * n_v + keep_v[None, :]).ravel()     # control point per column
+    group = np.arange(points.size)
+    for edge in poles:
+        on_edge = np.flatnonzero(np.isin(points, _pole_rows(edge, basis_u, basis_v)))
+        if on_edge.size:
+            group[on_edge] = group[on_edge].min()
+    if mask is not None:
+        # a pole moves unless all of its points are fixed
+        moving = np.bincount(group, weights=~mask.ravel()[points], minlength=points.size)
+        keep_group = moving[group] > 0
+    else:
+        keep_group = np.ones(points.size, dtype=bool)
+    leaders = np.flatnonzero((group == np.arange(points.size)) & keep_group)
+    if leaders.size == 0:
+        raise InputError("every control point is fixed: nothing can move")
+    column_of = {g: i for i, g in enumerate(leaders)}
+    rows = np.flatnonzero(np.isin(group, leaders))
+    S = sp.csr_matrix((np.ones(rows.size), (rows, [column_of[g] for g in group[rows]])),
+                      shape=(points.size, leaders.size))
+    return Constraints((T @ S).tocsr(), None, None, points[leaders], edges,
+                       mask is not None and bool(mask.any()))
