@@ -106,7 +106,7 @@ class BSplineBasis:
     >>> b = BSplineBasis(3, 4, 1.0, "open")
     >>> b.size
     7
-    >>> float(b.matrix([0.3]).sum())
+    >>> round(float(b.matrix([0.3]).sum()), 12)
     1.0
     """
 
