@@ -13,11 +13,12 @@ each separable (one 1-D operator per direction, never a 2-D dense solve):
     Gauss–Legendre, ``n + 3`` points per cell), i.e. ``G0u P G0v = R``.
 ``"quasi"``
     A local quasi-interpolant ``p_kl = Σ_i Σ_j w^u_{ki} w^v_{lj} f(s_i, t_j)``: for every
-    basis function the weights are the row of the inverse of the ``(n+1) × (n+1)``
-    collocation matrix of one knot span of its support at ``n + 1`` equally spaced points of
-    that span (Lyche–Schumaker / Lyche–Mørken local interpolation). It reproduces every
+    basis function the weights are a row of the inverse of a small collocation matrix of
+    the ``2n + 1`` functions living on ``n + 1`` knot spans of its support (Lyche–Schumaker /
+    Lyche–Mørken local interpolation, see :func:`quasi_weights`). It reproduces every
     spline of the space, hence polynomials of degree ``n``, and converges at order ``n + 1``
-    like the two global methods, for all three knot layouts.
+    like the two global methods, for all three knot layouts; each coefficient depends on
+    ``f`` near its own support only.
 
 Each built-in shape returns a :class:`~splinedeform.surface.Surface` whose ``fit_error``
 is the largest distance ``|x(u,v) - f(u,v)|`` on a sample with 4 points per cell plus
@@ -50,6 +51,7 @@ from .errors import InputError
 from .quadrature import gauss_points, gram_matrix
 from .surface import Surface
 
+Domain = tuple[tuple[float, float], tuple[float, float]]
 Map = Callable[[NDArray[np.float64], NDArray[np.float64]], ArrayLike]
 FIT_METHODS: tuple[str, ...] = ("interpolate", "l2", "quasi")
 POINT_METHODS: tuple[str, ...] = ("interpolate", "l2")
@@ -59,8 +61,9 @@ CLOSED_CELLS = (16, 8)
 #: sample points per cell used for ``fit_error``
 ERROR_SAMPLES_PER_CELL = 4
 
-__all__ = ["FIT_METHODS", "cylinder", "fit_control_points", "from_function", "from_points",
-           "half_sphere", "plane", "saddle", "tile", "torus"]
+__all__ = ["FIT_METHODS", "cylinder", "error_samples", "fit_control_points", "fit_error",
+           "from_function", "from_points", "half_sphere", "plane", "quasi_weights", "saddle",
+           "tile", "torus"]
 
 
 # -- argument handling ---------------------------------------------------------------------
@@ -157,7 +160,7 @@ def fit_error(surface: Surface, f: Map, origin: tuple[float, float] = (0.0, 0.0)
 
 # -- 1-D building blocks (all fits are Kronecker products of these) -------------------------
 def _solve_both(Au: sp.spmatrix, Av: sp.spmatrix, R: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``P`` with ``A_u P A_vᵀ = R`` (``R`` of shape ``(n_u, n_v, c)``), by two sparse LU solves."""
+    """``P`` with ``A_u P A_vᵀ = R`` (``R`` of shape ``(n_u, n_v, c)``): two sparse LU solves."""
     n_u, n_v, c = R.shape
     left = spla.splu(sp.csc_matrix(Au)).solve(R.reshape(n_u, n_v * c))        # A_u^{-1} R
     tmp = left.reshape(n_u, n_v, c).transpose(1, 0, 2).reshape(n_v, n_u * c)
@@ -177,43 +180,58 @@ def _apply_both(Wu: sp.spmatrix, Wv: sp.spmatrix, X: NDArray[np.float64]) -> NDA
 def quasi_weights(basis: BSplineBasis) -> tuple[sp.csr_matrix, NDArray[np.float64]]:
     """Weights ``W`` and nodes ``s`` of the local quasi-interpolant ``c_k = Σ_i W_ki f(s_i)``.
 
-    For function ``k`` take a knot span ``[a, a + h]`` in the middle of its support (inside
-    ``[0, L]``), the ``n + 1`` nodes ``a + r h / n`` (``r = 0..n``) and the
-    ``(n+1) × (n+1)`` matrix ``A_{rj} = b_j(a + r h / n)`` of the functions ``j`` living on
-    that span; row ``k`` of ``A^{-1}`` gives the weights. Since the rule interpolates exactly
-    on the span, any spline ``Σ c_j b_j`` is reproduced: ``c_k`` is recovered exactly.
-    The nodes are the ``m n + 1`` points ``i h / n`` (``m n`` when periodic).
+    For function ``k`` take a window ``I_k`` of ``w = min(n+1, m)`` knot spans of
+    ``[0, L]`` (``min(n+1, m-n)`` when periodic): its support when that lies inside
+    ``[0, L]``, else the ``w`` spans at the end of ``[0, L]`` it overlaps. The ``D = w + n``
+    functions ``b_j`` not vanishing on ``I_k`` span the splines on it; interpolate ``f``
+    there at the ``D`` Greville abscissae of a clamped knot vector on ``I_k`` (well
+    conditioned), i.e. solve ``A c = f(s)`` with ``A_{rj} = b_j(s_r)``, and keep ``c_k``:
+    the weights are row ``k`` of ``A^{-1}`` (Lyche–Schumaker / Lyche–Mørken local
+    interpolation). Any spline ``Σ c_j b_j`` agrees on ``I_k`` with its local part, so it is
+    reproduced exactly (polynomial precision ``n``, order ``n + 1``). For the interior of a
+    uniform cubic basis the weights are the fixed stencil of a whole-support rule.
     """
     n, m, h = basis.degree, basis.cells, basis.h
     k = np.arange(basis.size)
     if basis.periodic:
-        span = np.mod(k + (n + 1) // 2, m)      # function k lives on cells k..k+n (mod m)
-        count = m * n
+        w = min(n + 1, m - n)                  # the D = w + n local functions are distinct
+        start = k + (n + 1 - w) // 2           # function k lives on cells k..k+n (mod m)
+        active = np.mod(start[:, None] - n + np.arange(w + n), m)
     else:
-        lo, hi = np.maximum(k - n, 0), np.minimum(k, m - 1)
-        span = (lo + hi) // 2                  # function k lives on cells k-n..k
-        count = m * n + 1
-    node = span[:, None] * n + np.arange(n + 1)                     # (size, n+1) node indices
-    x = node * (h / n)
+        w = min(n + 1, m)
+        start = np.clip(k - n, 0, m - w)       # function k lives on cells k-n..k
+        active = start[:, None] + np.arange(w + n)
+    local = BSplineBasis(n, w, w * h, "open").greville()                 # (D,)
+    x = start[:, None] * h + local                                       # (size, D)
     if basis.periodic:
-        node = np.mod(node, count)
-    functions, _ = basis.nonzero(span * h + 0.5 * h)                  # (size, n+1) on each span
-    A = _span_collocation(basis, x, functions)                         # (size, n+1, n+1)
-    inverse = np.linalg.inv(A)                                         # rows: functions
-    position = np.argmax(functions == k[:, None], axis=1)              # where k sits in its span
-    weights = inverse[np.arange(basis.size), position, :]              # (size, n+1)
-    W = sp.csr_matrix((weights.ravel(), (np.repeat(k, n + 1), node.ravel())),
-                      shape=(basis.size, count))
-    nodes = np.arange(count) * (h / n)
+        x = np.mod(x, basis.length)
+    A = _local_collocation(basis, x, active)                             # (size, D, D)
+    position = np.argmax(active == k[:, None], axis=1)
+    weights = np.linalg.inv(A)[k, position, :]                           # (size, D)
+    nodes, where = _merge_nodes(x.ravel(), 1e-12 * h)
+    W = sp.csr_matrix((weights.ravel(), (np.repeat(k, w + n), where)),
+                      shape=(basis.size, nodes.size))
+    W.sum_duplicates()
     return W, nodes
 
 
-def _span_collocation(basis: BSplineBasis, x: NDArray[np.float64],
-                      functions: NDArray[np.int64]) -> NDArray[np.float64]:
+def _merge_nodes(x: NDArray[np.float64], tol: float
+                 ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """Distinct values of ``x`` (closer than ``tol`` counts as equal) and each one's index."""
+    order = np.argsort(x)
+    group = np.concatenate([[0], np.cumsum(np.diff(x[order]) > tol)])
+    where = np.empty_like(group)
+    where[order] = group
+    first = np.concatenate([[True], np.diff(group) > 0])
+    return x[order][first], where
+
+
+def _local_collocation(basis: BSplineBasis, x: NDArray[np.float64],
+                       functions: NDArray[np.int64]) -> NDArray[np.float64]:
     """``A[k, r, j] = b_{functions[k, j]}(x[k, r])`` (zero outside the support)."""
-    index, values = basis.nonzero(x)                                   # (size, n+1, n+1)
-    match = (index[:, :, :, None] == functions[:, None, None, :]).astype(float)        # (size, r, q, j)
-    return np.einsum("krq,krqj->krj", values, match)
+    index, values = basis.nonzero(x)                                     # (size, D, n+1)
+    match = index[:, :, :, None] == functions[:, None, None, :]          # (size, D, n+1, D)
+    return np.einsum("krq,krqj->krj", values, match.astype(float))
 
 
 def _projection_weights(basis: BSplineBasis, points_per_cell: int
@@ -257,7 +275,7 @@ def fit_control_points(f: Map, basis_u: BSplineBasis, basis_v: BSplineBasis,
 
 def from_function(f: Map, cells: int | tuple[int, int] = DEFAULT_CELLS, degree: int = 3,
                   knots: str | tuple[str, str] = "open",
-                  domain: tuple[tuple[float, float], tuple[float, float]] = ((0.0, 1.0), (0.0, 1.0)),
+                  domain: Domain = ((0.0, 1.0), (0.0, 1.0)),
                   method: str = "interpolate", name: str | None = None) -> Surface:
     """Fit a spline surface to a parametric map ``f(u, v)`` on a parameter rectangle.
 
@@ -298,12 +316,13 @@ def from_function(f: Map, cells: int | tuple[int, int] = DEFAULT_CELLS, degree: 
     return _fitted(f, bu, bv, method, name or "function", (a, c))
 
 
-def _domain(domain: Any) -> tuple[tuple[float, float], tuple[float, float]]:
+def _domain(domain: Any) -> Domain:
     try:
         (a, b), (c, d) = domain
         a, b, c, d = (float(t) for t in (a, b, c, d))
     except (TypeError, ValueError):
-        raise InputError(f"domain must be ((u_min, u_max), (v_min, v_max)), got {domain!r}") from None
+        raise InputError(f"domain must be ((u_min, u_max), (v_min, v_max)), "
+                         f"got {domain!r}") from None
     if not all(np.isfinite([a, b, c, d])) or b <= a or d <= c:
         raise InputError(f"domain must be finite with u_min < u_max and v_min < v_max, "
                          f"got {domain!r}")
@@ -320,7 +339,7 @@ def _fitted(f: Map, basis_u: BSplineBasis, basis_v: BSplineBasis, method: str, n
 # -- point grids ----------------------------------------------------------------------------
 def from_points(grid: ArrayLike, cells: int | tuple[int, int] = DEFAULT_CELLS, degree: int = 3,
                 knots: str | tuple[str, str] = "open", method: str = "interpolate",
-                domain: tuple[tuple[float, float], tuple[float, float]] = ((0.0, 1.0), (0.0, 1.0)),
+                domain: Domain = ((0.0, 1.0), (0.0, 1.0)),
                 name: str | None = None) -> Surface:
     """Fit a spline surface to a grid of points sampled evenly on the parameter domain.
 
