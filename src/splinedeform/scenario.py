@@ -396,6 +396,17 @@ def scalar_or_pair(item: Callable[[Any], Any], name: str) -> Callable[[Any], tup
     return check
 
 
+def one_or_pair(item: Callable[[Any], Any], name: str) -> Callable[[Any], Any]:
+    """Like :func:`scalar_or_pair` but a single value is kept as given (not doubled)."""
+    both = scalar_or_pair(item, name)
+
+    def check(value: Any) -> Any:
+        pair = both(value)
+        return pair if isinstance(value, list) else pair[0]
+    check.allowed = both.allowed  # type: ignore[attr-defined]
+    return check
+
+
 def array_of(item: Callable[[Any], Any], name: str, min_length: int = 0) -> Callable[[Any], tuple]:
     """Checker of an array (at least ``min_length`` long) of items."""
     allowed = f"an array of {name}" + (f" (at least {min_length})" if min_length else "")
@@ -441,23 +452,30 @@ _PAIR = vector(2, _POSITIVE, "[u, v]")
 _RANGE = vector(2, _REAL, "[low, high]")
 
 #: parameters of each built-in shape (passed to the function of ``splinedeform.shapes``)
+_SIZE = Key(scalar_or_pair(_POSITIVE, "[L_u, L_v]"), (1.0, 1.0),
+            "side lengths; the domain is [0, L_u] × [0, L_v]")
 SHAPE_PARAMETERS: dict[str, dict[str, Key]] = {
-    "plane": {"size": Key(scalar_or_pair(_POSITIVE, "[L_u, L_v]"), (1.0, 1.0),
-                          "side lengths of the square / rectangle")},
-    "tile": {},
+    "plane": {"size": _SIZE},
+    "tile": {"radius": Key(_POSITIVE, 1.0, "radius of the arc"),
+             "angle": Key(number(0.0, 2 * math.pi, open_low=True), math.pi / 2,
+                          "opening angle of the arc (radians, < 2π)"),
+             "length": Key(_POSITIVE, 2.0, "length along the axis")},
     "half_sphere": {"radius": Key(_POSITIVE, 1.0, "sphere radius")},
-    "cylinder": {},
-    "torus": {},
-    "saddle": {},
+    "cylinder": {"radius": Key(_POSITIVE, 1.0, "radius"),
+                 "height": Key(_POSITIVE, 2.0, "height (along z)")},
+    "torus": {"R": Key(_POSITIVE, 1.0, "radius of the centre line"),
+              "r": Key(_POSITIVE, 0.4, "tube radius (r < R)")},
+    "saddle": {"size": _SIZE,
+               "height": Key(_REAL, 0.25, "z = height (ξ² - η²), ξ, η in [-1, 1]")},
     "file": {},
 }
 
 SURFACE_KEYS: dict[str, Key] = {
     "shape": Key(choice(*SHAPES), doc="built-in shape, or a net / point grid from a file"),
-    "cells": Key(scalar_or_pair(integer(1, 512), "[m_u, m_v]"), (8, 8),
-                 "knot spans per direction"),
+    "cells": Key(scalar_or_pair(integer(1, 512), "[m_u, m_v]"), None,
+                 "knot spans per direction (default: the shape's own)"),
     "degree": Key(integer(1, 7), 3, "polynomial degree of the B-splines"),
-    "knots": Key(scalar_or_pair(choice(*KNOTS), "[u, v]"), None,
+    "knots": Key(one_or_pair(choice(*KNOTS), "[u, v]"), None,
                  "knot layout per direction (default: the shape's own)"),
     "method": Key(choice(*FIT_METHODS), "interpolate",
                   "how control points are fitted to the shape"),
@@ -568,9 +586,9 @@ class SurfaceSpec:
     """``[surface]``: a built-in shape with its parameters, or a file."""
 
     shape: str
-    cells: tuple[int, int] = (8, 8)
+    cells: tuple[int, int] | None = None
     degree: int = 3
-    knots: tuple[str, str] | None = None
+    knots: str | tuple[str, str] | None = None
     method: str = "interpolate"
     path: Path | None = None
     frame: int = -1
@@ -1168,11 +1186,18 @@ def build_surface(scenario: Scenario) -> Any:
         return _surface_from_file(scenario)
     from . import shapes
 
-    options: dict[str, Any] = {"cells": spec.cells, "degree": spec.degree}
+    with _located(scenario, "surface"):
+        return getattr(shapes, spec.shape)(**spec.parameters, **_fit_options(spec))
+
+
+def _fit_options(spec: SurfaceSpec) -> dict[str, Any]:
+    """``cells``, ``degree``, ``knots``, ``method`` for a shape function (None: its default)."""
+    options: dict[str, Any] = {"degree": spec.degree, "method": spec.method}
+    if spec.cells is not None:
+        options["cells"] = spec.cells
     if spec.knots is not None:
         options["knots"] = spec.knots
-    with _located(scenario, "surface"):
-        return getattr(shapes, spec.shape)(**spec.parameters, **options)
+    return options
 
 
 def _surface_from_file(scenario: Scenario) -> Any:
@@ -1200,12 +1225,11 @@ def _surface_from_file(scenario: Scenario) -> Any:
     if "frame" in scenario.raw.get("surface", {}):
         raise scenario.error("surface.frame", "applies to control net files only, "
                                               f"{path.name} is a point grid")
-    options: dict[str, Any] = {"cells": spec.cells, "degree": spec.degree,
-                               "method": spec.method}
-    if spec.knots is not None:
-        options["knots"] = spec.knots
+    if spec.method == "quasi":
+        raise scenario.error("surface.method", "a point grid is fitted by \"interpolate\" "
+                                               "or \"l2\" (\"quasi\" needs a function)")
     with _located(scenario, "surface.path"):
-        return shapes.from_points(grid, **options)
+        return shapes.from_points(grid, **_fit_options(spec))
 
 
 def _point_grid(scenario: Scenario, path: Path) -> Any:
