@@ -213,3 +213,11 @@ def test_demo_runs_the_built_in_half_sphere(tmp_path):
     assert report["inputs"]["surface"]["shape"] == "half_sphere"
     assert report["solver"]["kind"] == "dynamic" and report["solver"]["method"] == "analytic"
     assert report["inputs"]["load"][0]["kind"] == "point"
+
+
+def test_info_reports_a_missing_extra(monkeypatch):
+    monkeypatch.setitem(sys.modules, "pyvista", None)    # import fails like a missing package
+    result = runner.invoke(cli.app, ["info"])
+    assert result.exit_code == 0
+    row = next(line for line in result.stdout.splitlines() if "pyvista" in line)
+    assert "missing" in row

@@ -179,7 +179,7 @@ def all_test_texts() -> list[str]:
 
 
 def normalised(path: str) -> str:
-    """``load[2].force`` -> ``load.force``; element paths ``output.probes[1]`` -> ``output.probes``."""
+    """``load[2].force`` -> ``load.force``; ``output.probes[1]`` -> ``output.probes``."""
     return re.sub(r"\[\d+\]", "", path)
 
 
@@ -537,3 +537,50 @@ def test_doc_lists_every_output_format():
     table = text[text.index("| name | writes |"):]
     named = set(re.findall(r"\*\*([a-z0-9]+)\*\*", table))
     assert named == set(FORMATS) | set(FORMAT_ALIASES)
+
+
+# -- robustness: any wrong value gives a ScenarioError, never another exception ------------
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+TOML_VALUES = st.recursive(
+    st.none() | st.booleans() | st.integers(-10**6, 10**6)
+    | st.floats(allow_nan=True, allow_infinity=True) | st.text(max_size=8),
+    lambda inner: st.lists(inner, max_size=4) | st.dictionaries(
+        st.sampled_from(["u", "v", "kind", "x"]), inner, max_size=3),
+    max_leaves=8)
+
+
+def document(raw: dict) -> str:
+    """TOML text of a document given as nested dicts (tables as inline tables)."""
+    from splinedeform.scenario import _toml_value
+
+    def clean(value):   # TOML has no null: drop None
+        if isinstance(value, dict):
+            return {k: clean(v) for k, v in value.items() if v is not None}
+        if isinstance(value, list):
+            return [clean(v) for v in value if v is not None]
+        return value
+    return "\n".join(f"{k} = {_toml_value(v)}" for k, v in clean(raw).items()
+                     if v is not None) + "\n"
+
+
+@settings(max_examples=150, deadline=None)
+@given(table=st.sampled_from(sorted(COVERAGE)), data=st.data(), value=TOML_VALUES)
+def test_any_wrong_value_is_a_scenario_error(table, data, value):
+    import tomllib
+
+    raw = tomllib.loads(COVERAGE[table])
+    section = data.draw(st.sampled_from(sorted(raw)))
+    target = raw[section]
+    if isinstance(target, list):
+        target = target[0]
+    if isinstance(target, dict):
+        key = data.draw(st.sampled_from(sorted(target) + ["extra"]))
+        target[key] = value
+    else:
+        raw[section] = value
+    try:
+        parse_scenario(document(raw))
+    except ScenarioError as exc:
+        assert "<scenario>" in str(exc) and "TOML syntax error" not in str(exc)

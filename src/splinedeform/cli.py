@@ -147,7 +147,7 @@ def demo_scenario() -> Any:
 def demo_command(outdir: Path = typer.Option(Path("demo-output"), "-o", "--outdir",
                                              help="Output folder (created if missing)."),
                  quiet: bool = QUIET_OPT, debug: bool = DEBUG_OPT) -> None:
-    """Run the built-in demo: a clamped half sphere pushed in at the pole, every output."""
+    """Run the built-in demo: a clamped half sphere pushed in near the pole, every output."""
     with _reported_errors(debug):
         _run(demo_scenario(), outdir, quiet)
 
@@ -172,10 +172,17 @@ def examples_directory() -> Path | None:
 
 
 def _optional_rows() -> list[tuple[str, str]]:
+    """One row per optional package: its version if it imports, else why not."""
     rows = []
     for module, (dist, use) in OPTIONAL.items():
-        if importlib.util.find_spec(module) is None:
+        try:
+            importlib.import_module(module)
+        except ImportError:
             rows.append((dist, f"missing  ({use})"))
+            continue
+        except Exception as exc:  # noqa: BLE001  (installed but broken, e.g. a missing library)
+            rows.append((dist, f"installed but fails to import: {type(exc).__name__}: {exc}  "
+                               f"({use})"))
             continue
         try:
             version = metadata.version(dist)

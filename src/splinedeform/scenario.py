@@ -382,7 +382,8 @@ def vector(length: int, item: Callable[[Any], Any], name: str) -> Callable[[Any]
 def scalar_or_pair(item: Callable[[Any], Any], name: str) -> Callable[[Any], tuple]:
     """Checker of one value for both directions or a pair ``[u, v]``."""
     pair = vector(2, item, name)
-    allowed = f"{getattr(item, 'allowed', 'a value')} or {pair.allowed}"  # type: ignore[attr-defined]
+    pair_allowed = getattr(pair, "allowed", "a pair")
+    allowed = f"{getattr(item, 'allowed', 'a value')} or {pair_allowed}"
 
     def check(value: Any) -> tuple:
         if isinstance(value, list):
@@ -597,7 +598,7 @@ class SurfaceSpec:
 
 @dataclass(frozen=True)
 class MaterialSpec:
-    """``[material]``: the arguments of :class:`~splinedeform.material.Material` and the mass matrix."""
+    """``[material]``: the :class:`~splinedeform.material.Material` arguments and the mass matrix."""
 
     mass: float = 1.0
     damping: float = 0.0
@@ -663,7 +664,7 @@ class SolveSpec:
     dt: float | None = None
 
     def frame_times(self) -> tuple[float, ...]:
-        """The output times: ``times`` if given, else ``frames`` equally spaced in ``[0, t_end]``."""
+        """Frame times: ``times`` if given, else ``frames`` equally spaced in ``[0, t_end]``."""
         if self.times is not None:
             return self.times
         t_end = self.t_end or 0.0
