@@ -97,8 +97,14 @@ class Surface:
         """
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
         P = self.control_points if control_points is None else np.asarray(control_points, float)
-        E = self.evaluation_matrix(u, v, du, dv)
-        return np.asarray(E @ P.reshape(E.shape[1], -1)).reshape(u.shape + P.shape[2:])
+        iu, bu = self.basis_u.nonzero(u.ravel(), du)
+        iv, bv = self.basis_v.nonzero(v.ravel(), dv)
+        # gather the (n+1)² control points of each parameter's cell: Σ_r Σ_s bu_r bv_s p_rs
+        flat = P.reshape(P.shape[0] * P.shape[1], -1)
+        index = (iu[:, :, None] * P.shape[1] + iv[:, None, :]).reshape(u.size, -1)
+        weights = (bu[:, :, None] * bv[:, None, :]).reshape(u.size, -1)
+        out = np.einsum("pk,pkc->pc", weights, np.take(flat, index, axis=0))
+        return out.reshape(u.shape + P.shape[2:])
 
     def evaluate(self, u: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
         """Points ``x(u, v)``; ``u`` and ``v`` broadcast to ``S``, result ``S + (3,)``."""
