@@ -105,12 +105,19 @@ def _box(ax: Any, points: NDArray[np.float64], zoom: float = 1.0) -> None:
     """Equal aspect: the tight box around ``points``, padded where it is flat."""
     flat = points.reshape(-1, 3)
     lo, hi = flat.min(axis=0), flat.max(axis=0)
-    pad = np.maximum(hi - lo, 0.04 * max(float(np.max(hi - lo)), 1e-12)) / 2
+    pad = np.maximum(hi - lo, 0.05 * max(float(np.max(hi - lo)), 1e-12)) / 2
     centre = 0.5 * (lo + hi)
     ax.set_xlim(centre[0] - pad[0], centre[0] + pad[0])
     ax.set_ylim(centre[1] - pad[1], centre[1] + pad[1])
     ax.set_zlim(centre[2] - pad[2], centre[2] + pad[2])
     ax.set_box_aspect(tuple(2 * pad), zoom=zoom)
+    from matplotlib.ticker import MaxNLocator
+
+    for axis, extent in zip((ax.xaxis, ax.yaxis, ax.zaxis), pad / pad.max()):
+        if extent < 0.15:            # a thin side of the box has no room for tick labels
+            axis.set_ticks([])
+        elif extent < 0.4:
+            axis.set_major_locator(MaxNLocator(3))
 
 
 def _collection(vertices: NDArray[np.float64], faces: NDArray[np.int64],
