@@ -584,3 +584,8 @@ def test_any_wrong_value_is_a_scenario_error(table, data, value):
         parse_scenario(document(raw))
     except ScenarioError as exc:
         assert "<scenario>" in str(exc) and "TOML syntax error" not in str(exc)
+
+
+def test_printed_strings_survive_control_characters():
+    s = parse_scenario('title = "a\\u007fb\\u0001\\\\ \\" é"\n' + STATIC)
+    assert parse_scenario(scenario_to_toml(s)).title == s.title == 'a\x7fb\x01\\ " é'
