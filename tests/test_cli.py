@@ -134,7 +134,7 @@ def test_missing_file_is_an_input_error(tmp_path):
 
 
 def test_unexpected_errors_exit_1_without_traceback(scenario, tmp_path, monkeypatch):
-    import splinedeform.scenario as sc
+    import splinedeform.pipeline as sc
 
     def broken(*args, **kwargs):
         raise RuntimeError("disk on fire")

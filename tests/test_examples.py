@@ -11,7 +11,8 @@ from typing import Any, Callable
 import numpy as np
 import pytest
 
-from splinedeform.scenario import RunResult, load_scenario, run, with_overrides
+from splinedeform.pipeline import RunResult, run
+from splinedeform.scenario import load_scenario, with_overrides
 
 pytest.importorskip("splinedeform.shapes")
 

@@ -485,7 +485,7 @@ def test_domain_is_checked_after_building(tmp_path, shapes):
 def test_library_errors_are_located_at_the_scenario_key(shapes):
     text = STATIC.replace('u0 = "pinned"\nu1 = "pinned"\nv0 = "pinned"\nv1 = "pinned"', "")
     s = parse_scenario(text, source="case.toml")
-    from splinedeform.scenario import run
+    from splinedeform.pipeline import run
     line = text.splitlines().index("[solve]") + 1
     with pytest.raises(ScenarioError, match=rf"case\.toml:{line}: solve: .*unconstrained"):
         run(with_overrides(s, {"output.formats": []}))

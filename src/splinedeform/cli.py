@@ -104,7 +104,7 @@ def _table(title: str, rows: list[tuple[str, str]]) -> Any:
 def _run(scenario: Any, outdir: Path, quiet: bool) -> None:
     """Run a validated scenario with progress bars and print the summary table."""
     from ._progress import StageProgress
-    from .scenario import run, summary_rows
+    from .pipeline import run, summary_rows
 
     out, err = _consoles()
     with StageProgress(err, enabled=not quiet) as progress:
