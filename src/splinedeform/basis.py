@@ -62,22 +62,24 @@ def _hollig_table(s: NDArray[np.float64], degree: int, max_derivative: int
     (DESIGN.md §1.1, unscaled: ``h = 1``). Returns a list indexed by ``j`` of
     arrays of shape ``s.shape + (n+1,)``.
     """
-    levels = [np.ones(s.shape + (1,))]  # levels[d][..., q] = b^d(s + q)
+    # levels[d][q] = b^d(s + q), q = 0..d, kept as a leading axis so each update is contiguous
+    flat = np.ravel(s)
+    levels = [np.ones((1, flat.size))]
     for d in range(1, degree + 1):
         prev = levels[-1]
-        q = np.arange(d + 1)
-        y = s[..., None] + q
-        left = np.concatenate([prev, np.zeros(s.shape + (1,))], axis=-1)   # b^{d-1}(s+q)
-        right = np.concatenate([np.zeros(s.shape + (1,)), prev], axis=-1)  # b^{d-1}(s+q-1)
-        levels.append((y * left + (d + 1 - y) * right) / d)
+        new = np.zeros((d + 1, flat.size))
+        y = flat + np.arange(d + 1)[:, None]
+        new[:d] = y[:d] * prev                   # (s+q)/d · b^{d-1}(s+q)
+        new[1:] += (d + 1 - y[1:]) * prev        # (d+1-s-q)/d · b^{d-1}(s+q-1)
+        levels.append(new / d)
     out = []
     for j in range(max_derivative + 1):
         low = levels[degree - j]  # b^{n-j}(s + q), q = 0..n-j
-        acc = np.zeros(s.shape + (degree + 1,))
+        acc = np.zeros((degree + 1, flat.size))
         for i in range(j + 1):
             # b^{n-j}(s + q - i) sits at q = i .. i + n - j
-            acc[..., i:i + degree - j + 1] += (-1) ** i * comb(j, i) * low
-        out.append(acc)
+            acc[i:i + degree - j + 1] += (-1) ** i * comb(j, i) * low
+        out.append(np.moveaxis(acc, 0, -1).reshape(np.shape(s) + (degree + 1,)))
     return out
 
 
@@ -230,13 +232,15 @@ class BSplineBasis:
         if self.kind == "periodic":
             index = np.mod(index - n, self.cells)
         jmax = min(max_derivative, n)
+        table = _hollig_table(x / h - cell, n, jmax)
+        # function r (0..n) on the cell is b^n(s + n - r): reverse the q axis
+        values = np.stack([table[j][..., ::-1] * h ** (-j) for j in range(jmax + 1)])
         if self.kind == "open":
-            values = _cox_de_boor(self.knots, n, cell + n, x, jmax)
-        else:
-            s = x / h - cell
-            table = _hollig_table(s, n, jmax)
-            # function r (0..n) on the cell is b^n(s + n - r): reverse the q axis
-            values = np.stack([table[j][..., ::-1] * h ** (-j) for j in range(jmax + 1)])
+            # cells n-1 .. m-n see only uniform knots (Höllig applies); the n-1 cells at
+            # each end see repeated knots and take the general Cox–de Boor recurrence
+            ends = (cell < n - 1) | (cell > self.cells - n)
+            if np.any(ends):
+                values[:, ends] = _cox_de_boor(self.knots, n, cell[ends] + n, x[ends], jmax)
         if max_derivative > jmax:
             pad = np.zeros((max_derivative - jmax,) + values.shape[1:])
             values = np.concatenate([values, pad])
