@@ -17,7 +17,6 @@ import time
 from typing import Any, Mapping
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
@@ -28,6 +27,7 @@ from .loads import Load, as_load
 from .material import Material
 from .quadrature import gram_matrix
 from .solution import ModalSolution, SampledSolution, StaticSolution
+from .solvers import modal_basis
 from .solvers.analytic import ModalResponse
 from .surface import Surface
 
@@ -122,6 +122,7 @@ class Model:
         self._C = ((material.damping / material.mass) * self._M
                    + material.rayleigh * self._K).tocsc()
         self._eigen: tuple[Array, Array] | None = None
+        self._bases: dict[tuple, modal_basis.ModalBasis] = {}
         self.timings: dict[str, float] = {"assembly": time.perf_counter() - start}
 
     # -- layout --------------------------------------------------------------------
@@ -189,16 +190,64 @@ class Model:
     def eigen(self, k: int | None = None) -> tuple[Array, Array]:
         """Lowest ``k`` (default all) eigenpairs of ``K_r φ = λ M_r φ`` with ``Φᵀ M_r Φ = I``.
 
-        Dense ``eigh`` of the reduced system (the reference path); cached.
+        Ascending ``λ`` (round-off negatives clipped to 0) and explicit ``Φ`` of shape
+        ``(n_free, k)``. Dense ``eigh`` of the reduced system (the reference) up to
+        ``DENSE_LIMIT`` free coordinates; larger nets use the separable Kronecker factors
+        when they apply, sparse shift-invert Lanczos for the lowest ``k``, or dense ``eigh``
+        up to ``DENSE_MAX`` (see :mod:`splinedeform.solvers.modal_basis`). Cached.
         """
-        if self._eigen is None:
-            start = time.perf_counter()
-            lam, phi = sla.eigh(self._K.toarray(), self._M.toarray(), check_finite=False)
-            self._eigen = (np.maximum(lam, 0.0), phi)
-            self.timings["eigen"] = time.perf_counter() - start
-        lam, phi = self._eigen
-        k = lam.size if k is None else _check_count(k, lam.size)
-        return lam[:k], phi[:, :k]
+        n = self.n_free
+        if k is not None:
+            k = _check_count(k, n)
+        strategy = modal_basis.choose(self, "auto", truncated=k is not None and k <= n // 2)
+        if strategy == "dense":
+            basis = self.modal_basis("dense")
+            return basis.lam[:k], basis.phi[:, :k]
+        if strategy == "sparse":
+            basis = self.modal_basis("sparse", modes=k)
+            return basis.lam, basis.phi
+        basis = self.modal_basis("separable")
+        if k is None and n > modal_basis.DENSE_MAX:
+            raise InputError(f"all {n} modes as an explicit matrix need "
+                             f"{8 * n * n / 2**30:.1f} GiB; ask for the lowest k modes, or "
+                             "use dynamic(), which keeps the Kronecker factors")
+        order = np.argsort(basis.lam, kind="stable")[:k]
+        return basis.lam[order], basis.columns(order)
+
+    def modal_basis(self, eigensolver: str = "auto", modes: int | None = None,
+                    omega_max: float | None = None) -> modal_basis.ModalBasis:
+        """Modes as a :class:`~splinedeform.solvers.modal_basis.ModalBasis` (cached).
+
+        Parameters
+        ----------
+        eigensolver : {"auto", "dense", "separable", "sparse"}
+            See :func:`~splinedeform.solvers.modal_basis.choose`.
+        modes, omega_max : optional
+            Keep only the lowest ``modes`` modes, or those with ``ω <= omega_max``.
+        """
+        truncated = modes is not None or omega_max is not None
+        strategy = modal_basis.choose(self, eigensolver, truncated)
+        key = (strategy, modes, omega_max)
+        if key in self._bases:
+            return self._bases[key]
+        start = time.perf_counter()
+        if strategy == "sparse":
+            basis: modal_basis.ModalBasis = modal_basis.sparse_basis(
+                self._K, self._M, modes, omega_max, self.constraints.unconstrained)
+        else:
+            basis = self.modal_basis(strategy) if truncated else self._complete_basis(strategy)
+            if truncated:
+                basis = modal_basis.truncate(basis, modes, omega_max)
+        self._bases[key] = basis
+        self.timings["eigen"] = time.perf_counter() - start
+        return basis
+
+    def _complete_basis(self, strategy: str) -> modal_basis.ModalBasis:
+        if strategy == "separable":
+            return modal_basis.separable_basis(self)
+        basis = modal_basis.dense_basis(self._K, self._M)
+        self._eigen = (basis.lam, basis.phi)
+        return basis
 
     def frequencies(self, k: int = 6) -> Array:
         """Lowest ``k`` undamped angular frequencies ``ω_i = √λ_i``, ascending."""
@@ -247,7 +296,11 @@ class Model:
             Output times for numerical methods (default 201 evenly spaced on ``[0, t_end]``).
         options
             ``analytic``: ``function_samples`` (piecewise-constant sampling of time-dependent
-            ``Function`` loads, default 400). ``newmark``: ``dt``. ``solve_ivp`` methods:
+            ``Function`` loads, default 400); ``modes`` (keep the lowest k modes) or
+            ``omega_max`` (keep ``ω <= omega_max``), both with the exact static part of the
+            omitted modes (mode acceleration) and a report in ``solution.truncation``;
+            ``eigensolver`` (``"auto"``, ``"dense"``, ``"separable"``, ``"sparse"``, see
+            :func:`splinedeform.solvers.modal_basis.choose`). ``newmark``: ``dt``. ``solve_ivp`` methods:
             ``rtol``, ``atol``, ``max_step``.
         """
         from .solvers import numeric
@@ -268,16 +321,71 @@ class Model:
         return numeric.integrate(self, forcing, method, t_end, times, d0, v0, **options)
 
     def _analytic(self, forcing: Any, t_end: float, d0: Array, v0: Array,
-                  function_samples: int = 400) -> ModalSolution:
-        lam, phi = self.eigen()
+                  function_samples: int = 400, modes: int | None = None,
+                  omega_max: float | None = None, eigensolver: str = "auto") -> ModalSolution:
+        """Closed-form modal solution; ``modes``/``omega_max`` truncate with mode acceleration."""
+        modes, omega_max = self._truncation_request(modes, omega_max)
+        basis = self.modal_basis(eigensolver, modes, omega_max)
         start = time.perf_counter()
         M = self._M
+        lam = basis.lam
         c = self.material.damping / self.material.mass + self.material.rayleigh * lam
-        jumps, harmonics = forcing.modal_terms(phi, t_end, function_samples)
-        response = ModalResponse(lam, c, phi.T @ (M @ d0), phi.T @ (M @ v0), jumps, harmonics)
+        # the reduced force terms in space: modal terms of the identity basis
+        spatial = forcing.modal_terms(sp.identity(self.n_free, format="csr"), t_end,
+                                      function_samples)
+        jumps = [(t_j, basis.project(F)) for t_j, F in spatial[0]]
+        harmonics = [(w, phase, basis.project(F)) for w, phase, F in spatial[1]]
+        response = ModalResponse(lam, c, basis.project(M @ d0), basis.project(M @ v0),
+                                 jumps, harmonics)
+        correction, truncation = None, {}
+        if not basis.complete:
+            correction, truncation = self._truncation(basis, spatial, d0, v0)
         timings = dict(self.timings)
         timings["modal setup"] = time.perf_counter() - start
-        return ModalSolution(self, t_end, forcing, timings, phi, response, {})
+        return ModalSolution(self, t_end, forcing, timings, basis, response, truncation,
+                             correction)
+
+    def _truncation_request(self, modes: int | None, omega_max: float | None
+                            ) -> tuple[int | None, float | None]:
+        if modes is not None and omega_max is not None:
+            raise InputError("give either modes=k or omega_max=, not both")
+        if modes is not None:
+            modes = _check_count(modes, self.n_free)
+        if omega_max is not None:
+            try:
+                omega_max = float(omega_max)
+            except (TypeError, ValueError):
+                raise InputError(f"omega_max must be a number, got {omega_max!r}") from None
+            if not np.isfinite(omega_max) or omega_max <= 0:
+                raise InputError(f"omega_max must be finite and > 0, got {omega_max}")
+        return modes, omega_max
+
+    def _truncation(self, basis: modal_basis.ModalBasis, spatial: tuple[list, list],
+                    d0: Array, v0: Array) -> tuple[Any, dict[str, Any]]:
+        """Mode-acceleration correction and the truncation report of a truncated basis."""
+        report: dict[str, Any] = {
+            "modes": basis.size, "n_free": self.n_free,
+            "omega_max_kept": float(np.sqrt(basis.lam.max())),
+            "omega_first_omitted": float(np.sqrt(basis.first_omitted)),
+            "initial_residual": max(_outside(basis, self._M, d0), _outside(basis, self._M, v0)),
+        }
+        if not basis.can_solve_static:
+            report.update(static_correction=False, omitted_static=float("nan"),
+                          static_residual=float("nan"))
+            return None, report
+        correction, indicators = modal_basis.mode_acceleration(basis, self._K, self._M,
+                                                               *spatial)
+        report.update(static_correction=True, **indicators)
+        return correction, report
+
+
+def _outside(basis: modal_basis.ModalBasis, M: sp.spmatrix, x: Array) -> float:
+    """Relative M-norm of the part of ``x`` outside the span of a basis."""
+    norm = float(np.sqrt(np.sum(x * (M @ x))))
+    if norm == 0.0:
+        return 0.0
+    rest = x - basis.expand(basis.project(M @ x)[None])[0]
+    return float(np.sqrt(max(np.sum(rest * (M @ rest)), 0.0))) / norm
 
 
 def _check_count(k: int, available: int) -> int:
