@@ -10,7 +10,7 @@ share ``T``). Energies follow DESIGN.md §1.4: kinetic ``½ Σ_c v_cᵀ M v_c``,
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 import scipy.sparse as sp
@@ -37,6 +37,23 @@ class Energy:
     def total(self) -> Array:
         """``kinetic + strain - work``."""
         return self.kinetic + self.strain - self.work
+
+
+@dataclass(frozen=True)
+class Frames:
+    """Many frames of a solution (see :meth:`Solution.frames`).
+
+    Attributes
+    ----------
+    times : ndarray (F,)
+    control_points : ndarray (F, n_u, n_v, 3)
+    points : ndarray (F, r_u, r_v, 3) or None
+        Surface samples on the parameter grid, when a resolution was asked for.
+    """
+
+    times: Array
+    control_points: Array
+    points: Array | None
 
 
 def _check_times(t: ArrayLike, t_end: float | None = None) -> tuple[Array, bool]:
@@ -116,6 +133,7 @@ class Solution(_Displaced):
         self.t_end = float(t_end)
         self._force_free = force_free
         self.timings = timings
+        self._grid_matrices: dict = {}
 
     def state(self, t: ArrayLike) -> tuple[Array, Array]:
         """Free displacements and velocities at times ``t`` (F,), each ``(F, n_free, 3)``."""
@@ -149,6 +167,30 @@ class Solution(_Displaced):
         out = out.reshape((times.size,) + u.shape + (3,))
         return out[0] if scalar else out
 
+    def frames(self, times: ArrayLike, resolution: int | tuple[int, int] | None = None
+               ) -> Frames:
+        """Control nets at many times and, with ``resolution``, the surface sampled per frame.
+
+        The samples on the ``r_u × r_v`` parameter grid of
+        :meth:`~splinedeform.Surface.sample_parameters` are ``X_f = E P_f`` with the sparse
+        evaluation matrix ``E_{(i,j),(k,l)} = b_k(u_i) b_l(v_j)``, built once per resolution
+        and applied to all frames and coordinates in one sparse product.
+        """
+        times_arr, _ = _check_times(times)
+        nets = self.control_points(times_arr)
+        if resolution is None:
+            return Frames(times_arr, nets, None)
+        surf = self.model.surface
+        cache = self._grid_matrices
+        key = resolution if np.isscalar(resolution) else tuple(resolution)
+        if key not in cache:
+            u, v = surf.sample_parameters(resolution)
+            cache[key] = (surf.evaluation_matrix(u[:, None], v[None, :]), u.size, v.size)
+        E, ru, rv = cache[key]
+        flat = np.moveaxis(nets.reshape(times_arr.size, -1, 3), 0, 1).reshape(E.shape[1], -1)
+        points = np.moveaxis(np.asarray(E @ flat).reshape(ru, rv, times_arr.size, 3), 2, 0)
+        return Frames(times_arr, nets, points)
+
     def energy(self, t: ArrayLike) -> Energy:
         """Kinetic, strain and load-work energies at ``t`` (see the module docstring)."""
         times, scalar = _check_times(t)
@@ -170,25 +212,63 @@ def _quadratic(A: sp.spmatrix, x: Array) -> Array:
 
 
 class ModalSolution(Solution):
-    """Analytic solution: ``d_free(t) = Φ Q(t)`` with closed-form modal coordinates."""
+    """Analytic solution: ``d_free(t) = Φ Q(t)`` with closed-form modal coordinates.
+
+    ``Φ`` is a :class:`~splinedeform.solvers.modal_basis.ModalBasis` (an explicit matrix is
+    accepted too); a truncated basis adds the mode-acceleration ``correction(t)`` and reports
+    its truncation in ``truncation`` (see :meth:`splinedeform.Model.dynamic`). Times are
+    processed in chunks of about :attr:`chunk_entries` modal values so that many frames of a
+    large net fit in memory.
+    """
+
+    chunk_entries = 4_000_000
 
     def __init__(self, model: Model, t_end: float, force_free: Callable[[float], Array],
-                 timings: dict[str, float], phi: Array, response: Callable, omitted: dict):
+                 timings: dict[str, float], phi: Any, response: Callable, omitted: dict,
+                 correction: Callable[[Array], Array] | None = None):
+        from .solvers.modal_basis import DenseBasis, ModalBasis
+
         super().__init__(model, "analytic", t_end, force_free, timings)
-        self.phi = phi
+        self.basis = phi if isinstance(phi, ModalBasis) else DenseBasis(response.lam, phi)
         self.response = response
         self.truncation = omitted
-        self._full_phi: Array | None = None
+        self.correction = correction
+
+    @property
+    def phi(self) -> Array:
+        """The modes as an explicit ``(n_free, N)`` matrix (formed on demand for structured bases)."""
+        return self.basis.columns(np.arange(self.basis.size))
+
+    def _chunks(self, times: Array) -> list[Array]:
+        per = max(1, self.chunk_entries // max(3 * self.basis.size, 1))
+        return [times[i:i + per] for i in range(0, times.size, per)] or [times]
+
+    def _displacements(self, times: Array, velocities: bool) -> tuple[Array, Array | None]:
+        n = self.basis.n_free
+        d = np.empty((times.size, n, 3))
+        v = np.empty((times.size, n, 3)) if velocities else None
+        i = 0
+        for part in self._chunks(times):
+            Q, V = self.response(part)
+            d[i:i + part.size] = self.basis.expand(Q)
+            if self.correction is not None:
+                d[i:i + part.size] += self.correction(part)
+            if v is not None:
+                v[i:i + part.size] = self.basis.expand(V)
+            i += part.size
+        return d, v
 
     def state(self, t: ArrayLike) -> tuple[Array, Array]:
         times, _ = _check_times(t)
-        Q, V = self.response(times)
-        d = np.einsum("nk,fkc->fnc", self.phi, Q, optimize=True)
-        v = np.einsum("nk,fkc->fnc", self.phi, V, optimize=True)
-        static = getattr(self.response, "static_correction", None)
-        if static is not None:
-            d = d + static(times)
+        d, v = self._displacements(times, True)
+        assert v is not None
         return d, v
+
+    def control_points(self, t: ArrayLike) -> Array:
+        """Control net at ``t``: ``(n_u, n_v, 3)`` for a number, ``(F, n_u, n_v, 3)`` for an array."""
+        times, scalar = _check_times(t)
+        nets = self._full(self._displacements(times, False)[0])
+        return nets[0] if scalar else nets
 
     def modal(self, t: ArrayLike) -> tuple[Array, Array]:
         """Modal coordinates ``Q(t), Q'(t)``, each ``(F, N, 3)``."""
