@@ -91,10 +91,16 @@ def main(argv: list[str] | None = None) -> int:
     out = HERE / "out" / ("quick" if args.quick else "full")
     result = bench.main(sizes=sizes, quick=args.quick, outdir=out, budget=args.budget,
                         frames=args.frames, goals=False if args.no_goals else None)
-    evaluate, _ = evaluate_section(args.quick)
+    evaluate, evaluated = evaluate_section(args.quick)
     print("\nratios numerical / analytic (time to the same frames at the same accuracy):")
     for line in ratio_lines(result["rows"]):
         print("  " + line)
+    for row in evaluated if isinstance(evaluated, list) else []:
+        if isinstance(row, dict) and "ratio" in row:
+            print(f"  evaluation: {row.get('name', '?')}: ratio {_text(row['ratio'])}")
+    for goal in result["goals"]:
+        met = "—" if goal.met is None else ("met" if goal.met else "NOT met")
+        print(f"  goal [{met}] {goal.name}: {goal.measured}")
     target = out if args.quick else HERE
     study_md = result["files"]["markdown"].read_text(encoding="utf-8")
     body = study_md.replace("\n## ", "\n### ").replace("# Cost study", "## Cost study", 1)
