@@ -102,9 +102,13 @@ def test_search_stops_at_the_budget(monkeypatch):
     assert best is None and tried[max(tried)].stopped
 
 
-def test_fitted_slope_recovers_a_power_law():
+def test_fitted_slope_recovers_a_power_law_over_the_largest_nets():
     rows = [bench.Row("clamped", c, n, "x", "ok", seconds=2e-6 * n**1.7)
-            for c, n in ((8, 49), (16, 225), (32, 961), (64, 3969))]
+            for c, n in ((16, 225), (32, 961))]
+    rows.insert(0, bench.Row("clamped", 4, 9, "x", "ok", seconds=1.0))      # overhead only
+    rows.append(bench.Row("clamped", 64, 3969, "x", "over budget", seconds=30.0,
+                          estimate=2e-6 * 3969**1.7))
+    rows.append(bench.Row("clamped", 128, 16129, "x", "skipped", estimate=1e9))
     assert bench.fitted_slope(rows) == pytest.approx(1.7, abs=1e-12)
 
 

@@ -588,14 +588,23 @@ def _playback_goal(r: dict) -> Goal:
 
 
 # --------------------------------------------------------------------------- outputs
-def fitted_slope(rows: list[Row], key: str = "seconds") -> float:
-    """Least-squares slope of log(time) against log(n_free) over the measured rows (n_free >= 50)."""
-    points = [(r.n_free, getattr(r, key)) for r in rows
-              if r.status in ("ok", "exact") and math.isfinite(getattr(r, key))
-              and getattr(r, key) > 0]
-    large = [p for p in points if p[0] >= 50]
-    use = large if len(large) >= 2 else points
-    if len(use) < 2 or len({p[0] for p in use}) < 2:
+def fitted_slope(rows: list[Row], key: str = "seconds", largest: int = 3) -> float:
+    """Least-squares slope ``p`` of ``log(time) = p log(n_free) + c`` over the ``largest`` nets.
+
+    Uses measured times and, for ``seconds``, the extrapolations of runs stopped at the budget
+    (not the forecasts of skipped runs, which come from a slope already).
+    """
+    points = []
+    for r in rows:
+        value = getattr(r, key)
+        if r.status == "over budget" and key == "seconds":
+            value = r.estimate
+        elif r.status not in ("ok", "exact"):
+            continue
+        if math.isfinite(value) and value > 0:
+            points.append((r.n_free, value))
+    use = sorted(points)[-largest:]
+    if len({p[0] for p in use}) < 2:
         return math.nan
     x, y = np.log([p[0] for p in use]), np.log([p[1] for p in use])
     return float(np.polyfit(x, y, 1)[0])
@@ -664,7 +673,7 @@ def markdown(rows: list[Row], goals: list[Goal], study: Study, seconds: float) -
               f"{_fmt(1e3 * a.per_frame, ' ms')} | {_fmt(a.seconds, ' s')} | {check} | "
               + " | ".join(_cell(here[m]) if m in here else "—" for m in study.methods) + " |\n")
         w("\nSettings found (coarsest reaching the target) and fitted cost slopes "
-          "(time ∝ n_free^p over the measured nets with ≥ 50 free coordinates):\n\n")
+          "(time ∝ n_free^p, least squares over the three largest nets measured or extrapolated from a run stopped at the budget):\n\n")
         w("| solver | " + " | ".join(f"{c}×{c}" for c in study.sizes) + " | slope p |\n")
         w("|---" * (len(study.sizes) + 2) + "|\n")
         for solver in ("analytic",) + tuple(study.methods):
@@ -731,7 +740,7 @@ def plot(rows: list[Row], family: str, path: Path, methods: Sequence[str]) -> Pa
         sr = [r for r in fam if r.solver == solver]
         ok = [r for r in sr if r.status in ("ok", "exact")]
         est = [r for r in sr if r.status in ("over budget", "skipped")]
-        slope = fitted_slope(ok, key)
+        slope = fitted_slope(sr, key)
         text = label + (f" (p = {slope:.2f})" if math.isfinite(slope) else "")
         line, = ax.loglog([r.n_free for r in ok], [getattr(r, key) for r in ok], marker=marker,
                           color=colour, label=text)
@@ -740,7 +749,7 @@ def plot(rows: list[Row], family: str, path: Path, methods: Sequence[str]) -> Pa
                       linestyle=":", mfc="none", color=line.get_color())
     ax.set_xlabel("free control points per coordinate")
     ax.set_ylabel("time [s]")
-    ax.set_title(f"{family}: cost against net size (hollow: extrapolated)")
+    ax.set_title(f"{family}: cost against net size (hollow: extrapolated)", fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     write_with(path, lambda tmp: fig.savefig(tmp, format="png", dpi=110))
