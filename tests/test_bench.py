@@ -21,7 +21,7 @@ def quick(tmp_path_factory):
 
 
 def test_quick_run_writes_the_table_the_csv_and_the_plots(quick):
-    result, out = quick
+    _, out = quick
     for name in ("bench.md", "bench.csv", "cost_clamped.png", "cost_region.png"):
         assert (out / name).is_file(), name
     assert (out / "cost_clamped.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -32,7 +32,7 @@ def test_quick_run_writes_the_table_the_csv_and_the_plots(quick):
 
 
 def test_quick_run_errors_are_within_the_target(quick):
-    result, out = quick
+    _, out = quick
     target = bench.QUICK.target
     with open(out / "bench.csv", newline="") as f:
         rows = list(csv.DictReader(f))
@@ -124,11 +124,11 @@ def test_forecast_skips_after_a_run_over_budget():
 
 
 @pytest.mark.parametrize("kwargs, words", [
-    (dict(sizes=[4, 1]), "sizes"),
-    (dict(methods=["euler"]), "unknown numerical method"),
-    (dict(families=["dome"]), "unknown problem family"),
-    (dict(budget=0), "budget"),
-    (dict(target=2.0), "target"),
+    ({"sizes": [4, 1]}, "sizes"),
+    ({"methods": ["euler"]}, "unknown numerical method"),
+    ({"families": ["dome"]}, "unknown problem family"),
+    ({"budget": 0}, "budget"),
+    ({"target": 2.0}, "target"),
 ])
 def test_bad_settings_are_refused(kwargs, words, tmp_path):
     with pytest.raises(InputError, match=words):

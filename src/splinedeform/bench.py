@@ -42,9 +42,10 @@ import os
 import platform
 import resource
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -815,7 +816,7 @@ def _study(sizes: Sequence[int] | None, quick: bool, frames: int | None, target:
         if not sizes or any(isinstance(s, bool) or not isinstance(s, (int, np.integer)) or s < 2
                             for s in sizes):
             raise InputError(f"sizes must be integers >= 2 (cells per direction), got {list(sizes)}")
-        changes["sizes"] = tuple(sorted(set(int(s) for s in sizes)))
+        changes["sizes"] = tuple(sorted({int(s) for s in sizes}))
     if frames is not None:
         if int(frames) < 2:
             raise InputError(f"frames must be >= 2, got {frames}")

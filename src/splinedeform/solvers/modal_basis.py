@@ -25,8 +25,9 @@ so that a truncated basis can add the mode-acceleration correction
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import scipy.linalg as sla
@@ -213,7 +214,7 @@ class SeparableBasis(ModalBasis):
         return out / np.sqrt(self.mass)
 
     def expand(self, Q: Array) -> Array:
-        F, N, c = Q.shape
+        F, _, c = Q.shape
         if self.keep is None:
             grid = Q.reshape(F, self.shape[0], self.shape[1], c)
         else:
