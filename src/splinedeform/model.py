@@ -300,8 +300,8 @@ class Model:
             ``omega_max`` (keep ``ω <= omega_max``), both with the exact static part of the
             omitted modes (mode acceleration) and a report in ``solution.truncation``;
             ``eigensolver`` (``"auto"``, ``"dense"``, ``"separable"``, ``"sparse"``, see
-            :func:`splinedeform.solvers.modal_basis.choose`). ``newmark``: ``dt``. ``solve_ivp`` methods:
-            ``rtol``, ``atol``, ``max_step``.
+            :func:`splinedeform.solvers.modal_basis.choose`). ``newmark``: ``dt``.
+            ``solve_ivp`` methods: ``rtol``, ``atol``, ``max_step``.
         """
         from .solvers import numeric
 
