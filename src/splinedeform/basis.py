@@ -249,10 +249,10 @@ class BSplineBasis:
     def matrix(self, x: ArrayLike, derivative: int = 0) -> sp.csr_matrix:
         """Sparse collocation matrix ``A_{ij} = D^derivative b_j(x_i)``, shape ``(len(x), size)``."""
         x = np.atleast_1d(np.asarray(x, dtype=float)).ravel()
-        index, values = self.nonzero_derivatives(x, derivative)
-        rows = np.repeat(np.arange(x.size), self.degree + 1)
-        return sp.csr_matrix((values[derivative].ravel(), (rows, index.ravel())),
-                             shape=(x.size, self.size))
+        index, values = self.nonzero(x, derivative)
+        # exactly n+1 entries per row: build the CSR arrays directly (no COO round trip)
+        indptr = np.arange(0, x.size * (self.degree + 1) + 1, self.degree + 1)
+        return sp.csr_matrix((values.ravel(), index.ravel(), indptr), shape=(x.size, self.size))
 
     def __call__(self, x: ArrayLike, derivative: int = 0) -> NDArray[np.float64]:
         """Dense collocation matrix; convenient for small problems and tests."""
