@@ -655,7 +655,9 @@ def markdown(rows: list[Row], goals: list[Goal], study: Study, seconds: float) -
     w("Problem: " + _problem_text(study) + "\n\n")
     w("Cells of the numerical columns: total time (ratio numerical / analytic; error "
       "reached). `> budget`: stopped at the budget, the full run extrapolated from the "
-      "simulated time reached; `skipped`: forecast from the smaller nets.\n")
+      "simulated time reached (this assumes a uniform cost per simulated time, so it "
+      "over-estimates methods whose first steps are the most expensive, like BDF and Radau "
+      "right after the load switches on); `skipped`: forecast from the smaller nets.\n")
     for family in study.families:
         fam = [r for r in rows if r.family == family]
         if not fam:
