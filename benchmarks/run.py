@@ -3,6 +3,7 @@
     python benchmarks/run.py              # full study, writes benchmarks/results.md and .csv
     python benchmarks/run.py --quick      # smoke run, writes benchmarks/out/quick/results.md
     python benchmarks/run.py --sizes 4,8,16,32 --budget 120
+    python benchmarks/run.py --render-only   # rewrite the reports from the last bench.json
 
 Runs :func:`splinedeform.bench.main` (its own files go to ``benchmarks/out/…``), then
 ``benchmarks/bench_evaluate.py``'s ``run(quick)`` when that file exists, prints the ratios
@@ -14,6 +15,7 @@ from __future__ import annotations
 import argparse
 import datetime
 import importlib.util
+import json
 import math
 import sys
 from pathlib import Path
@@ -36,6 +38,9 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--frames", type=int, help="number of frames")
     p.add_argument("--no-goals", action="store_true", help="skip the goals at scale")
     p.add_argument("--note", default=NOTE, help="sentence on the machine for the results file")
+    p.add_argument("--render-only", action="store_true",
+                   help="rewrite the reports from the last run's bench.json, measuring nothing "
+                        "(the evaluation benchmark still runs)")
     return p.parse_args(argv)
 
 
@@ -89,8 +94,14 @@ def main(argv: list[str] | None = None) -> int:
     args = parse(argv)
     sizes = [int(s) for s in args.sizes.split(",")] if args.sizes else None
     out = HERE / "out" / ("quick" if args.quick else "full")
-    result = bench.main(sizes=sizes, quick=args.quick, outdir=out, budget=args.budget,
-                        frames=args.frames, goals=False if args.no_goals else None)
+    if args.render_only:
+        files = bench.render(out)
+        record = json.loads((out / "bench.json").read_text(encoding="utf-8"))
+        result = {"rows": [bench.Row(**r) for r in record["rows"]],
+                  "goals": [bench.Goal(**g) for g in record["goals"]], "files": files}
+    else:
+        result = bench.main(sizes=sizes, quick=args.quick, outdir=out, budget=args.budget,
+                            frames=args.frames, goals=False if args.no_goals else None)
     evaluate, evaluated = evaluate_section(args.quick)
     print("\nratios numerical / analytic (time to the same frames at the same accuracy):")
     for line in ratio_lines(result["rows"]):

@@ -22,13 +22,22 @@ def quick(tmp_path_factory):
 
 def test_quick_run_writes_the_table_the_csv_and_the_plots(quick):
     _, out = quick
-    for name in ("bench.md", "bench.csv", "cost_clamped.png", "cost_region.png"):
+    for name in ("bench.json", "bench.md", "bench.csv", "cost_clamped.png", "cost_region.png"):
         assert (out / name).is_file(), name
     assert (out / "cost_clamped.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     text = (out / "bench.md").read_text()
     assert "## Family `clamped`" in text and "## Family `region`" in text
     assert "| cells | free | analytic set-up | per frame |" in text
     assert not list(out.glob(".*tmp*"))                       # atomic writes left nothing
+
+
+def test_reports_are_rendered_again_from_the_recorded_numbers(quick):
+    _, out = quick
+    before = (out / "bench.md").read_text(), (out / "bench.csv").read_text()
+    (out / "bench.md").unlink()
+    files = bench.render(out)
+    assert files["markdown"].read_text() == before[0]
+    assert files["csv"].read_text() == before[1]
 
 
 def test_quick_run_errors_are_within_the_target(quick):

@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import math
 import os
 import platform
@@ -118,6 +119,7 @@ class Row:
     estimate: float = math.nan  # extrapolated seconds when stopped or skipped
     ratio: float = math.nan     # numerical seconds (or estimate) / analytic seconds
     runs: int = 0
+    progress: float = math.nan  # fraction of t_end simulated when stopped at the budget
     note: str = ""
 
 
@@ -216,6 +218,7 @@ class Attempt:
     error: float = math.inf
     stopped: bool = False
     estimate: float = math.nan
+    progress: float = math.nan
 
 
 def options(method: str, level: int, case: Case) -> dict[str, float]:
@@ -245,7 +248,8 @@ def attempt(case: Case, method: str, level: int, budget: float,
     except OverBudget:
         elapsed = time.perf_counter() - start
         reached = max(forcing.reached, 1e-3 * case.t_end)
-        return Attempt(level, elapsed, stopped=True, estimate=elapsed * case.t_end / reached)
+        return Attempt(level, elapsed, stopped=True, estimate=elapsed * case.t_end / reached,
+                       progress=forcing.reached / case.t_end)
     except InputError:                      # the integrator gave up: treat as inaccurate
         return Attempt(level, time.perf_counter() - start)
     seconds = time.perf_counter() - start
@@ -300,7 +304,9 @@ def numerical_row(case: Case, method: str, tried: dict[int, Attempt], best: int 
         row.estimate = assembly + a.estimate
         row.ratio = row.estimate / analytic.seconds
         row.setting = setting_label(method, a.level)
-        row.note = f"stopped after {a.seconds:.0f} s; full run extrapolated"
+        row.progress = a.progress
+        row.note = (f"stopped after {a.seconds:.0f} s at {a.progress:.1%} of t_end; full run "
+                    "extrapolated")
     finished = [a for a in tried.values() if not a.stopped]
     if finished:
         row.error = min(a.error for a in finished)
@@ -640,18 +646,28 @@ def _cell(row: Row) -> str:
     if row.status == "ok":
         return f"{_fmt(row.seconds, ' s')} (×{_fmt(row.ratio)}; {row.error:.0e})"
     if row.status == "over budget":
-        return f"> budget, ≈{_fmt(row.estimate, ' s')} (≈×{_fmt(row.ratio)})"
+        return (f"> budget at {row.progress:.0%} of t_end, ≈{_fmt(row.estimate, ' s')} "
+                f"(≈×{_fmt(row.ratio)})")
     if row.status == "skipped":
         return f"skipped, ≈{_fmt(row.estimate, ' s')} (≈×{_fmt(row.ratio)})"
     return f"not reached ({row.error:.0e})"
 
 
-def markdown(rows: list[Row], goals: list[Goal], study: Study, seconds: float) -> str:
+def _setting_cell(row: Row) -> str:
+    if row.status in ("ok", "exact"):
+        return row.setting
+    if row.status == "over budget":
+        return f"> budget at {row.setting}"
+    return row.status
+
+
+def markdown(rows: list[Row], goals: list[Goal], study: Study, seconds: float,
+             machine_text: str | None = None) -> str:
     """The report: problem, one table per family, settings, slopes and goals."""
     out = io.StringIO()
     w = out.write
     w("# Cost study: analytic against numerical solution\n\n")
-    w(f"Machine: {machine()}. Study time {seconds:.0f} s.\n\n")
+    w(f"Machine: {machine_text or machine()}. Study time {seconds:.0f} s.\n\n")
     w("Problem: " + _problem_text(study) + "\n\n")
     w("Cells of the numerical columns: total time (ratio numerical / analytic; error "
       "reached). `> budget`: stopped at the budget, the full run extrapolated from the "
@@ -683,7 +699,7 @@ def markdown(rows: list[Row], goals: list[Goal], study: Study, seconds: float) -
             sr = [r for r in fam if r.solver == solver]
             by = {r.cells: r for r in sr}
             w(f"| {solver} | " + " | ".join(
-                (by[c].setting or by[c].status) if c in by else "—" for c in study.sizes)
+                _setting_cell(by[c]) if c in by else "—" for c in study.sizes)
               + f" | {_fmt(fitted_slope(sr), digits=2)} |\n")
             if solver == "analytic":
                 w("| analytic set-up only | " + " | ".join("" for _ in study.sizes)
@@ -766,7 +782,11 @@ def main(sizes: Sequence[int] | None = None, quick: bool = False,
          frames: int | None = None, target: float | None = None, budget: float | None = None,
          methods: Sequence[str] | None = None, families: Sequence[str] | None = None,
          goals: bool | None = None) -> dict[str, Any]:
-    """Run the cost study and write ``bench.md``, ``bench.csv`` and one plot per family.
+    """Run the cost study and write its results to ``outdir``.
+
+    Files: ``bench.json`` (every number, see :func:`render`), ``bench.md`` (the tables and
+    goals), ``bench.csv`` (one row per solver and net) and ``cost_<family>.png`` (log–log
+    time against free control points with fitted slopes).
 
     Parameters
     ----------
@@ -780,7 +800,7 @@ def main(sizes: Sequence[int] | None = None, quick: bool = False,
     Returns
     -------
     dict with ``rows`` (list of :class:`Row`), ``goals`` (list of :class:`Goal`),
-    ``scale`` (raw goal measurements) and ``files`` (paths written).
+    ``scale`` (raw goal measurements), ``files`` (paths written), ``study`` and ``seconds``.
     """
     study = _study(sizes, quick, frames, target, budget, methods, families, goals)
     out = Path(outdir)
@@ -797,15 +817,39 @@ def main(sizes: Sequence[int] | None = None, quick: bool = False,
         more, raw = scale_goals(say)
         goal_list += more
     elapsed = time.perf_counter() - start
-    files = {"markdown": write_text(out / "bench.md", markdown(rows, goal_list, study, elapsed)),
-             "csv": write_text(out / "bench.csv", csv_text(rows))}
-    for family in study.families:
-        files[f"plot_{family}"] = plot(rows, family, out / f"cost_{family}.png", study.methods)
+    record = {"study": asdict(study), "rows": [asdict(r) for r in rows],
+              "goals": [asdict(g) for g in goal_list], "scale": raw, "seconds": elapsed,
+              "machine": machine()}
+    files = {"json": write_text(out / "bench.json", json.dumps(record, indent=1))}
+    files.update(render(out))
     for g in goal_list:
         say(f"goal: {g.name}: {g.measured} [{'—' if g.met is None else ('met' if g.met else 'NOT met')}]")
     say(f"written: {', '.join(str(p) for p in files.values())}")
     return {"rows": rows, "goals": goal_list, "scale": raw, "files": files, "study": study,
             "seconds": elapsed}
+
+
+def render(outdir: str | os.PathLike[str]) -> dict[str, Path]:
+    """Write ``bench.md``, ``bench.csv`` and the plots from the ``bench.json`` of a study run.
+
+    Lets the report be regenerated without measuring again.
+    """
+    out = Path(outdir)
+    try:
+        record = json.loads((out / "bench.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise InputError(f"cannot read the study results {out / 'bench.json'}: {exc}") from None
+    study = Study(**{k: tuple(v) if isinstance(v, list) else v
+                     for k, v in record["study"].items()})
+    rows = [Row(**r) for r in record["rows"]]
+    goals = [Goal(**g) for g in record["goals"]]
+    files = {"markdown": write_text(out / "bench.md", markdown(rows, goals, study,
+                                                               record["seconds"],
+                                                               record.get("machine"))),
+             "csv": write_text(out / "bench.csv", csv_text(rows))}
+    for family in study.families:
+        files[f"plot_{family}"] = plot(rows, family, out / f"cost_{family}.png", study.methods)
+    return files
 
 
 def _study(sizes: Sequence[int] | None, quick: bool, frames: int | None, target: float | None,
