@@ -100,6 +100,19 @@ def test_search_finds_the_coarsest_level_on_a_synthetic_error_law(monkeypatch):
     assert len(calls) <= 6
 
 
+def test_search_stops_loosening_when_it_no_longer_saves_time(monkeypatch):
+    """Stability-limited explicit method: every rtol reaches the target at the same cost."""
+    calls = []
+
+    def fake(case, method, level, budget, opts=None):
+        calls.append(level)
+        return bench.Attempt(level, 10.0, error=1e-8)
+
+    monkeypatch.setattr(bench, "attempt", fake)
+    _, best = bench.search(None, "dop853", 4, bench.Study(target=1e-6))
+    assert calls == [4, 3] and best in (3, 4)
+
+
 def test_search_stops_at_the_budget(monkeypatch):
     def fake(case, method, level, budget, opts=None):
         if level >= 4:
