@@ -26,7 +26,7 @@ from .errors import InputError, SingularSystemError
 from .loads import Load, as_load
 from .material import Material
 from .quadrature import gram_matrix
-from .solution import ModalSolution, SampledSolution, StaticSolution
+from .solution import ModalSolution, StaticSolution
 from .solvers import modal_basis
 from .solvers.analytic import ModalResponse
 from .surface import Surface
