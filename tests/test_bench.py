@@ -134,6 +134,21 @@ def test_fitted_slope_recovers_a_power_law_over_the_largest_nets():
     assert bench.fitted_slope(rows) == pytest.approx(1.7, abs=1e-12)
 
 
+def test_runs_stopped_too_early_are_not_extrapolated():
+    analytic = bench.Row("clamped", 32, 961, "analytic", "exact", seconds=0.5)
+    case = bench.Case("clamped", 32, bench.build_model("clamped", 32), None, 1.0, np.zeros(2))
+    early = {3: bench.Attempt(3, 90.0, stopped=True, estimate=9e4, progress=0.001)}
+    row = bench.numerical_row(case, "bdf", early, None, analytic)
+    assert row.status == "over budget" and math.isnan(row.estimate)
+    assert row.ratio == pytest.approx(row.seconds / 0.5)              # a lower bound
+    assert "and more" in bench._cell(row)
+    later = bench.skip_row(case, "bdf", [row], 30.0, analytic)
+    assert later.status == "skipped" and math.isnan(later.estimate)
+    half = {3: bench.Attempt(3, 90.0, stopped=True, estimate=180.0, progress=0.5)}
+    row = bench.numerical_row(case, "bdf", half, None, analytic)
+    assert row.estimate == pytest.approx(180.0 + case.model.timings["assembly"])
+
+
 def test_forecast_skips_after_a_run_over_budget():
     analytic = bench.Row("clamped", 32, 961, "analytic", "exact", seconds=0.5)
     history = [bench.Row("clamped", 8, 49, "rk45", "ok", seconds=1.0),
