@@ -23,7 +23,8 @@ next coarser setting while it costs less. A run that exceeds the time budget is 
 extrapolated from the simulated time it reached. On the smallest nets the analytic solution
 itself is compared with a DOP853 run at ``rtol = 10⁻¹²`` (the yardstick is checked, not
 trusted). Times include the assembly for both; the analytic set-up (assembly, reduction,
-eigen-solution, modal forces) and the per-frame cost are reported separately.
+eigen-solution, modal forces) and the per-frame cost are reported separately, as the median
+of three runs when one run takes less than 3 s (numerical runs are timed once).
 
 Besides the table the study measures the goals of the analytic path at scale (separable
 256×256 and 512×512, general 128×128 with 200 modes and the static correction, playback
@@ -174,21 +175,33 @@ def relative_error(nets: Array, case: Case) -> float:
 
 
 # --------------------------------------------------------------------------- analytic
-def run_analytic(case: Case) -> Row:
-    """Time the analytic solution (set-up and frames separately) and keep it as the reference."""
-    model = case.model
-    start = time.perf_counter()
-    solution = model.dynamic(case.load, case.t_end)
-    solve = time.perf_counter() - start
-    start = time.perf_counter()
-    nets = solution.control_points(case.times)
-    frames = time.perf_counter() - start
-    case.reference = nets
-    case.scale = float(np.abs(nets - model.surface.control_points).max())
-    setup = model.timings["assembly"] + solve
-    return Row(case.family, case.cells, model.n_free, "analytic", "exact", setup + frames, setup,
-               frames / case.times.size, setting=f"{solution.basis.kind} eigen, all modes",
-               runs=1)
+def run_analytic(case: Case, repeats: int = 3) -> Row:
+    """Time the analytic solution (set-up and frames separately) and keep it as the reference.
+
+    The whole path (assembly, eigen-solution, modal set-up, frames) runs ``repeats`` times on
+    freshly built models while one run takes under a few seconds, and the run of median total
+    time is reported: a single outlier on a shared machine neither helps nor hurts the ratio.
+    """
+    timings = []
+    for i in range(max(1, repeats)):
+        model = case.model if i == 0 else build_model(case.family, case.cells)
+        start = time.perf_counter()
+        solution = model.dynamic(case.load, case.t_end)
+        solve = time.perf_counter() - start
+        start = time.perf_counter()
+        nets = solution.control_points(case.times)
+        frames = time.perf_counter() - start
+        setup = model.timings["assembly"] + solve
+        timings.append((setup + frames, setup, frames))
+        if i == 0:
+            case.reference = nets
+            case.scale = float(np.abs(nets - model.surface.control_points).max())
+            kind = solution.basis.kind
+        if setup + frames > 3.0:
+            break
+    total, setup, frames = sorted(timings)[len(timings) // 2]
+    return Row(case.family, case.cells, case.model.n_free, "analytic", "exact", total, setup,
+               frames / case.times.size, setting=f"{kind} eigen, all modes", runs=len(timings))
 
 
 # --------------------------------------------------------------------------- numerical
@@ -756,7 +769,8 @@ def _problem_text(study: Study) -> str:
             f"{study.target:g} (max relative error of the control points at the frames, "
             f"against the analytic solution); budget {study.budget:g} s per numerical run. "
             "Family `clamped`: all edges clamped. Family `region`: only the control points "
-            f"in the central disc of radius {REGION_RADIUS} move. Times include the assembly. "
+            f"in the central disc of radius {REGION_RADIUS} move. Times include the assembly; "
+            "the analytic times are the median of three runs when one run takes < 3 s. "
             "Analytic check: difference to DOP853 at rtol 1e-12 (smallest nets).")
 
 
