@@ -430,7 +430,8 @@ def describe(row: Row) -> str:
         return (f"{row.solver:8s} {row.setting:20s} {row.seconds:8.3g} s  error {row.error:.1e}"
                 f"  ({row.ratio:.3g}× analytic, {row.runs} runs)")
     if row.status == "skipped":
-        return f"{row.solver:8s} skipped: {row.note} (≈{row.estimate:.3g} s)"
+        return (f"{row.solver:8s} skipped: {row.note}"
+                + (f" (≈{row.estimate:.3g} s)" if math.isfinite(row.estimate) else ""))
     if row.status == "over budget":
         return (f"{row.solver:8s} {row.setting:20s} over budget: {row.note}"
                 + (f", ≈{row.estimate:.3g} s" if math.isfinite(row.estimate) else ""))
