@@ -1,0 +1,191 @@
+"""Building library objects (surface, model, load) from a scenario."""
+
+from __future__ import annotations
+
+import math
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Iterator
+
+from ..errors import InputError, ScenarioError
+from .spec import Scenario, SurfaceSpec
+
+
+@dataclass
+class Built:
+    """The library objects of a scenario (see :func:`build`)."""
+
+    surface: Any            # splinedeform.Surface
+    model: Any              # splinedeform.Model
+    load: Any               # splinedeform.loads.Load or None
+    fixed: Any = None       # bool mask (n_u, n_v) of the free region, or None
+
+
+@contextmanager
+def _located(scenario: Scenario, path: str) -> Iterator[None]:
+    """Re-raise library input errors as scenario errors located at ``path``."""
+    try:
+        yield
+    except ScenarioError:
+        raise
+    except InputError as exc:
+        raise scenario.error(path, str(exc)) from None
+
+
+def build_surface(scenario: Scenario) -> Any:
+    """The initial surface: a built-in shape, a stored control net or a fitted point grid."""
+    spec = scenario.surface
+    if spec.shape == "file":
+        return _surface_from_file(scenario)
+    from .. import shapes
+
+    with _located(scenario, "surface"):
+        return getattr(shapes, spec.shape)(**spec.parameters, **_fit_options(spec))
+
+
+def _fit_options(spec: SurfaceSpec) -> dict[str, Any]:
+    """``cells``, ``degree``, ``knots``, ``method`` for a shape function (None: its default)."""
+    options: dict[str, Any] = {"degree": spec.degree, "method": spec.method}
+    if spec.cells is not None:
+        options["cells"] = spec.cells
+    if spec.knots is not None:
+        options["knots"] = spec.knots
+    return options
+
+
+def _surface_from_file(scenario: Scenario) -> Any:
+    from .. import shapes
+    from ..export import read_control_net
+
+    spec = scenario.surface
+    path = spec.path
+    assert path is not None
+    suffix = path.suffix.lower()
+    if not path.is_file():
+        raise scenario.error("surface.path", f"file not found: {path}")
+    if suffix not in (".json", ".npz", ".npy"):
+        raise scenario.error("surface.path", f"expected a control net (.json, .npz) or a point "
+                                             f"grid (.npy, .npz), got {path.name!r}")
+    grid = _point_grid(scenario, path) if suffix in (".npy", ".npz") else None
+    if grid is None:
+        fitted = [k for k in ("cells", "degree", "knots", "method")
+                  if k in scenario.raw.get("surface", {})]
+        if fitted:
+            raise scenario.error(f"surface.{fitted[0]}", f"does not apply to a control net "
+                                                         f"file ({path.name} holds its own bases)")
+        with _located(scenario, "surface.path"):
+            return read_control_net(path, frame=spec.frame)
+    if "frame" in scenario.raw.get("surface", {}):
+        raise scenario.error("surface.frame", "applies to control net files only, "
+                                              f"{path.name} is a point grid")
+    if spec.method == "quasi":
+        raise scenario.error("surface.method", "a point grid is fitted by \"interpolate\" "
+                                               "or \"l2\" (\"quasi\" needs a function)")
+    with _located(scenario, "surface.path"):
+        return shapes.from_points(grid, **_fit_options(spec))
+
+
+def _point_grid(scenario: Scenario, path: Path) -> Any:
+    """The ``(N_u, N_v, 3)`` grid in a ``.npy`` / ``.npz`` file, or None for a control net."""
+    import numpy as np
+
+    try:
+        with open(path, "rb") as fh:
+            data = np.load(fh, allow_pickle=False)
+            if isinstance(data, np.lib.npyio.NpzFile):
+                if "control_points" in data.files and "kind_u" in data.files:
+                    return None
+                names = data.files
+                if "points" not in names and len(names) != 1:
+                    raise scenario.error("surface.path", f"{path.name} holds {names}; a point "
+                                                         "grid .npz needs one array or 'points'")
+                data = data["points" if "points" in names else names[0]]
+    except (OSError, ValueError) as exc:
+        raise scenario.error("surface.path", f"cannot read {path.name}: {exc}") from None
+    if data.ndim != 3 or data.shape[2] != 3:
+        raise scenario.error("surface.path", f"a point grid must have shape (N_u, N_v, 3), "
+                                             f"got {data.shape}")
+    return data
+
+
+def build_load(scenario: Scenario) -> Any:
+    """The sum of the ``[[load]]`` tables as a :mod:`splinedeform.loads` object (or None)."""
+    from .. import loads as L
+
+    total = None
+    for i, spec in enumerate(scenario.loads, start=1):
+        with _located(scenario, f"load[{i}]"):
+            profile = {"constant": lambda: L.Constant(),
+                       "step": lambda: L.Step(spec.t_on, spec.t_off),
+                       "piecewise": lambda: L.Piecewise(spec.points),
+                       "harmonic": lambda: L.Harmonic(spec.omega, spec.phase)}[spec.profile]()
+            load = {"point": lambda: L.Point(spec.at[0], spec.at[1], spec.force, profile),
+                    "uniform": lambda: L.Uniform(spec.force, profile),
+                    "pressure": lambda: L.Pressure(spec.q, profile)}[spec.kind]()
+        total = load if total is None else total + load
+    return total
+
+
+def free_region_mask(scenario: Scenario, surface: Any) -> Any:
+    """``fixed`` mask (True = fixed): control points whose Greville point lies outside the box."""
+    boundary = scenario.boundary
+    if not boundary.has_free_region:
+        return None
+    inside = []
+    for name, basis in (("u", surface.basis_u), ("v", surface.basis_v)):
+        g = basis.greville()
+        box = getattr(boundary, f"free_{name}") or (-math.inf, math.inf)
+        tol = 1e-12 * basis.length
+        inside.append((g >= box[0] - tol) & (g <= box[1] + tol))
+    moving = inside[0][:, None] & inside[1][None, :]
+    if not moving.any():
+        raise scenario.error("boundary.free_region", "no control point has its Greville "
+                                                     "abscissae inside this box; widen it")
+    return ~moving
+
+
+def _check_parameters(scenario: Scenario, surface: Any) -> None:
+    """Point loads and probes must lie on the parameter domain (any value when periodic)."""
+    bases = (surface.basis_u, surface.basis_v)
+    checks = [(f"load[{i}].at", spec.at) for i, spec in enumerate(scenario.loads, start=1)
+              if spec.at is not None]
+    checks += [(f"output.probes[{i}]", p) for i, p in enumerate(scenario.output.probes, start=1)]
+    for path, (u, v) in checks:
+        for x, basis, name in ((u, bases[0], "u"), (v, bases[1], "v")):
+            if not basis.periodic and not -1e-12 <= x <= basis.length * (1 + 1e-12):
+                raise scenario.error(path, f"{name} = {x:g} is outside the parameter domain "
+                                           f"[0, {basis.length:g}] of this surface")
+
+
+def build(scenario: Scenario) -> Built:
+    """Surface, model and load of a scenario; library input errors name the scenario key."""
+    from ..material import Material
+    from ..model import Model
+
+    surface = build_surface(scenario)
+    _check_parameters(scenario, surface)
+    fixed = free_region_mask(scenario, surface)
+    with _located(scenario, "material"):
+        material = Material(**scenario.material.weights())
+    with _located(scenario, "boundary"):
+        model = Model(surface, material, boundary=scenario.boundary.edges(), fixed=fixed,
+                      mass_matrix=scenario.material.mass_matrix)
+    return Built(surface=surface, model=model, load=build_load(scenario), fixed=fixed)
+
+
+def describe(scenario: Scenario, built: Built | None = None) -> list[tuple[str, str]]:
+    """(label, value) rows saying what :func:`run` would do (for ``splinedeform validate``)."""
+    s = scenario
+    rows = [("scenario", s.title or s.name), ("surface", s.surface.shape)]
+    if built is not None:
+        n_u, n_v = built.surface.shape
+        rows += [("control net", f"{n_u} x {n_v} ({n_u * n_v} points)"),
+                 ("free control points", str(built.model.n_free))]
+    rows += [("loads", ", ".join(f"{ld.kind} ({ld.profile})" for ld in s.loads) or "none"),
+             ("solve", s.solve.kind + (f" with {s.solve.method} to t = {s.solve.t_end:g}"
+                                       if s.solve.kind == "dynamic" else "")),
+             ("frames", str(len(s.solve.frame_times()) if s.solve.kind == "dynamic"
+                            else s.solve.frames)),
+             ("outputs", ", ".join(s.output.formats) or "none")]
+    return rows

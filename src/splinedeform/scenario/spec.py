@@ -1,0 +1,145 @@
+"""The validated scenario: one frozen dataclass per table."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ..boundary import EDGES
+from ..errors import ScenarioError
+from .keys import MATERIAL_KEYS
+from .locate import _Problems
+
+
+@dataclass(frozen=True)
+class SurfaceSpec:
+    """``[surface]``: a built-in shape with its parameters, or a file."""
+
+    shape: str
+    cells: tuple[int, int] | None = None
+    degree: int = 3
+    knots: str | tuple[str, str] | None = None
+    method: str = "interpolate"
+    path: Path | None = None
+    frame: int = -1
+    parameters: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class MaterialSpec:
+    """``[material]``: the :class:`~splinedeform.material.Material` arguments and the mass matrix."""
+
+    mass: float = 1.0
+    damping: float = 0.0
+    rayleigh: float = 0.0
+    w10: float = 0.0
+    w01: float = 0.0
+    w20: float = 0.0
+    w11: float = 0.0
+    w02: float = 0.0
+    mass_matrix: str = "consistent"
+
+    def weights(self) -> dict[str, float]:
+        return {k: getattr(self, k) for k in MATERIAL_KEYS if k != "mass_matrix"}
+
+
+@dataclass(frozen=True)
+class BoundarySpec:
+    """``[boundary]``: edge presets and an optional box of moving control points."""
+
+    u0: str = "free"
+    u1: str = "free"
+    v0: str = "free"
+    v1: str = "free"
+    free_u: tuple[float, float] | None = None
+    free_v: tuple[float, float] | None = None
+
+    def edges(self) -> dict[str, str]:
+        return {e: getattr(self, e) for e in EDGES}
+
+    @property
+    def has_free_region(self) -> bool:
+        return self.free_u is not None or self.free_v is not None
+
+
+@dataclass(frozen=True)
+class LoadSpec:
+    """One ``[[load]]`` table."""
+
+    kind: str
+    at: tuple[float, float] | None = None
+    force: tuple[float, float, float] | None = None
+    q: float | None = None
+    profile: str = "constant"
+    t_on: float = 0.0
+    t_off: float = math.inf
+    points: tuple[tuple[float, float], ...] | None = None
+    omega: float | None = None
+    phase: float = 0.0
+
+
+@dataclass(frozen=True)
+class SolveSpec:
+    """``[solve]``: what to compute and at which times."""
+
+    kind: str
+    method: str = "analytic"
+    t_end: float | None = None
+    frames: int = 50
+    times: tuple[float, ...] | None = None
+    modes: int = 6
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    dt: float | None = None
+
+    def frame_times(self) -> tuple[float, ...]:
+        """Frame times: ``times`` if given, else ``frames`` equally spaced in ``[0, t_end]``."""
+        if self.times is not None:
+            return self.times
+        t_end = self.t_end or 0.0
+        return tuple(t_end * i / (self.frames - 1) for i in range(self.frames))
+
+
+@dataclass(frozen=True)
+class OutputSpec:
+    """``[output]``: which files to write."""
+
+    formats: tuple[str, ...] = ("report",)
+    resolution: int = 32
+    probes: tuple[tuple[float, float], ...] = ()
+    time: float | None = None
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario; build it with :func:`build`, run it with :func:`run`."""
+
+    surface: SurfaceSpec
+    material: MaterialSpec
+    boundary: BoundarySpec
+    loads: tuple[LoadSpec, ...]
+    solve: SolveSpec
+    output: OutputSpec
+    title: str = ""
+    description: str = ""
+    source: str = "<scenario>"
+    directory: Path = field(default_factory=Path.cwd)
+    raw: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+    lines: dict[str, int] = field(default_factory=dict, repr=False, compare=False)
+    origins: dict[str, str] = field(default_factory=dict, repr=False, compare=False)
+
+    @property
+    def name(self) -> str:
+        """File stem (or ``scenario``), used to name outputs."""
+        stem = Path(self.source).stem
+        return stem if stem and not stem.startswith("<") else "scenario"
+
+    def error(self, path: str, message: str) -> ScenarioError:
+        """A :class:`ScenarioError` located at ``path`` (``file:line: path: message``)."""
+        problems = _Problems(self.source, self.lines, self.origins)
+        problems.add(path, message)
+        return ScenarioError(problems.message())
+
+
