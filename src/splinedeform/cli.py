@@ -48,6 +48,9 @@ OUTDIR_OPT = typer.Option(None, "-o", "--outdir", help="Output folder (created i
                                                        "[default: <scenario name>-output]")
 QUIET_OPT = typer.Option(False, "--quiet", "-q", help="Print nothing but errors.")
 DEBUG_OPT = typer.Option(False, "--debug", help="Show the full traceback of an error.")
+OUTSIDE_OPT = typer.Option(False, "--allow-outside-paths",
+                           help="Let the scenario read files outside its own folder "
+                                "(surface.path); refused by default.")
 
 
 def _consoles() -> tuple[Any, Any]:
@@ -121,12 +124,13 @@ def run_command(scenario: Path = SCENARIO_ARG, outdir: Optional[Path] = OUTDIR_O
                                            "dop853, radau, bdf."),
                 frames: Optional[int] = typer.Option(
                     None, "--frames", help="Override solve.frames (replaces solve.times)."),
+                allow_outside_paths: bool = OUTSIDE_OPT,
                 quiet: bool = QUIET_OPT, debug: bool = DEBUG_OPT) -> None:
     """Run a scenario file: build, solve, sample frames and write its outputs."""
     from .scenario import load_scenario, with_overrides
 
     with _reported_errors(debug):
-        loaded = load_scenario(scenario)
+        loaded = load_scenario(scenario, allow_outside_paths=allow_outside_paths)
         if method is not None:
             loaded = with_overrides(loaded, {"solve.method": method}, origin="--method")
         if frames is not None:
@@ -153,12 +157,13 @@ def demo_command(outdir: Path = typer.Option(Path("demo-output"), "-o", "--outdi
 
 
 @app.command("validate")
-def validate_command(scenario: Path = SCENARIO_ARG, debug: bool = DEBUG_OPT) -> None:
+def validate_command(scenario: Path = SCENARIO_ARG, allow_outside_paths: bool = OUTSIDE_OPT,
+                     debug: bool = DEBUG_OPT) -> None:
     """Check a scenario file and print what it would run (with every default filled in)."""
     from .scenario import build, describe, load_scenario, scenario_to_toml
 
     with _reported_errors(debug):
-        loaded = load_scenario(scenario)
+        loaded = load_scenario(scenario, allow_outside_paths=allow_outside_paths)
         built = build(loaded)
         out, _ = _consoles()
         out.print(_table(f"{scenario}: valid", describe(loaded, built)))

@@ -145,7 +145,7 @@ def _method_options(solve: SolveSpec, times: Any, mesh_time: float | None) -> di
     import numpy as np
 
     if solve.method == "analytic":
-        return {}
+        return {"function_samples": solve.function_samples}
     extra = [] if mesh_time is None else [mesh_time]
     options: dict[str, Any] = {"times": np.union1d(times, extra)}
     if solve.method == "newmark":

@@ -24,13 +24,22 @@ class Built:
 
 @contextmanager
 def _located(scenario: Scenario, path: str) -> Iterator[None]:
-    """Re-raise library input errors as scenario errors located at ``path``."""
+    """Re-raise library errors as scenario errors located at ``path``.
+
+    :class:`~splinedeform.errors.InputError` (and :class:`SingularSystemError`) keep their
+    message; a numerical failure further down (``ValueError`` such as numpy's
+    ``LinAlgError``, ``ArithmeticError`` such as an overflow) is named with its kind, so a
+    scenario never ends in a traceback.
+    """
     try:
         yield
     except ScenarioError:
         raise
     except InputError as exc:
         raise scenario.error(path, str(exc)) from None
+    except (ValueError, ArithmeticError) as exc:
+        raise scenario.error(path, f"numerical failure ({type(exc).__name__}: {exc}); the "
+                                   "values given are probably too extreme") from None
 
 
 def build_surface(scenario: Scenario) -> Any:

@@ -26,6 +26,10 @@ FORMAT_ALIASES = {"pvd": ("vtu",), "nets": ("json", "npz"), "animation": ("gif",
 
 
 _POSITIVE = number(0.0, open_low=True)
+#: latest time a scenario may ask for: beyond it the phase ω t of a vibration keeps no digits
+TIME_MAX = 1e12
+_TIME = number(0.0, TIME_MAX, open_low=True)
+_TIME0 = number(0.0, TIME_MAX)
 _NONNEG = number(0.0)
 _REAL = number()
 _PAIR = vector(2, _POSITIVE, "[u, v]")
@@ -93,7 +97,7 @@ LOAD_KEYS: dict[str, Key] = {
     "force": Key(vector(3, _REAL, "[fx, fy, fz]"), None, "force (point) or force per area"),
     "q": Key(_REAL, None, "pressure along the initial normal x_u × x_v"),
     "profile": Key(choice(*PROFILES), "constant", "time profile s(t) scaling the load"),
-    "t_on": Key(_NONNEG, 0.0, "step: switch-on time"),
+    "t_on": Key(_TIME0, 0.0, "step: switch-on time"),
     "t_off": Key(number(0.0, allow_inf=True), math.inf, "step: switch-off time"),
     "points": Key(array_of(vector(2, _REAL, "[t, s]"), "[t, s] pairs", 1), None,
                   "piecewise: scale s from time t on"),
@@ -109,19 +113,21 @@ PROFILE_KEYS = {"constant": (), "step": ("t_on", "t_off"), "piecewise": ("points
 SOLVE_KEYS: dict[str, Key] = {
     "kind": Key(choice(*SOLVE_KINDS), doc="static equilibrium, free vibration modes, or motion"),
     "method": Key(choice(*METHODS), "analytic", "time integration (dynamic)"),
-    "t_end": Key(_POSITIVE, None, "end time (dynamic)"),
+    "t_end": Key(_TIME, None, "end time (dynamic)"),
     "frames": Key(integer(2, 100000), 50, "number of equally spaced frames in [0, t_end]"),
-    "times": Key(array_of(_NONNEG, "times >= 0", 1), None, "explicit frame times"),
+    "times": Key(array_of(_TIME0, "times >= 0", 1), None, "explicit frame times"),
     "modes": Key(integer(0, 1000), 6, "number of vibration modes to report"),
     "rtol": Key(number(0.0, 1.0, open_low=True), 1e-8, "relative tolerance (rk45..bdf)"),
     "atol": Key(_POSITIVE, 1e-10, "absolute tolerance (rk45..bdf)"),
     "dt": Key(_POSITIVE, None, "time step (newmark); default t_end / (20 (frames - 1))"),
+    "function_samples": Key(integer(1, 100000), 400, "analytic: samples of a time-dependent "
+                                                     "load profile"),
 }
 
 #: keys of [solve] used by each kind / method
 SOLVE_KIND_KEYS = {"static": ("frames",), "modes": ("modes", "frames"),
                    "dynamic": ("method", "t_end", "frames", "times", "modes", "rtol", "atol",
-                               "dt")}
+                               "dt", "function_samples")}
 
 OUTPUT_KEYS: dict[str, Key] = {
     "formats": Key(array_of(choice(*FORMATS, *FORMAT_ALIASES), "format names"), ("report",),
@@ -129,7 +135,7 @@ OUTPUT_KEYS: dict[str, Key] = {
     "resolution": Key(integer(2, 1024), 32, "tessellation samples per direction"),
     "probes": Key(array_of(vector(2, _REAL, "[u, v]"), "[u, v] pairs"), (),
                   "points whose displacement is reported and plotted"),
-    "time": Key(_NONNEG, None, "state written as a mesh (default: the last frame)"),
+    "time": Key(_TIME0, None, "state written as a mesh (default: the last frame)"),
 }
 
 TOP_KEYS: dict[str, Key] = {

@@ -169,6 +169,36 @@ class _KeyScanner:
                 self.advance()
 
 
+#: deepest nesting of arrays and inline tables a scenario may use (it needs 3)
+MAX_NESTING = 64
+
+
+def nesting_too_deep(text: str, limit: int = MAX_NESTING) -> int | None:
+    """Line where arrays / inline tables nest deeper than ``limit``, or None.
+
+    Checked before parsing: :mod:`tomllib` and the key scanner recurse once per level, so a
+    file nested thousands deep would otherwise end in a ``RecursionError``.
+    """
+    scanner = _KeyScanner(text)
+    depth = 0
+    while not scanner.at_end():
+        c = scanner.peek()
+        if c in ('"', "'"):
+            scanner.string()
+            continue
+        if c == "#":
+            scanner.skip_to_line_end()
+            continue
+        if c in "[{":
+            depth += 1
+            if depth > limit:
+                return scanner.line
+        elif c in "]}":
+            depth = max(depth - 1, 0)
+        scanner.advance()
+    return None
+
+
 def key_lines(text: str) -> dict[str, int]:
     """Line number (from 1) of every key path written in a TOML text.
 

@@ -3,25 +3,20 @@
 from __future__ import annotations
 
 import copy
-import math
 import re
 import tomllib
 from pathlib import Path
-from typing import Any, Iterable, Mapping
+from typing import Any, Mapping
 
 from ..errors import InputError, ScenarioError
-from .checks import Key, _Invalid
-from .keys import (BOUNDARY_KEYS, FORMAT_ALIASES, FREE_REGION_KEYS, IVP_METHODS, LOAD_KEYS,
-                   LOAD_KIND_KEYS, MATERIAL_KEYS, PROFILE_KEYS, SHAPE_PARAMETERS, SOLVE_KEYS,
-                   SOLVE_KIND_KEYS, SURFACE_KEYS, TABLES, TOP_KEYS, OUTPUT_KEYS)
-from .locate import _describe, _Problems, key_lines
-from .spec import (BoundarySpec, LoadSpec, MaterialSpec, OutputSpec, Scenario, SolveSpec,
-                   SurfaceSpec)
+from .locate import MAX_NESTING, key_lines, nesting_too_deep
+from .spec import Scenario
+from .validate import _validate
 
 
 # -- reading ---------------------------------------------------------------------------
 def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None,
-                  origin: str = "override") -> Scenario:
+                  origin: str = "override", allow_outside_paths: bool = False) -> Scenario:
     """Read and validate a scenario file.
 
     Parameters
@@ -33,6 +28,10 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None,
         ``{"solve.frames": 5, "surface.cells": 4}``: values replacing (or, for ``None``,
         removing) keys of the file before validation; problems with them are reported as
         coming from ``origin``.
+    allow_outside_paths : bool
+        Files named in the scenario (``surface.path``) must lie inside the scenario's
+        folder (after following ``..`` and symbolic links) unless this is True: scenario
+        files are shared, and a shared file must not read whatever its user can read.
 
     Raises
     ------
@@ -47,15 +46,22 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None,
     except (OSError, UnicodeDecodeError) as exc:
         raise ScenarioError(f"{path}: cannot read the scenario file ({exc})") from None
     return parse_scenario(content, source=str(path), directory=path.parent.resolve(),
-                          overrides=overrides, origin=origin)
+                          overrides=overrides, origin=origin,
+                          allow_outside_paths=allow_outside_paths)
 
 
 def parse_scenario(content: str, source: str = "<scenario>", directory: Path | None = None,
                    overrides: Mapping[str, Any] | None = None,
-                   origin: str = "override") -> Scenario:
+                   origin: str = "override", allow_outside_paths: bool = False) -> Scenario:
     """Validate the TOML text of a scenario (see :func:`load_scenario`)."""
+    deep = nesting_too_deep(content)
+    if deep is not None:
+        raise ScenarioError(f"{source}:{deep}: arrays or inline tables nested more than "
+                            f"{MAX_NESTING} deep; a scenario needs at most 3 levels")
     try:
         raw = tomllib.loads(content)
+    except RecursionError:   # belt and braces: nesting_too_deep should have caught it
+        raise ScenarioError(f"{source}: arrays or inline tables nested too deep") from None
     except tomllib.TOMLDecodeError as exc:
         match = re.search(r"\(at line (\d+), column (\d+)\)", str(exc))
         reason = re.sub(r"\s*\(at line \d+, column \d+\)", "", str(exc))
@@ -67,7 +73,7 @@ def parse_scenario(content: str, source: str = "<scenario>", directory: Path | N
     if overrides:
         raw = _apply_overrides(raw, overrides)
         origins = {key: origin for key in overrides}
-    return _validate(raw, source, lines, origins, directory or Path.cwd())
+    return _validate(raw, source, lines, origins, directory or Path.cwd(), allow_outside_paths)
 
 
 def with_overrides(scenario: Scenario, overrides: Mapping[str, Any],
@@ -79,7 +85,8 @@ def with_overrides(scenario: Scenario, overrides: Mapping[str, Any],
     """
     raw = _apply_overrides(scenario.raw, overrides)
     origins = {**scenario.origins, **{key: origin for key in overrides}}
-    return _validate(raw, scenario.source, scenario.lines, origins, scenario.directory)
+    return _validate(raw, scenario.source, scenario.lines, origins, scenario.directory,
+                     scenario.allow_outside_paths)
 
 
 def _apply_overrides(raw: Mapping[str, Any], overrides: Mapping[str, Any]) -> dict[str, Any]:
@@ -101,285 +108,5 @@ def _apply_overrides(raw: Mapping[str, Any], overrides: Mapping[str, Any]) -> di
             else:
                 target[name] = copy.deepcopy(value)
     return out
-
-
-# -- validation ------------------------------------------------------------------------
-def _check_table(raw: Any, schema: Mapping[str, Key], path: str, problems: _Problems,
-                 table_name: str, allowed_extra: Mapping[str, Key] | None = None
-                 ) -> dict[str, Any]:
-    """Check each key of a table against its schema; return the valid values given."""
-    if not isinstance(raw, dict):
-        problems.add(path, f"expected a table [{table_name}], got {_describe(raw)}")
-        return {}
-    known = {**schema, **(allowed_extra or {})}
-    values: dict[str, Any] = {}
-    for key, value in raw.items():
-        where = f"{path}.{key}"
-        if key not in known:
-            problems.add(where, f"unknown key in [{table_name}]; allowed keys: "
-                                f"{', '.join(known)}")
-            continue
-        try:
-            values[key] = known[key].check(value)
-        except _Invalid as exc:
-            problems.add(where + exc.sub, str(exc))
-    return values
-
-
-def _require(values: Mapping[str, Any], raw: Any, keys: Iterable[str], schema: Mapping[str, Key],
-             path: str, problems: _Problems, reason: str = "") -> None:
-    """Report each key of ``keys`` missing from the table ``raw``."""
-    if not isinstance(raw, dict):
-        return
-    for key in keys:
-        if key not in raw:
-            problems.add(f"{path}.{key}", f"missing{reason}; expected {schema[key].allowed}")
-
-
-def _not_applicable(raw: Any, keys: Iterable[str], allowed: Iterable[str], path: str,
-                    problems: _Problems, context: str) -> None:
-    """Report keys given although they do not apply (``context`` says why)."""
-    if not isinstance(raw, dict):
-        return
-    allowed = set(allowed)
-    for key in keys:
-        if key in raw and key not in allowed:
-            problems.add(f"{path}.{key}", f"does not apply {context}")
-
-
-def _with_defaults(schema: Mapping[str, Key], values: Mapping[str, Any],
-                   keys: Iterable[str]) -> dict[str, Any]:
-    out = {}
-    for key in keys:
-        if key in values:
-            out[key] = values[key]
-        elif not schema[key].required:
-            out[key] = schema[key].default
-    return out
-
-
-def _validate(raw: dict[str, Any], source: str, lines: Mapping[str, int],
-              origins: Mapping[str, str], directory: Path) -> Scenario:
-    problems = _Problems(source, lines, origins)
-    for key in raw:
-        if key not in TABLES and key not in TOP_KEYS:
-            problems.add(key, "unknown key or table; allowed: "
-                              f"{', '.join(list(TOP_KEYS) + [f'[{t}]' for t in TABLES])}")
-    top = {}
-    for key in TOP_KEYS:
-        if key in raw:
-            try:
-                top[key] = TOP_KEYS[key].check(raw[key])
-            except _Invalid as exc:
-                problems.add(key, str(exc))
-    surface = _validate_surface(raw, problems, directory)
-    material = _validate_material(raw, problems, surface)
-    boundary = _validate_boundary(raw, problems)
-    solve = _validate_solve(raw, problems)
-    loads = _validate_loads(raw, problems, solve)
-    output = _validate_output(raw, problems, solve)
-    problems.raise_if_any()
-    assert surface and material and boundary and solve and output is not None
-    return Scenario(surface=surface, material=material, boundary=boundary, loads=loads,
-                    solve=solve, output=output, title=top.get("title", ""),
-                    description=top.get("description", ""), source=source,
-                    directory=directory, raw=raw, lines=dict(lines), origins=dict(origins))
-
-
-def _validate_surface(raw: Mapping[str, Any], problems: _Problems,
-                      directory: Path) -> SurfaceSpec | None:
-    if "surface" not in raw:
-        problems.add("surface", "missing table [surface]; it needs at least shape = "
-                                f"{SURFACE_KEYS['shape'].allowed}")
-        return None
-    table = raw["surface"]
-    parameters = {k: v for params in SHAPE_PARAMETERS.values() for k, v in params.items()}
-    values = _check_table(table, SURFACE_KEYS, "surface", problems, "surface", parameters)
-    _require(values, table, ["shape"], SURFACE_KEYS, "surface", problems)
-    shape = values.get("shape")
-    if shape is None:
-        return None
-    own = SHAPE_PARAMETERS[shape]
-    for key in parameters:
-        if isinstance(table, dict) and key in table and key not in own:
-            problems.add(f"surface.{key}", f"is not a parameter of shape {shape!r}; its "
-                                           f"parameters are: {', '.join(own) or 'none'}")
-    if shape == "file":
-        _require(values, table, ["path"], SURFACE_KEYS, "surface", problems,
-                 " (shape = \"file\" reads the net or grid from this file)")
-    else:
-        _not_applicable(table, ["path", "frame"], [], "surface", problems,
-                        f"to shape {shape!r}, only to shape = \"file\"")
-    spec = _with_defaults(SURFACE_KEYS, values, [k for k in SURFACE_KEYS if k != "shape"])
-    if spec.get("path") is not None:
-        spec["path"] = (directory / spec["path"]).resolve()
-    params = {k: values.get(k, key.default) for k, key in own.items()}
-    return SurfaceSpec(shape=shape, parameters=params, **spec)
-
-
-def _validate_material(raw: Mapping[str, Any], problems: _Problems,
-                       surface: SurfaceSpec | None) -> MaterialSpec | None:
-    table = raw.get("material", {})
-    values = _check_table(table, MATERIAL_KEYS, "material", problems, "material")
-    spec = MaterialSpec(**values)
-    weights = ("w10", "w01", "w20", "w11", "w02")
-    if isinstance(table, dict) and all(getattr(spec, w) == 0 for w in weights) and not any(
-            w in table and w not in values for w in weights):
-        problems.add("material", "all stiffness weights are zero (or missing): the surface "
-                                 "would have no elastic energy; set a tension weight (w10, "
-                                 "w01) or a bending weight (w20, w11, w02) > 0")
-    bending = spec.w20 > 0 or spec.w11 > 0 or spec.w02 > 0
-    if bending and surface is not None and surface.shape != "file" and surface.degree < 2:
-        problems.add("surface.degree", "bending weights (w20, w11, w02) need second "
-                                       "derivatives: degree must be >= 2")
-    return spec
-
-
-def _validate_boundary(raw: Mapping[str, Any], problems: _Problems) -> BoundarySpec | None:
-    table = raw.get("boundary", {})
-    values = _check_table(table, BOUNDARY_KEYS, "boundary", problems, "boundary")
-    region = values.pop("free_region", None)
-    box: dict[str, tuple[float, float] | None] = {"free_u": None, "free_v": None}
-    if region is not None:
-        ranges = _check_table(region, FREE_REGION_KEYS, "boundary.free_region", problems,
-                              "boundary.free_region")
-        if isinstance(region, dict) and not region:
-            problems.add("boundary.free_region", "is empty; give u = [low, high] and/or "
-                                                 "v = [low, high]")
-        for key, (low, high) in ranges.items():
-            if not low < high:
-                problems.add(f"boundary.free_region.{key}",
-                             f"expected [low, high] with low < high, got [{low:g}, {high:g}]")
-            box[f"free_{key}"] = (low, high)
-    return BoundarySpec(**values, **box)
-
-
-def _validate_loads(raw: Mapping[str, Any], problems: _Problems,
-                    solve: SolveSpec | None) -> tuple[LoadSpec, ...]:
-    tables = raw.get("load", [])
-    if isinstance(tables, dict):
-        problems.add("load", "write loads as an array of tables: [[load]] (double brackets)")
-        return ()
-    if not isinstance(tables, list):
-        problems.add("load", f"expected [[load]] tables, got {_describe(tables)}")
-        return ()
-    if not tables and solve is not None and solve.kind != "modes":
-        problems.add("load", f"a {solve.kind} solve needs at least one [[load]] table")
-    return tuple(spec for i, table in enumerate(tables, start=1)
-                 if (spec := _validate_load(table, f"load[{i}]", problems)) is not None)
-
-
-def _validate_load(table: Any, path: str, problems: _Problems) -> LoadSpec | None:
-    values = _check_table(table, LOAD_KEYS, path, problems, "[load]")
-    _require(values, table, ["kind"], LOAD_KEYS, path, problems)
-    kind, profile = values.get("kind"), values.get("profile", "constant")
-    if kind is None:
-        return None
-    _require(values, table, LOAD_KIND_KEYS[kind], LOAD_KEYS, path, problems,
-             f" (a {kind} load needs it)")
-    _not_applicable(table, ("at", "force", "q"), LOAD_KIND_KEYS[kind], path, problems,
-                    f"to a {kind} load (it uses {', '.join(LOAD_KIND_KEYS[kind])})")
-    used = PROFILE_KEYS[profile]
-    _not_applicable(table, ("t_on", "t_off", "points", "omega", "phase"), used, path, problems,
-                    f"to profile {profile!r}" + (f" (it uses {', '.join(used)})" if used else ""))
-    needed = {"piecewise": ["points"], "harmonic": ["omega"]}.get(profile, [])
-    _require(values, table, needed, LOAD_KEYS, path, problems, f" (profile {profile!r} needs it)")
-    if profile == "step" and values.get("t_off", math.inf) <= values.get("t_on", 0.0):
-        problems.add(f"{path}.t_off", f"must be > t_on = {values.get('t_on', 0.0):g}, got "
-                                      f"{values['t_off']:g}")
-    if "points" in values:
-        times = [t for t, _ in values["points"]]
-        bad = _first_not_increasing(times)
-        if bad is not None:
-            problems.add(f"{path}.points[{bad}]", f"times must be >= 0 and increasing, got "
-                                                  f"{times}")
-    if "at" in values:
-        if any(x < 0 for x in values["at"]):
-            problems.add(f"{path}.at", f"parameters must be >= 0, got {list(values['at'])}")
-    if values.get("q") == 0 or ("force" in values and not any(values["force"])):
-        problems.add(f"{path}.{'q' if kind == 'pressure' else 'force'}",
-                     "is zero: this load does nothing; remove the [[load]] table or give a "
-                     "non-zero value")
-    given = [k for k in LOAD_KEYS if k != "kind"]
-    return LoadSpec(kind=kind, **_with_defaults(LOAD_KEYS, values, given))
-
-
-def _first_not_increasing(times: Iterable[float]) -> int | None:
-    """Index (from 1) of the first time that is negative or not above the one before."""
-    previous = -math.inf
-    for i, t in enumerate(times, start=1):
-        if t < 0 or t <= previous:
-            return i
-        previous = t
-    return None
-
-
-def _validate_solve(raw: Mapping[str, Any], problems: _Problems) -> SolveSpec | None:
-    if "solve" not in raw:
-        problems.add("solve", f"missing table [solve]; it needs kind = "
-                              f"{SOLVE_KEYS['kind'].allowed}")
-        return None
-    table = raw["solve"]
-    values = _check_table(table, SOLVE_KEYS, "solve", problems, "solve")
-    _require(values, table, ["kind"], SOLVE_KEYS, "solve", problems)
-    kind = values.get("kind")
-    if kind is None:
-        return None
-    used = SOLVE_KIND_KEYS[kind]
-    _not_applicable(table, SOLVE_KEYS, ("kind",) + used, "solve", problems,
-                    f"to kind {kind!r}" + (f" (it uses {', '.join(used)})" if used else ""))
-    if kind == "dynamic":
-        _check_dynamic(table, values, problems)
-    if kind == "modes" and values.get("modes", 1) < 1:
-        problems.add("solve.modes", f"a modes solve needs modes >= 1, got {values['modes']}")
-    return SolveSpec(kind=kind, **_with_defaults(SOLVE_KEYS, values,
-                                                 [k for k in SOLVE_KEYS if k != "kind"]))
-
-
-def _check_dynamic(table: Mapping[str, Any], values: dict[str, Any], problems: _Problems) -> None:
-    method = values.get("method", "analytic")
-    if "frames" in table and "times" in table:
-        problems.add("solve.times", "give either frames or times, not both")
-    if "t_end" not in table and "times" not in table:
-        problems.add("solve.t_end", f"missing (a dynamic solve needs an end time); expected "
-                                    f"{SOLVE_KEYS['t_end'].allowed}")
-    times = values.get("times")
-    if times is not None:
-        bad = _first_not_increasing(times)
-        if bad is not None:
-            problems.add(f"solve.times[{bad}]", f"times must be increasing, got {list(times)}")
-        if "t_end" in values and times[-1] > values["t_end"]:
-            problems.add("solve.times", f"times must be <= t_end = {values['t_end']:g}, "
-                                        f"got {times[-1]:g}")
-        values.setdefault("t_end", times[-1] if times[-1] > 0 else None)
-        if values["t_end"] is None:
-            problems.add("solve.times", "needs a time > 0")
-    _not_applicable(table, ("rtol", "atol"), ("rtol", "atol") if method in IVP_METHODS else (),
-                    "solve", problems, f"to method {method!r} (only to {', '.join(IVP_METHODS)})")
-    _not_applicable(table, ("dt",), ("dt",) if method == "newmark" else (), "solve", problems,
-                    f"to method {method!r} (only to newmark)")
-
-
-def _validate_output(raw: Mapping[str, Any], problems: _Problems,
-                     solve: SolveSpec | None) -> OutputSpec | None:
-    table = raw.get("output", {})
-    values = _check_table(table, OUTPUT_KEYS, "output", problems, "output")
-    if "formats" in values:
-        expanded: list[str] = []
-        for name in values["formats"]:
-            for f in FORMAT_ALIASES.get(name, (name,)):
-                if f not in expanded:
-                    expanded.append(f)
-        values["formats"] = tuple(expanded)
-    if "time" in values and solve is not None:
-        if solve.kind != "dynamic":
-            problems.add("output.time", f"does not apply to a {solve.kind} solve (only dynamic)")
-        elif solve.t_end is not None and values["time"] > solve.t_end:
-            problems.add("output.time", f"must be <= t_end = {solve.t_end:g}, got "
-                                        f"{values['time']:g}")
-    for i, (u, v) in enumerate(values.get("probes", ()), start=1):
-        if u < 0 or v < 0:
-            problems.add(f"output.probes[{i}]", f"parameters must be >= 0, got [{u:g}, {v:g}]")
-    return OutputSpec(**values)
 
 

@@ -93,13 +93,14 @@ class SolveSpec:
     rtol: float = 1e-8
     atol: float = 1e-10
     dt: float | None = None
+    function_samples: int = 400
 
     def frame_times(self) -> tuple[float, ...]:
         """Frame times: ``times`` if given, else ``frames`` equally spaced in ``[0, t_end]``."""
         if self.times is not None:
             return self.times
         t_end = self.t_end or 0.0
-        return tuple(t_end * i / (self.frames - 1) for i in range(self.frames))
+        return tuple(t_end * (i / (self.frames - 1)) for i in range(self.frames))
 
 
 @dataclass(frozen=True)
@@ -129,6 +130,7 @@ class Scenario:
     raw: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
     lines: dict[str, int] = field(default_factory=dict, repr=False, compare=False)
     origins: dict[str, str] = field(default_factory=dict, repr=False, compare=False)
+    allow_outside_paths: bool = field(default=False, repr=False, compare=False)
 
     @property
     def name(self) -> str:

@@ -46,6 +46,8 @@ def _solve_items(solve: SolveSpec) -> list[tuple[str, Any]]:
             items += [("rtol", solve.rtol), ("atol", solve.atol)]
         if solve.method == "newmark":
             items += [("dt", solve.dt)]
+        if solve.method == "analytic":
+            items += [("function_samples", solve.function_samples)]
     elif solve.kind == "modes":
         items += [("modes", solve.modes), ("frames", solve.frames)]
     return items

@@ -1,0 +1,177 @@
+"""Hostile and extreme scenario files: every one is a located ScenarioError, never a traceback.
+
+Scenario files are shared between people, so besides absurd values these tests cover files
+that try to read outside their own folder (``surface.path``).
+"""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from splinedeform import BSplineBasis, ScenarioError, Surface
+from splinedeform.scenario import _located, load_scenario, parse_scenario, scenario_to_toml
+
+DYNAMIC = """\
+[surface]
+shape = "plane"
+cells = 3
+
+[material]
+w10 = 1.0
+w01 = 1.0
+
+[boundary]
+u0 = "clamped"
+u1 = "clamped"
+
+[[load]]
+kind = "uniform"
+force = [0.0, 0.0, -1.0]
+profile = "step"
+
+[solve]
+kind = "dynamic"
+t_end = 2.0
+frames = 5
+"""
+
+
+def line_of(text: str, start: str) -> int:
+    """Line (from 1) of the first line of ``text`` starting with ``start``."""
+    return next(i for i, line in enumerate(text.splitlines(), 1) if line.startswith(start))
+
+
+def error_of(text: str) -> str:
+    with pytest.raises(ScenarioError) as info:
+        parse_scenario(text, source="case.toml")
+    return str(info.value)
+
+
+# -- values ---------------------------------------------------------------------------------
+@pytest.mark.parametrize("depth", [65, 5000])
+def test_deep_nesting_is_a_located_error_not_a_recursion_error(depth):
+    for opening, closing in (("[", "]"), ("{a = ", "}")):
+        text = f"title = \"x\"\nnested = {opening * depth}1{closing * depth}\n" + DYNAMIC
+        assert error_of(text).startswith("case.toml:2: arrays or inline tables nested more than")
+
+
+def test_brackets_inside_strings_and_comments_are_not_nesting():
+    text = f'title = "{"[" * 200}"  # {"{" * 200}\n' + DYNAMIC
+    assert parse_scenario(text).title == "[" * 200
+
+
+@pytest.mark.parametrize("key, value", [("t_end", "1e308"), ("t_end", "inf"),
+                                        ("times", "[0.0, 1e300]")])
+def test_times_beyond_any_meaningful_phase_name_their_key(key, value):
+    text = DYNAMIC.replace("t_end = 2.0\nframes = 5", f"{key} = {value}")
+    message = error_of(text)
+    assert f"case.toml:{line_of(text, key)}: solve.{key}" in message and "<= 1e+12" in message
+
+
+@pytest.mark.parametrize("value", ["0", "-3", "2.5"])
+def test_function_samples_must_be_a_positive_integer(value):
+    text = DYNAMIC + f"function_samples = {value}\n"
+    message = error_of(text)
+    assert f"case.toml:{line_of(text, 'function_samples')}: solve.function_samples: expected an integer >= 1" in message
+
+
+def test_function_samples_applies_to_the_analytic_method_only():
+    s = parse_scenario(DYNAMIC + "function_samples = 64\n")
+    assert s.solve.function_samples == 64
+    assert parse_scenario(scenario_to_toml(s)).solve.function_samples == 64
+    message = error_of(DYNAMIC + 'method = "rk45"\nfunction_samples = 64\n')
+    assert "solve.function_samples: does not apply to method 'rk45'" in message
+
+
+def test_numerical_failures_while_building_are_located():
+    s = parse_scenario(DYNAMIC, source="case.toml")
+    for exc in (ValueError("bad"), np.linalg.LinAlgError("not positive definite"),
+                OverflowError("math range error")):
+        with pytest.raises(ScenarioError) as info, _located(s, "material"):
+            raise exc
+        message = str(info.value)
+        assert message.startswith(f"case.toml:{line_of(DYNAMIC, '[material]')}: material: numerical failure")
+        assert type(exc).__name__ in message and str(exc) in message
+
+
+def test_a_denormal_mass_is_a_located_error():
+    from splinedeform.pipeline import run
+
+    text = DYNAMIC.replace("[material]\n", "[material]\nmass = 1e-320\n")
+    s = parse_scenario(text + "[output]\nformats = []\n", source="case.toml")
+    with pytest.raises(ScenarioError, match=r"^case\.toml:\d+: "):
+        run(s)
+
+
+# -- files outside the scenario's folder ----------------------------------------------------
+def file_text(path: str) -> str:
+    return (f'[surface]\nshape = "file"\npath = "{path}"\n'
+            '[material]\nw10 = 1.0\nw01 = 1.0\n[solve]\nkind = "modes"\nmodes = 2\n')
+
+
+@pytest.fixture
+def layout(tmp_path: Path) -> Path:
+    """``tmp/secret/net.json`` outside, ``tmp/shared/`` the scenario folder, ``inner/net.json``."""
+    from splinedeform.export import write_control_nets
+
+    basis = BSplineBasis(2, 3, 1.0, "open")
+    P = np.zeros((5, 5, 3))
+    P[..., 0] = basis.greville()[:, None]
+    P[..., 1] = basis.greville()[None, :]
+    for folder in (tmp_path / "secret", tmp_path / "shared" / "inner"):
+        folder.mkdir(parents=True)
+        write_control_nets(folder, "net", Surface(P, basis, basis), [0.0], P[None])
+    return tmp_path
+
+
+def write_scenario(layout: Path, path: str) -> Path:
+    scenario = layout / "shared" / "case.toml"
+    scenario.write_text(file_text(path))
+    return scenario
+
+
+def test_paths_inside_the_folder_are_read(layout):
+    for path in ("inner/net.json", "inner/../inner/net.json",
+                 str(layout / "shared" / "inner" / "net.json")):
+        s = load_scenario(write_scenario(layout, path))
+        assert s.surface.path == (layout / "shared" / "inner" / "net.json").resolve()
+
+
+@pytest.mark.parametrize("kind", ["dotdot", "absolute", "symlink"])
+def test_paths_leaving_the_folder_are_refused_without_saying_if_they_exist(layout, kind):
+    outside = layout / "secret" / "net.json"
+    if kind == "symlink":
+        (layout / "shared" / "link.json").symlink_to(outside)
+        (layout / "shared" / "dangling.json").symlink_to(layout / "secret" / "absent.json")
+        existing, absent = "link.json", "dangling.json"
+    elif kind == "dotdot":
+        existing, absent = "../secret/net.json", "../secret/absent.json"
+    else:
+        existing, absent = str(outside), str(layout / "secret" / "absent.json")
+    messages = []
+    for path in (existing, absent):
+        with pytest.raises(ScenarioError) as info:
+            load_scenario(write_scenario(layout, path))
+        messages.append(str(info.value).replace(path, "<path>"))
+    assert "case.toml:3: surface.path: '<path>' lies outside the scenario's folder" in messages[0]
+    assert "--allow-outside-paths" in messages[0] and "allow_outside_paths=True" in messages[0]
+    assert messages[0] == messages[1]          # nothing tells whether the file exists
+    assert "secret" not in messages[0].replace(str(layout / "secret"), "")
+    s = load_scenario(write_scenario(layout, existing), allow_outside_paths=True)
+    assert s.surface.path == outside.resolve()
+
+
+def test_the_opt_in_survives_overrides_and_reaches_the_command_line(layout):
+    from splinedeform import cli
+    from splinedeform.scenario import with_overrides
+
+    scenario = write_scenario(layout, "../secret/net.json")
+    s = load_scenario(scenario, allow_outside_paths=True)
+    assert with_overrides(s, {"solve.modes": 3}).solve.modes == 3
+    runner = CliRunner()
+    refused = runner.invoke(cli.app, ["validate", str(scenario)])
+    assert refused.exit_code != 0 and "outside the scenario's folder" in refused.output
+    allowed = runner.invoke(cli.app, ["validate", "--allow-outside-paths", str(scenario)])
+    assert allowed.exit_code == 0, allowed.output
