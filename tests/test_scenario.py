@@ -147,7 +147,38 @@ force = [0, 0, -1]
 kind = "static"
 """
 
-COVERAGE = {"plane": PLANE, "newmark": NEWMARK, "modes": MODES, "static": STATIC}
+ANALYTIC = """
+[surface]
+shape = "plane"
+cells = 3
+
+[material]
+w10 = 1.0
+w01 = 1.0
+
+[boundary]
+u0 = "clamped"
+u1 = "clamped"
+
+[[load]]
+kind = "uniform"
+force = [0.0, 0.0, -1.0]
+profile = "piecewise"
+points = [[0.0, 1.0], [0.5, 0.0]]
+
+[solve]
+kind = "dynamic"
+method = "analytic"
+t_end = 1.0
+frames = 3
+function_samples = 64
+
+[output]
+formats = []
+"""
+
+COVERAGE = {"plane": PLANE, "newmark": NEWMARK, "modes": MODES, "static": STATIC,
+            "analytic": ANALYTIC}
 
 
 def shape_scenario(shape: str, params: dict[str, object]) -> str:
