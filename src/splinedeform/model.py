@@ -25,6 +25,7 @@ from .boundary import Constraints, build_constraints
 from .errors import InputError, SingularSystemError
 from .loads import Load, as_load
 from .material import Material
+from .physics import PHYSICS, intrinsic
 from .quadrature import gram_matrix
 from .solution import ModalSolution, StaticSolution
 from .solvers import modal_basis
@@ -75,6 +76,10 @@ class Model:
     rest : {"initial", "none"}
         Rest shape: the initial surface (an unloaded surface stays put), or none (the
         energy of the position itself, i.e. the extra load ``-K p0``).
+    physics : {"parametric", "intrinsic"}
+        ``parametric``: the paper's energy per unit parameter area (Kronecker matrices);
+        ``intrinsic``: the same plate under tension measured on the initial surface
+        (:mod:`splinedeform.physics.intrinsic`), independent of the parametrisation.
 
     Examples
     --------
@@ -87,7 +92,8 @@ class Model:
 
     def __init__(self, surface: Surface, material: Material,
                  boundary: str | Mapping[str, str] = "free", fixed: ArrayLike | None = None,
-                 mass_matrix: str = "consistent", rest: str = "initial"):
+                 mass_matrix: str = "consistent", rest: str = "initial",
+                 physics: str = "parametric"):
         start = time.perf_counter()
         if not isinstance(surface, Surface):
             raise InputError(f"surface must be a splinedeform.Surface, got {type(surface).__name__}")
@@ -98,6 +104,8 @@ class Model:
             raise InputError(f"mass_matrix must be 'consistent' or 'lumped', got {mass_matrix!r}")
         if rest not in ("initial", "none"):
             raise InputError(f"rest must be 'initial' or 'none', got {rest!r}")
+        if physics not in PHYSICS:
+            raise InputError(f"physics must be one of {PHYSICS}, got {physics!r}")
         for name, basis, weight in (("u", surface.basis_u, material.w20),
                                     ("v", surface.basis_v, material.w02)):
             if weight and basis.degree < 2:
@@ -107,14 +115,18 @@ class Model:
         self.material = material
         self.mass_matrix = mass_matrix
         self.rest = rest
+        self.physics = physics
         self.constraints: Constraints = build_constraints(
             surface.basis_u, surface.basis_v, boundary,
             None if fixed is None else np.asarray(fixed))
         top = lambda b: min(2, b.degree)  # noqa: E731
         self.gram_u = [gram_matrix(surface.basis_u, a) for a in range(top(surface.basis_u) + 1)]
         self.gram_v = [gram_matrix(surface.basis_v, a) for a in range(top(surface.basis_v) + 1)]
-        K = stiffness(self.gram_u, self.gram_v, material)
-        M = mass(self.gram_u, self.gram_v, material.mass, mass_matrix == "lumped")
+        if physics == "intrinsic":
+            K, M = intrinsic.matrices(surface, material, mass_matrix == "lumped")
+        else:
+            K = stiffness(self.gram_u, self.gram_v, material)
+            M = mass(self.gram_u, self.gram_v, material.mass, mass_matrix == "lumped")
         T = self.constraints.T
         self.K_full, self.M_full = K, M
         self._K = (T.T @ K @ T).tocsc()

@@ -246,6 +246,8 @@ def dense_basis(K: sp.spmatrix, M: sp.spmatrix) -> DenseBasis:
 
 def separable_reason(model: Model) -> str | None:
     """Why the separable fast path does not apply to ``model`` (``None`` if it does)."""
+    if getattr(model, "physics", "parametric") != "parametric":
+        return "the surface metric varies over the parameters (no Kronecker factors)"
     if model.material.w11 != 0:
         return "the twist weight w11 is not 0 (its term G1u⊗G1v couples the directions)"
     if model.mass_matrix != "consistent":

@@ -1,0 +1,124 @@
+"""The first fundamental form of a surface on a 2-D tensor Gauss grid.
+
+At every quadrature point ``(u_a, v_b)``: the covariant basis ``a_α = x_,α``, the
+second derivatives ``a_αβ = x_,αβ``, the metric ``g_αβ = a_α·a_β``, its inverse
+``g^αβ``, the area element ``√g = |a_1 × a_2|`` and the Christoffel symbols
+``Γ^γ_αβ = a^γ·a_αβ`` with the contravariant basis ``a^γ = g^γδ a_δ``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import InputError
+from ..quadrature import gauss_points
+from ..surface import Surface
+
+Array = NDArray[np.float64]
+DEGENERATE = 1e-9      # √g below this fraction of its largest value is a degenerate metric
+
+
+@dataclass(frozen=True)
+class Grid:
+    """Tensor Gauss grid with the 1-D basis values and the metric of the initial surface.
+
+    ``index_u (Qu, pu)``, ``values_u (3, Qu, pu)`` (derivative orders 0..2), likewise in v;
+    ``weight (Qu, Qv)`` the parameter quadrature weights; ``a (2, Qu, Qv, 3)``,
+    ``a2 (3, Qu, Qv, 3)`` for ``a_11, a_12, a_22``; ``sqrt_g``, ``g_inv (Qu, Qv, 2, 2)``,
+    ``gamma (2, 3, Qu, Qv)`` = ``Γ^γ_{11}, Γ^γ_{12}, Γ^γ_{22}``.
+    """
+
+    index_u: NDArray[np.int64]
+    values_u: Array
+    index_v: NDArray[np.int64]
+    values_v: Array
+    weight: Array
+    a: Array
+    a2: Array
+    sqrt_g: Array
+    g_inv: Array
+    gamma: Array
+
+
+def poles(surface: Surface, tol: float = 1e-10) -> tuple[str, ...]:
+    """Edges whose control points all coincide (declared poles, e.g. ``"v1"`` of a half sphere)."""
+    P = surface.control_points
+    scale = max(1.0, float(np.abs(P).max()))
+    rows = {"u0": P[0], "u1": P[-1], "v0": P[:, 0], "v1": P[:, -1]}
+    return tuple(edge for edge, row in rows.items()
+                 if np.max(np.linalg.norm(row - row[0], axis=-1)) <= tol * scale)
+
+
+def check_metric(surface: Surface, samples: int = 4) -> None:
+    """Refuse a first fundamental form that degenerates away from a declared pole.
+
+    Samples ``√g = |x_u × x_v|`` on ``samples`` points per cell and both ends in each
+    direction; a point with ``√g <= DEGENERATE · max √g`` that does not lie on a pole edge
+    (see :func:`poles`) raises :class:`InputError` naming the parameter point.
+    """
+    bu, bv = surface.basis_u, surface.basis_v
+    u = np.linspace(0.0, bu.length, samples * bu.cells + 1)
+    v = np.linspace(0.0, bv.length, samples * bv.cells + 1)
+    cross = np.cross(surface.evaluate_grid(u, v, 1, 0), surface.evaluate_grid(u, v, 0, 1))
+    area = np.linalg.norm(cross, axis=-1)
+    bad = area <= DEGENERATE * area.max()
+    on_pole = {"u0": (slice(0, 1), slice(None)), "u1": (slice(-1, None), slice(None)),
+               "v0": (slice(None), slice(0, 1)), "v1": (slice(None), slice(-1, None))}
+    for edge in poles(surface):
+        bad[on_pole[edge]] = False
+    if np.any(bad):
+        i, j = np.argwhere(bad)[0]
+        raise InputError(
+            f"the first fundamental form of surface {surface.name!r} degenerates at parameter "
+            f"(u, v) = ({u[i]:.6g}, {v[j]:.6g}): |x_u × x_v| = {area[i, j]:.3g} there. The "
+            "surface physics needs a regular surface; a pole is allowed only as a "
+            "whole edge whose control points coincide")
+
+
+def grid(surface: Surface, extra_points: int = 2) -> Grid:
+    """Gauss grid with ``n + 1 + extra_points`` points per cell and direction, and its metric.
+
+    The integrands are rational in the parameters (the inverse metric), so the rule is not
+    exact; ``extra_points`` beyond the polynomial rule keeps its error below the
+    discretisation error.
+    """
+    check_metric(surface)
+    bu, bv = surface.basis_u, surface.basis_v
+    xu, wu = gauss_points(bu, bu.degree + 1 + extra_points)
+    xv, wv = gauss_points(bv, bv.degree + 1 + extra_points)
+    iu, Bu = bu.nonzero_derivatives(xu, 2)
+    iv, Bv = bv.nonzero_derivatives(xv, 2)
+    P = surface.control_points
+    net = np.take(np.take(P, iu, axis=0), iv, axis=2)          # (Qu, pu, Qv, pv, 3)
+
+    def derivative(p: int, q: int) -> Array:
+        return np.einsum("ai,bj,aibjc->abc", Bu[p], Bv[q], net)
+
+    a = np.stack([derivative(1, 0), derivative(0, 1)])
+    a2 = np.stack([derivative(2, 0), derivative(1, 1), derivative(0, 2)])
+    g = np.einsum("iabc,jabc->abij", a, a)
+    det = g[..., 0, 0] * g[..., 1, 1] - g[..., 0, 1] ** 2
+    sqrt_g = np.sqrt(np.maximum(det, 0.0))
+    g_inv = np.stack([np.stack([g[..., 1, 1], -g[..., 0, 1]], -1),
+                      np.stack([-g[..., 1, 0], g[..., 0, 0]], -1)], -2) / det[..., None, None]
+    contra = np.einsum("abij,jabc->iabc", g_inv, a)               # a^γ
+    gamma = np.einsum("iabc,kabc->ikab", contra, a2)              # Γ^γ_{(11,12,22)}
+    return Grid(iu, Bu, iv, Bv, wu[:, None] * wv[None, :], a, a2, sqrt_g, g_inv, gamma)
+
+
+def shape_derivatives(G: Grid) -> dict[tuple[int, int], Array]:
+    """``D^p_u D^q_v N_k`` at every grid point, ``(Qu, Qv, pu·pv)`` for ``p + q <= 2``."""
+    out = {}
+    for p, q in ((0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)):
+        values = G.values_u[p][:, None, :, None] * G.values_v[q][None, :, None, :]
+        out[p, q] = values.reshape(values.shape[0], values.shape[1], -1)
+    return out
+
+
+def global_index(G: Grid, n_v: int) -> NDArray[np.int64]:
+    """Flat control point index ``k n_v + l`` of each local function, ``(Qu, Qv, pu·pv)``."""
+    idx = G.index_u[:, None, :, None] * n_v + G.index_v[None, :, None, :]
+    return idx.reshape(idx.shape[0], idx.shape[1], -1)
