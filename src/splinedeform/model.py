@@ -33,7 +33,8 @@ from .solvers.analytic import ModalResponse
 from .surface import Surface
 
 Array = NDArray[np.float64]
-METHODS = ("analytic", "newmark", "rk45", "dop853", "radau", "bdf")
+METHODS = ("analytic", "newmark", "radau3", "radau5", "radau7", "genalpha", "rk45", "dop853",
+           "radau", "bdf")
 
 
 def stiffness(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], material: Material
@@ -301,7 +302,8 @@ class Model:
 
         Parameters
         ----------
-        method : {"analytic", "newmark", "rk45", "dop853", "radau", "bdf"}
+        method : {"analytic", "newmark", "radau3", "radau5", "radau7", "genalpha", "rk45", \
+"dop853", "radau", "bdf"}
             ``analytic`` is the closed-form modal solution, valid at any ``t``.
             Numerical methods integrate to the output ``times``.
         times : array, optional
@@ -313,6 +315,9 @@ class Model:
             omitted modes (mode acceleration) and a report in ``solution.truncation``;
             ``eigensolver`` (``"auto"``, ``"dense"``, ``"separable"``, ``"sparse"``, see
             :func:`splinedeform.solvers.modal_basis.choose`). ``newmark``: ``dt``.
+            ``radau3/5/7`` (Radau IIA, order 5/9/13) and ``genalpha``: ``dt`` or
+            ``substeps`` (steps per interval between output times and load breakpoints;
+            Radau default one, gen-α default ``dt = t_end/2000``), gen-α ``rho_inf``.
             ``solve_ivp`` methods: ``rtol``, ``atol``, ``max_step``.
         """
         from .solvers import numeric

@@ -4,7 +4,10 @@
   ``K_eff = K + (2/Δt) C + (4/Δt²) M`` factorised once per distinct step.
 * ``scipy.integrate.solve_ivp`` (RK45, DOP853, Radau, BDF) on the first-order form
   ``y = (d, v)``, ``v' = M⁻¹ (F - C v - K d)`` with a sparse LU of ``M``; the stiff methods get
-  the exact Jacobian.
+  the exact (dense) Jacobian. This is what a casual user does; the strong integrators are
+  :mod:`.radau` (Radau IIA with the mass matrix) and :mod:`.genalpha`.
+* ``radau3``/``radau5``/``radau7`` and ``genalpha`` take the matrices directly
+  (:func:`.radau.radau`, :func:`.genalpha.genalpha`).
 
 Both restart at the load's breakpoints (steps and switches), so discontinuities do not cost
 accuracy, and return a :class:`~splinedeform.solution.SampledSolution` at the output times.
@@ -16,6 +19,7 @@ import time
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
@@ -24,12 +28,17 @@ from scipy.integrate import solve_ivp
 from ..errors import InputError
 from ..loads import Harmonic, Load
 from ..solution import SampledSolution
+from .genalpha import genalpha
+from .radau import radau
+from .stepping import active_columns
 
 if TYPE_CHECKING:
     from ..model import Model
 
 Array = NDArray[np.float64]
 IVP_METHODS = {"rk45": "RK45", "dop853": "DOP853", "radau": "Radau", "bdf": "BDF"}
+RADAU_METHODS = {"radau3": 3, "radau5": 5, "radau7": 7}
+ONE_STEP_METHODS = (*RADAU_METHODS, "genalpha")
 
 
 class ReducedForcing:
@@ -120,6 +129,17 @@ def integrate(model: Model, forcing: ReducedForcing, method: str, t_end: float,
     start = time.perf_counter()
     if method == "newmark":
         d, v, stats = newmark(model, forcing, t_end, out_times, d0, v0, **options)
+    elif method in ONE_STEP_METHODS:
+        M, C, K = model.matrices()
+        try:
+            if method == "genalpha":
+                d, v, stats = genalpha(M, C, K, forcing, forcing.breakpoints, t_end, out_times,
+                                       d0, v0, **options)
+            else:
+                d, v, stats = radau(M, C, K, forcing, forcing.breakpoints, t_end, out_times,
+                                    d0, v0, stages=RADAU_METHODS[method], **options)
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"method {method!r}: {exc}") from None
     else:
         d, v, stats = ivp(model, forcing, IVP_METHODS[method], t_end, out_times, d0, v0, **options)
     timings = dict(model.timings)
@@ -178,49 +198,62 @@ def newmark(model: Model, forcing: ReducedForcing, t_end: float, out_times: Arra
 def ivp(model: Model, forcing: ReducedForcing, method: str, t_end: float, out_times: Array,
         d0: Array, v0: Array, rtol: float = 1e-8, atol: float = 1e-12,
         max_step: float = np.inf) -> tuple[Array, Array, dict]:
-    """``solve_ivp`` on ``y = (d_x, v_x, d_y, v_y, d_z, v_z)``, restarted at breakpoints."""
+    """``solve_ivp`` on ``y = (d_c, v_c)`` for the moving coordinates ``c``, restarted at
+    breakpoints; the other coordinates stay at rest."""
     for name, value in (("rtol", rtol), ("atol", atol)):
         if not np.isfinite(value) or value <= 0:
             raise InputError(f"{name} must be finite and > 0, got {value}")
     M, C, K = model.matrices()
     n = model.n_free
     mass_lu = spla.splu(M)
+    cols = active_columns(forcing, forcing.breakpoints, t_end, d0, v0)
+    m = len(cols)
 
     def rhs(t: float, y: Array) -> Array:
-        state = y.reshape(3, 2, n)
+        state = y.reshape(m, 2, n)
         d, v = state[:, 0].T, state[:, 1].T
-        a = mass_lu.solve(forcing(t) - C @ v - K @ d)
+        a = mass_lu.solve(forcing(t)[:, cols] - C @ v - K @ d)
         return np.stack([v.T, a.T], axis=1).ravel()
 
     options: dict[str, Any] = {"rtol": rtol, "atol": atol, "max_step": max_step}
-    if method in ("Radau", "BDF"):
-        options["jac"] = _jacobian(M, C, K, mass_lu)
-    y = np.stack([d0.T, v0.T], axis=1).ravel()
-    d_out, v_out = np.empty((out_times.size, n, 3)), np.empty((out_times.size, n, 3))
-    stats = {"nfev": 0, "njev": 0, "nlu": 0}
+    if method in ("Radau", "BDF") and m:
+        options["jac"] = _jacobian(M, C, K, m)
+    y = np.stack([d0[:, cols].T, v0[:, cols].T], axis=1).ravel()
+    d_out, v_out = np.zeros((out_times.size, n, 3)), np.zeros((out_times.size, n, 3))
+    stats = {"nfev": 0, "njev": 0, "nlu": 0, "columns": m}
     filled = 0
     for ta, tb in _segments(forcing.breakpoints, t_end):
         last = tb == t_end
         inside = out_times[(out_times >= ta) & ((out_times <= tb) if last else (out_times < tb))]
+        if not m:
+            filled += inside.size
+            continue
         seg_rhs = lambda t, y, ta=ta, tb=tb: rhs(min(t, _left_limit(ta, tb)), y)  # noqa: E731
         sol = solve_ivp(seg_rhs, (ta, tb), y, method=method,
                         t_eval=np.union1d(inside, [tb]), **options)
         if not sol.success:
             raise InputError(f"{method} failed: {sol.message}")
-        for key in stats:
+        for key in ("nfev", "njev", "nlu"):
             stats[key] += int(getattr(sol, key))
-        states = sol.y[:, : inside.size].T.reshape(-1, 3, 2, n)
-        d_out[filled:filled + inside.size] = states[:, :, 0].transpose(0, 2, 1)
-        v_out[filled:filled + inside.size] = states[:, :, 1].transpose(0, 2, 1)
+        states = sol.y[:, : inside.size].T.reshape(-1, m, 2, n)
+        d_out[filled:filled + inside.size][:, :, cols] = states[:, :, 0].transpose(0, 2, 1)
+        v_out[filled:filled + inside.size][:, :, cols] = states[:, :, 1].transpose(0, 2, 1)
         filled += inside.size
         y = sol.y[:, -1]
     return d_out, v_out, stats
 
 
-def _jacobian(M: sp.spmatrix, C: sp.spmatrix, K: sp.spmatrix, mass_lu: Any) -> sp.csr_matrix:
-    """Exact Jacobian ``[[0, I], [-M⁻¹K, -M⁻¹C]]`` for the three coordinates."""
+def _jacobian(M: sp.spmatrix, C: sp.spmatrix, K: sp.spmatrix, columns: int) -> Array:
+    """Exact Jacobian ``[[0, I], [-M⁻¹K, -M⁻¹C]]`` per moving coordinate, as a dense array.
+
+    ``M⁻¹`` of a B-spline mass matrix is dense, so the exact Jacobian of the first-order form
+    is dense; given as an ndarray, ``solve_ivp`` factorises ``I - h γ J`` with LAPACK rather
+    than a sparse LU of a dense matrix. ``M⁻¹K`` and ``M⁻¹C`` come from one Cholesky of ``M``.
+    """
     n = M.shape[0]
-    minv_k = sp.csr_matrix(mass_lu.solve(K.toarray()))
-    minv_c = sp.csr_matrix(mass_lu.solve(C.toarray()))
-    block = sp.bmat([[None, sp.identity(n)], [-minv_k, -minv_c]], format="csr")
-    return sp.block_diag([block] * 3, format="csr")
+    factor = sla.cho_factor(M.toarray())
+    block = np.zeros((2 * n, 2 * n))
+    block[:n, n:] = np.eye(n)
+    block[n:, :n] = -sla.cho_solve(factor, K.toarray())
+    block[n:, n:] = -sla.cho_solve(factor, C.toarray())
+    return sla.block_diag(*[block] * columns) if columns > 1 else block
