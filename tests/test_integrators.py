@@ -5,6 +5,8 @@ References: the matrix exponential of the first-order system augmented by the fo
 every damping regime, and the model's closed-form modal solution.
 """
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import scipy.linalg as sla
@@ -151,3 +153,14 @@ def test_bad_options_are_named():
         model.dynamic(sd.Uniform((0, 0, -1.0)), 1.0, method="radau7", substeps=0)
     with pytest.raises(InputError, match="rho_inf"):
         model.dynamic(sd.Uniform((0, 0, -1.0)), 1.0, method="genalpha", rho_inf=2.0)
+
+
+def test_scenario_runs_radau7_and_rejects_dt_for_rk45(tmp_path):
+    from splinedeform.scenario import parse_scenario, with_overrides
+
+    text = (Path(__file__).parent.parent / "examples" / "saddle_gravity_newmark.toml").read_text()
+    s = parse_scenario(text, source="case.toml")
+    radau7 = with_overrides(s, {"solve.method": "radau7"}, origin="--method")
+    assert radau7.solve.method == "radau7"
+    with pytest.raises(InputError, match="dt"):
+        with_overrides(s, {"solve.method": "rk45"}, origin="--method")

@@ -120,7 +120,8 @@ def _run(scenario: Any, outdir: Path, quiet: bool) -> None:
 @app.command("run")
 def run_command(scenario: Path = SCENARIO_ARG, outdir: Optional[Path] = OUTDIR_OPT,
                 method: Optional[str] = typer.Option(
-                    None, "--method", help="Override solve.method: analytic, newmark, rk45, "
+                    None, "--method", help="Override solve.method: analytic, newmark, radau3, "
+                                           "radau5, radau7, genalpha, rk45, "
                                            "dop853, radau, bdf."),
                 frames: Optional[int] = typer.Option(
                     None, "--frames", help="Override solve.frames (replaces solve.times)."),

@@ -35,6 +35,7 @@ from .surface import Surface
 Array = NDArray[np.float64]
 METHODS = ("analytic", "newmark", "radau3", "radau5", "radau7", "genalpha", "rk45", "dop853",
            "radau", "bdf")
+STEP_METHODS = ("newmark", "radau3", "radau5", "radau7", "genalpha")   # take a step dt
 
 
 def stiffness(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], material: Material

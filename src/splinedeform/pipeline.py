@@ -148,9 +148,11 @@ def _method_options(solve: SolveSpec, times: Any, mesh_time: float | None) -> di
         return {"function_samples": solve.function_samples}
     extra = [] if mesh_time is None else [mesh_time]
     options: dict[str, Any] = {"times": np.union1d(times, extra)}
-    if solve.method == "newmark":
+    if solve.method in ("newmark", "genalpha"):
         frames = max(len(times) - 1, 1)
         options["dt"] = solve.dt if solve.dt is not None else solve.t_end / (20 * frames)
+    elif solve.method.startswith("radau") and solve.method != "radau":
+        options["dt"] = solve.dt                 # None: one Radau IIA step per frame
     else:
         options.update(rtol=solve.rtol, atol=solve.atol)
     return options

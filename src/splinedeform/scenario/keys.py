@@ -6,7 +6,7 @@ import math
 
 from ..basis import KNOT_KINDS as KNOTS
 from ..boundary import EDGES, PRESETS
-from ..model import METHODS
+from ..model import METHODS, STEP_METHODS
 from ..shapes import FIT_METHODS
 from .checks import Key, array_of, choice, integer, number, one_or_pair, scalar_or_pair, text, vector
 
@@ -119,7 +119,8 @@ SOLVE_KEYS: dict[str, Key] = {
     "modes": Key(integer(0, 1000), 6, "number of vibration modes to report"),
     "rtol": Key(number(0.0, 1.0, open_low=True), 1e-8, "relative tolerance (rk45..bdf)"),
     "atol": Key(_POSITIVE, 1e-10, "absolute tolerance (rk45..bdf)"),
-    "dt": Key(_POSITIVE, None, "time step (newmark); default t_end / (20 (frames - 1))"),
+    "dt": Key(_POSITIVE, None, "time step (newmark, genalpha, radau3/5/7); default "
+                          "t_end / (20 (frames - 1)), Radau one step per frame"),
     "function_samples": Key(integer(1, 100000), 400, "analytic: samples of a time-dependent "
                                                      "load profile"),
 }

@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping
 
 from .checks import Key, _Invalid
-from .keys import (BOUNDARY_KEYS, FORMAT_ALIASES, FREE_REGION_KEYS, IVP_METHODS, LOAD_KEYS,
+from .keys import (STEP_METHODS, BOUNDARY_KEYS, FORMAT_ALIASES, FREE_REGION_KEYS, IVP_METHODS, LOAD_KEYS,
                    LOAD_KIND_KEYS, MATERIAL_KEYS, PROFILE_KEYS, SHAPE_PARAMETERS, SOLVE_KEYS,
                    SOLVE_KIND_KEYS, SURFACE_KEYS, TABLES, TOP_KEYS, OUTPUT_KEYS)
 from .locate import _describe, _Problems
@@ -286,8 +286,8 @@ def _check_dynamic(table: Mapping[str, Any], values: dict[str, Any], problems: _
             problems.add("solve.times", "needs a time > 0")
     _not_applicable(table, ("rtol", "atol"), ("rtol", "atol") if method in IVP_METHODS else (),
                     "solve", problems, f"to method {method!r} (only to {', '.join(IVP_METHODS)})")
-    _not_applicable(table, ("dt",), ("dt",) if method == "newmark" else (), "solve", problems,
-                    f"to method {method!r} (only to newmark)")
+    _not_applicable(table, ("dt",), ("dt",) if method in STEP_METHODS else (), "solve", problems,
+                    f"to method {method!r} (only to {', '.join(STEP_METHODS)})")
     _not_applicable(table, ("function_samples",), ("function_samples",)
                     if method == "analytic" else (), "solve", problems,
                     f"to method {method!r} (only to analytic)")

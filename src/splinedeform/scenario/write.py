@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any, Iterable
 
 from ..boundary import EDGES
-from .keys import IVP_METHODS, LOAD_KIND_KEYS, MATERIAL_KEYS, OUTPUT_KEYS, PROFILE_KEYS, TOP_KEYS
+from .keys import STEP_METHODS, IVP_METHODS, LOAD_KIND_KEYS, MATERIAL_KEYS, OUTPUT_KEYS, PROFILE_KEYS, TOP_KEYS
 from .spec import LoadSpec, Scenario, SolveSpec
 
 
@@ -44,7 +44,7 @@ def _solve_items(solve: SolveSpec) -> list[tuple[str, Any]]:
         items += [("modes", solve.modes)]
         if solve.method in IVP_METHODS:
             items += [("rtol", solve.rtol), ("atol", solve.atol)]
-        if solve.method == "newmark":
+        if solve.method in STEP_METHODS:
             items += [("dt", solve.dt)]
         if solve.method == "analytic":
             items += [("function_samples", solve.function_samples)]
