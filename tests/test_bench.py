@@ -52,7 +52,7 @@ def test_quick_run_errors_are_within_the_target(quick):
         assert float(r["error"]) <= target
         assert float(r["error"]) < 1e-9
     numerical = [r for r in rows if r["solver"] != "analytic"]
-    assert {r["solver"] for r in numerical} == set(bench.NUMERICAL)
+    assert {r["solver"] for r in numerical} == set(bench.DEFAULT_METHODS)
     for r in numerical:
         if r["status"] == "ok":
             assert float(r["error"]) <= target
@@ -170,3 +170,17 @@ def test_forecast_skips_after_a_run_over_budget():
 def test_bad_settings_are_refused(kwargs, words, tmp_path):
     with pytest.raises(InputError, match=words):
         bench.main(outdir=tmp_path, quiet=True, **kwargs)
+
+
+def test_substep_levels_are_a_factor_sqrt2_apart():
+    steps = [bench.substeps(k) for k in range(2, 21)]
+    ratios = np.array(steps[1:]) / np.array(steps[:-1])
+    # √2 between levels up to the rounding of small integers (3/2 = 1.5, 4/3 ≈ 1.33)
+    assert np.all(ratios <= 1.5 + 1e-12) and np.all(ratios >= 1.3)
+
+
+def test_fastest_of_a_row_is_the_quickest_finished_run():
+    rows = [bench.Row("clamped", 8, 10, "analytic", "exact", 2.0),
+            bench.Row("clamped", 8, 10, "radau7", "ok", 1.0),
+            bench.Row("clamped", 8, 10, "genalpha", "over budget", 0.5)]
+    assert bench.fastest(rows).solver == "radau7"

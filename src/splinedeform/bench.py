@@ -61,10 +61,16 @@ from .shapes import plane
 from .solvers import numeric
 
 Array = NDArray[np.float64]
-NUMERICAL = ("newmark", "rk45", "dop853", "radau", "bdf")
+NUMERICAL = ("radau7", "radau3", "genalpha", "newmark", "rk45", "dop853", "radau", "bdf")
+SUBSTEP_METHODS = ("radau7", "radau3", "genalpha")
+"""Methods whose setting is a number of equal steps per frame interval, ``round(√2^k)``."""
+DEFAULT_METHODS = ("radau7", "radau3", "genalpha", "radau")
 FAMILIES = ("clamped", "region")
-MAX_LEVEL = {"newmark": 14, "rk45": 10, "dop853": 10, "radau": 10, "bdf": 10}
-START_LEVEL = {"newmark": 1, "rk45": 2, "dop853": 2, "radau": 2, "bdf": 2}
+MAX_LEVEL = {"radau7": 20, "radau3": 24, "genalpha": 30, "newmark": 14, "rk45": 10,
+             "dop853": 10, "radau": 10, "bdf": 10}
+START_LEVEL = {"radau7": 0, "radau3": 2, "genalpha": 8, "newmark": 1, "rk45": 2, "dop853": 2,
+               "radau": 2, "bdf": 2}
+ORDER = {"radau7": 13, "radau3": 5, "genalpha": 2}
 PLATE = Material(mass=1.0, damping=0.8, rayleigh=5e-4, w10=10.0, w01=10.0, w20=1.0, w11=1.0,
                  w02=1.0)
 SEPARABLE_PLATE = replace(PLATE, w11=0.0)
@@ -95,7 +101,7 @@ class Study:
     frames: int = 200
     target: float = 1e-6
     budget: float = 30.0
-    methods: tuple[str, ...] = NUMERICAL
+    methods: tuple[str, ...] = DEFAULT_METHODS
     families: tuple[str, ...] = FAMILIES
     yardstick_sizes: int = 2
     goals: bool = True
@@ -236,8 +242,16 @@ class Attempt:
     progress: float = math.nan
 
 
+def substeps(level: int) -> int:
+    """Steps per frame interval at a level: ``round(√2^k)`` (a factor √2 between levels)."""
+    return max(1, round(math.sqrt(2.0) ** level))
+
+
 def options(method: str, level: int, case: Case) -> dict[str, float]:
-    """Solver settings of a level: Newmark ``dt = t_end/(250·2^k)``, else ``rtol = 10^-(2+k)``."""
+    """Solver settings of a level: Radau IIA / gen-α ``round(√2^k)`` steps per frame,
+    Newmark ``dt = t_end/(250·2^k)``, else ``rtol = 10^-(2+k)``."""
+    if method in SUBSTEP_METHODS:
+        return {"substeps": substeps(level)}
     if method == "newmark":
         return {"dt": case.t_end / (250 * 2**level)}
     rtol = 10.0 ** -(2 + level)
@@ -245,6 +259,8 @@ def options(method: str, level: int, case: Case) -> dict[str, float]:
 
 
 def setting_label(method: str, level: int) -> str:
+    if method in SUBSTEP_METHODS:
+        return f"{substeps(level)} steps/frame"
     if method == "newmark":
         return f"dt = t_end/{250 * 2**level}"
     return f"rtol = 1e-{2 + level:02d}"
@@ -272,9 +288,12 @@ def attempt(case: Case, method: str, level: int, budget: float,
 
 
 def next_level(method: str, level: int, error: float, target: float) -> int:
-    """Predicted finer level: order 2 for Newmark (error ∝ dt²), error ∝ rtol otherwise."""
+    """Predicted finer level: order 2 for Newmark (error ∝ dt²), ``p`` for Radau IIA and
+    gen-α (error ∝ h^p, a factor √2^p per level), error ∝ rtol otherwise."""
     ratio = error / target if math.isfinite(error) else 1e6
     per_level = 4.0 if method == "newmark" else 10.0
+    if method in ORDER:
+        per_level = math.sqrt(2.0) ** ORDER[method]
     jump = math.ceil(math.log(max(ratio, 1.0) * 1.2) / math.log(per_level))
     return level + min(max(jump, 1), 3)
 
@@ -679,7 +698,15 @@ def _fmt(value: float, unit: str = "", digits: int = 3) -> str:
     return f"{value:.{digits}g}{unit}"
 
 
-def _cell(row: Row) -> str:
+def fastest(rows: Sequence[Row]) -> Row | None:
+    """The quickest finished run (analytic or numerical at its passing setting) of a row."""
+    done = [r for r in rows if r.status in ("ok", "exact") and math.isfinite(r.seconds)]
+    return min(done, key=lambda r: r.seconds) if done else None
+
+
+def _cell(row: Row, best: Row | None = None) -> str:
+    if row.status == "ok" and best is not None:
+        return f"{_fmt(row.seconds, ' s')} (×{_fmt(row.seconds / best.seconds)}; {row.error:.0e})"
     if row.status == "ok":
         return f"{_fmt(row.seconds, ' s')} (×{_fmt(row.ratio)}; {row.error:.0e})"
     if row.status == "over budget" and not math.isfinite(row.estimate):
@@ -711,8 +738,10 @@ def markdown(rows: list[Row], goals: list[Goal], study: Study, seconds: float,
     w("# Cost study: analytic against numerical solution\n\n")
     w(f"Machine: {machine_text or machine()}. Study time {seconds:.0f} s.\n\n")
     w("Problem: " + _problem_text(study) + "\n\n")
-    w("Cells of the numerical columns: total time (ratio numerical / analytic; error "
-      "reached). `> budget`: stopped at the budget, the full run extrapolated from the "
+    w("Cells of the numerical columns: total time (ratio to the fastest method of the row; "
+      "error reached); `fastest` names that method and `analytic ×` is the analytic time over "
+      "the fastest time (1 when the analytic path wins; above 1 it loses by that factor). "
+      "Ratios of runs over budget are against the analytic time. `> budget`: stopped at the budget, the full run extrapolated from the "
       "simulated time reached (this assumes a uniform cost per simulated time, so it "
       "over-estimates methods whose first steps are the most expensive, like BDF and Radau "
       f"right after the load switches on; below {MIN_PROGRESS:.0%} of t_end nothing is "
@@ -724,17 +753,20 @@ def markdown(rows: list[Row], goals: list[Goal], study: Study, seconds: float,
             continue
         w(f"\n## Family `{family}`\n\n")
         w("| cells | free | analytic set-up | per frame | analytic total | analytic check | "
-          + " | ".join(study.methods) + " |\n")
-        w("|---" * (6 + len(study.methods)) + "|\n")
+          + " | ".join(study.methods) + " | fastest | analytic × |\n")
+        w("|---" * (8 + len(study.methods)) + "|\n")
         for cells in study.sizes:
             here = {r.solver: r for r in fam if r.cells == cells}
             a = here.get("analytic")
             if a is None:
                 continue
             check = f"{a.error:.0e}" if math.isfinite(a.error) else "—"
+            best = fastest(list(here.values()))
             w(f"| {cells}×{cells} | {a.n_free} | {_fmt(a.setup, ' s')} | "
               f"{_fmt(1e3 * a.per_frame, ' ms')} | {_fmt(a.seconds, ' s')} | {check} | "
-              + " | ".join(_cell(here[m]) if m in here else "—" for m in study.methods) + " |\n")
+              + " | ".join(_cell(here[m], best) if m in here else "—" for m in study.methods)
+              + f" | {best.solver if best else '—'} | "
+              + (f"{_fmt(a.seconds / best.seconds)} |\n" if best else "— |\n"))
         w("\nSettings found (coarsest reaching the target) and fitted cost slopes "
           "(time ∝ n_free^p, least squares over the three largest nets measured or extrapolated from a run stopped at the budget):\n\n")
         w("| solver | " + " | ".join(f"{c}×{c}" for c in study.sizes) + " | slope p |\n")
