@@ -171,6 +171,16 @@ def validate_command(scenario: Path = SCENARIO_ARG, allow_outside_paths: bool = 
         out.print(scenario_to_toml(loaded), markup=False, highlight=False)
 
 
+@app.command("schema")
+def schema_command() -> None:
+    """Print the JSON Schema of scenario files (for editors: see docs/scenario.md)."""
+    import json
+
+    from .scenario.schema import json_schema
+
+    sys.stdout.write(json.dumps(json_schema(), indent=2, ensure_ascii=False) + "\n")
+
+
 def examples_directory() -> Path | None:
     """The ``examples/`` folder of a source checkout, if there is one."""
     candidate = Path(__file__).resolve().parents[2] / "examples"

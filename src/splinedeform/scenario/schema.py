@@ -1,0 +1,243 @@
+"""The scenario file as typed pydantic models: the source of its JSON Schema.
+
+One model per table; a discriminated union where a key selects the other keys that apply
+(``surface.shape``, ``load.kind``, ``solve.kind``). ``splinedeform schema`` prints
+:func:`json_schema`, which editors (taplo, "Even Better TOML") use to complete and check
+scenario files while they are written; ``tests/test_scenario_schema.py`` validates every
+example against it and checks that these models and the reader's keys
+(:mod:`.keys`) agree key for key, default for default.
+
+Extending
+---------
+- a shape: one model with ``shape: Literal["name"]`` and its parameters, added to
+  :data:`SHAPE_MODELS` (and its entry in ``keys.SHAPE_PARAMETERS``);
+- a solve method: one name in ``splinedeform.model.METHODS`` (the literal below follows it);
+- a load kind / solve kind: one model added to :data:`LOAD_MODELS` / :data:`SOLVE_MODELS`;
+- a key: one field with its type, constraints, default and ``description``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Any, Literal, Optional, Union
+
+from pydantic import BaseModel, ConfigDict, Field, Strict
+
+from ..basis import KNOT_KINDS
+from ..boundary import PRESETS
+from ..model import METHODS
+from ..shapes import FIT_METHODS
+from .keys import FORMAT_ALIASES, FORMATS, MASS_MATRICES, PROFILES, TIME_MAX
+
+Real = Annotated[float, Strict(), Field(allow_inf_nan=False)]
+Positive = Annotated[float, Strict(), Field(gt=0, allow_inf_nan=False)]
+NonNegative = Annotated[float, Strict(), Field(ge=0, allow_inf_nan=False)]
+Time = Annotated[float, Strict(), Field(ge=0, le=TIME_MAX, allow_inf_nan=False)]
+Integer = Annotated[int, Strict()]
+Text = Annotated[str, Strict()]
+Pair = tuple[Real, Real]
+Cells = Annotated[int, Strict(), Field(ge=1, le=512)]
+Knots = Literal[KNOT_KINDS]  # type: ignore[valid-type]
+Preset = Literal[PRESETS]  # type: ignore[valid-type]
+
+
+class _Table(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+# -- [surface] ---------------------------------------------------------------------------------
+class _Fitted(_Table):
+    cells: Optional[Union[Cells, tuple[Cells, Cells]]] = Field(
+        None, description="knot spans per direction, one or [m_u, m_v] (default: the shape's own)")
+    degree: Annotated[int, Strict(), Field(ge=1, le=7)] = Field(
+        3, description="polynomial degree of the B-splines")
+    knots: Optional[Union[Knots, tuple[Knots, Knots]]] = Field(
+        None, description="knot layout per direction (default: the shape's own)")
+    method: Literal[FIT_METHODS] = Field(  # type: ignore[valid-type]
+        "interpolate", description="how control points are fitted to the shape")
+
+
+Size = Union[Positive, tuple[Positive, Positive]]
+SIZE_DOC = "side lengths [L_u, L_v] (or one for both); the domain is [0, L_u] × [0, L_v]"
+
+
+class Plane(_Fitted):
+    shape: Literal["plane"]
+    size: Size = Field(1.0, description=SIZE_DOC)
+
+
+class Tile(_Fitted):
+    shape: Literal["tile"]
+    radius: Positive = Field(1.0, description="radius of the arc")
+    angle: Annotated[float, Strict(), Field(gt=0, le=2 * math.pi, allow_inf_nan=False)] = Field(
+        math.pi / 2, description="opening angle of the arc (radians, < 2π)")
+    length: Positive = Field(2.0, description="length along the axis")
+
+
+class HalfSphere(_Fitted):
+    shape: Literal["half_sphere"]
+    radius: Positive = Field(1.0, description="sphere radius")
+
+
+class Cylinder(_Fitted):
+    shape: Literal["cylinder"]
+    radius: Positive = Field(1.0, description="radius")
+    height: Positive = Field(2.0, description="height (along z)")
+
+
+class Torus(_Fitted):
+    shape: Literal["torus"]
+    R: Positive = Field(1.0, description="radius of the centre line")
+    r: Positive = Field(0.4, description="tube radius (r < R)")
+
+
+class Saddle(_Fitted):
+    shape: Literal["saddle"]
+    size: Size = Field(1.0, description=SIZE_DOC)
+    height: Real = Field(0.25, description="z = height (ξ² - η²), ξ, η in [-1, 1]")
+
+
+class FromFile(_Fitted):
+    shape: Literal["file"]
+    path: Text = Field(description="control net (.json/.npz) or point grid (.npy/.npz) file, "
+                                   "inside the scenario's folder")
+    frame: Integer = Field(-1, description="frame of a control net file (negative from the end)")
+
+
+#: every ``surface.shape``; a new shape is one model here
+SHAPE_MODELS = (Plane, Tile, HalfSphere, Cylinder, Torus, Saddle, FromFile)
+Surface = Annotated[Union[SHAPE_MODELS], Field(discriminator="shape")]  # type: ignore[valid-type]
+
+
+# -- [material], [boundary] --------------------------------------------------------------------
+class Material(_Table):
+    mass: Positive = Field(1.0, description="mass density μ")
+    damping: NonNegative = Field(0.0, description="viscous damping γ")
+    rayleigh: NonNegative = Field(0.0, description="stiffness-proportional damping β")
+    w10: NonNegative = Field(0.0, description="tension in u")
+    w01: NonNegative = Field(0.0, description="tension in v")
+    w20: NonNegative = Field(0.0, description="bending in u")
+    w11: NonNegative = Field(0.0, description="twist (bending, mixed)")
+    w02: NonNegative = Field(0.0, description="bending in v")
+    mass_matrix: Literal[MASS_MATRICES] = Field(  # type: ignore[valid-type]
+        "consistent", description="consistent or lumped mass")
+
+
+class FreeRegion(_Table):
+    u: Optional[Pair] = Field(None, description="parameter range [low, high] in u")
+    v: Optional[Pair] = Field(None, description="parameter range [low, high] in v")
+
+
+class Boundary(_Table):
+    u0: Preset = Field("free", description="edge u = 0")
+    u1: Preset = Field("free", description="edge u = L")
+    v0: Preset = Field("free", description="edge v = 0")
+    v1: Preset = Field("free", description="edge v = L")
+    free_region: Optional[FreeRegion] = Field(
+        None, description="only control points with Greville abscissae in this box move")
+
+
+# -- [[load]] ----------------------------------------------------------------------------------
+class _Profiled(_Table):
+    profile: Literal[PROFILES] = Field(  # type: ignore[valid-type]
+        "constant", description="time profile s(t) scaling the load")
+    t_on: Time = Field(0.0, description="step: switch-on time")
+    t_off: Optional[Annotated[float, Strict(), Field(ge=0)]] = Field(
+        None, description="step: switch-off time (default: never, inf)")
+    points: Optional[list[Pair]] = Field(None, min_length=1,
+                                         description="piecewise: scale s from time t on, [t, s]")
+    omega: Optional[Positive] = Field(None, description="harmonic: angular frequency ω")
+    phase: Real = Field(0.0, description="harmonic: phase φ in sin(ωt + φ)")
+
+
+class PointLoad(_Profiled):
+    kind: Literal["point"]
+    at: Pair = Field(description="parameters [u, v] of the point")
+    force: tuple[Real, Real, Real] = Field(description="force [fx, fy, fz]")
+
+
+class UniformLoad(_Profiled):
+    kind: Literal["uniform"]
+    force: tuple[Real, Real, Real] = Field(description="force per area [fx, fy, fz]")
+
+
+class PressureLoad(_Profiled):
+    kind: Literal["pressure"]
+    q: Real = Field(description="pressure along the initial normal x_u × x_v")
+
+
+#: every ``load.kind``; a new kind is one model here
+LOAD_MODELS = (PointLoad, UniformLoad, PressureLoad)
+Load = Annotated[Union[LOAD_MODELS], Field(discriminator="kind")]  # type: ignore[valid-type]
+
+
+# -- [solve], [output] -------------------------------------------------------------------------
+Frames = Annotated[int, Strict(), Field(ge=2, le=100000)]
+FRAMES_DOC = "number of equally spaced frames"
+
+
+class StaticSolve(_Table):
+    kind: Literal["static"]
+    frames: Frames = Field(50, description=FRAMES_DOC + " (load factors in [0, 1])")
+
+
+class ModesSolve(_Table):
+    kind: Literal["modes"]
+    modes: Annotated[int, Strict(), Field(ge=1, le=1000)] = Field(
+        6, description="number of vibration modes to report")
+    frames: Frames = Field(50, description=FRAMES_DOC + " (phases over one period)")
+
+
+class DynamicSolve(_Table):
+    kind: Literal["dynamic"]
+    method: Literal[METHODS] = Field(  # type: ignore[valid-type]
+        "analytic", description="closed-form modal solution or a numerical integrator")
+    t_end: Optional[Annotated[float, Strict(), Field(gt=0, le=TIME_MAX)]] = Field(
+        None, description="end time (required unless times is given)")
+    frames: Frames = Field(50, description=FRAMES_DOC + " in [0, t_end]")
+    times: Optional[list[Time]] = Field(None, min_length=1,
+                                        description="explicit increasing frame times")
+    modes: Annotated[int, Strict(), Field(ge=0, le=1000)] = Field(
+        6, description="number of vibration modes to report")
+    rtol: Annotated[float, Strict(), Field(gt=0, le=1)] = Field(
+        1e-8, description="relative tolerance (rk45, dop853, radau, bdf)")
+    atol: Positive = Field(1e-10, description="absolute tolerance (rk45, dop853, radau, bdf)")
+    dt: Optional[Positive] = Field(None, description="time step (newmark)")
+    function_samples: Annotated[int, Strict(), Field(ge=1, le=100000)] = Field(
+        400, description="analytic: samples of a time-dependent load profile")
+
+
+#: every ``solve.kind``
+SOLVE_MODELS = (StaticSolve, ModesSolve, DynamicSolve)
+Solve = Annotated[Union[SOLVE_MODELS], Field(discriminator="kind")]  # type: ignore[valid-type]
+
+
+class Output(_Table):
+    formats: list[Literal[FORMATS + tuple(FORMAT_ALIASES)]] = Field(  # type: ignore[misc]
+        ["report"], description="what to write")
+    resolution: Annotated[int, Strict(), Field(ge=2, le=1024)] = Field(
+        32, description="tessellation samples per direction")
+    probes: list[Pair] = Field([], description="[u, v] points whose displacement is reported")
+    time: Optional[Time] = Field(None, description="state written as a mesh (dynamic)")
+
+
+class ScenarioFile(_Table):
+    """A scenario file: one simulation (see ``docs/scenario.md``)."""
+
+    model_config = ConfigDict(extra="forbid", title="splinedeform scenario")
+
+    title: Text = Field("", description="a one-line title, shown in reports")
+    description: Text = Field("", description="free text, copied to the report")
+    surface: Surface
+    material: Material = Field(default_factory=Material)
+    boundary: Boundary = Field(default_factory=Boundary)
+    load: list[Load] = Field([], description="[[load]] tables, summed")
+    solve: Solve
+    output: Output = Field(default_factory=Output)
+
+
+def json_schema() -> dict[str, Any]:
+    """JSON Schema (draft 2020-12) of scenario files, generated from :class:`ScenarioFile`."""
+    schema = ScenarioFile.model_json_schema()
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    return schema
