@@ -1,0 +1,84 @@
+"""Linear Kirchhoff–Love shell against closed forms and the shell obstacle course.
+
+Closed forms: Timoshenko's clamped square plate under uniform load (centre deflection
+0.00126532 q a⁴/D) and the simply supported plate's frequencies π²(m² + n²)√(D/ρt).
+Obstacle course (converged Kirchhoff–Love values): Scordelis–Lo roof 0.3006, pinched
+hemisphere with an 18° hole 0.0924.
+"""
+
+from math import pi
+
+import numpy as np
+import pytest
+
+import splinedeform as sd
+from splinedeform.errors import InputError
+from splinedeform.physics.shell import ShellMaterial
+from splinedeform.physics.shell_model import AreaForce, ShellModel
+
+ALL = ("u0", "u1", "v0", "v1")
+
+
+def test_clamped_plate_deflection_and_simply_supported_frequencies():
+    E, nu, t = 1e4, 0.3, 0.01
+    D = E * t ** 3 / (12 * (1 - nu ** 2))
+    plate = sd.shapes.plane(cells=8)
+    d = ShellModel(plate, ShellMaterial(E, nu, t), {e: "clamped" for e in ALL}).static(
+        AreaForce(force=(0, 0, 1.0)))
+    w = plate.derivative(0.5, 0.5, control_points=d)[2]
+    # Timoshenko's series value has 5 digits; measured ratio 0.99986 at 8×8 cells
+    assert w / (0.00126532 / D) == pytest.approx(1.0, abs=5e-4)
+    omega = ShellModel(sd.shapes.plane(cells=12), ShellMaterial(E, nu, t),
+                       {e: "pinned" for e in ALL}).frequencies(3)
+    # discretisation error measured 9e-5 for the (1, 2) pair at 12×12 cells
+    np.testing.assert_allclose(omega, pi ** 2 * np.array([2, 5, 5]) * np.sqrt(D / t), rtol=5e-4)
+
+
+def scordelis_lo(cells):
+    roof = sd.shapes.tile(radius=25.0, angle=80 * pi / 180, length=50.0, cells=cells)
+    model = ShellModel(roof, ShellMaterial(4.32e8, 0.0, 0.25),
+                       {"v0": "diaphragm", "v1": "diaphragm"})
+    d = model.static(AreaForce(force=(0, 0, -90.0)))
+    return roof, roof.derivative(0.0, 25.0, control_points=d)
+
+
+def test_scordelis_lo_roof():
+    roof, d = scordelis_lo(8)
+    assert roof.fit_error < 1e-4   # of a radius 25: the geometry is exact to 4e-6 relative
+    # vertical displacement at the middle of a free edge: measured 0.30015 (0.15 % low)
+    assert -d[2] == pytest.approx(0.3006, rel=0.005)
+    assert abs(d[1]) < 1e-10       # midspan is a symmetry plane (round-off scale)
+
+
+def pinched_hemisphere(cells):
+    """Quarter of the hemisphere with an 18° hole, symmetry edges, half loads on them."""
+    def f(u, v):
+        return 10.0 * np.stack([np.cos(v) * np.cos(u), np.cos(v) * np.sin(u), np.sin(v)], -1)
+    quarter = sd.shapes.from_function(f, cells=cells, domain=((0, pi / 2), (0, 72 * pi / 180)))
+    model = ShellModel(quarter, ShellMaterial(6.825e7, 0.3, 0.04),
+                       {"u0": "symmetry", "u1": "symmetry"})
+    load = sd.loads.Point(0.0, 0.0, (1.0, 0, 0)) + sd.loads.Point(pi / 2, 0.0, (0, -1.0, 0))
+    d = model.static(load)
+    return quarter, quarter.derivative(0.0, 0.0, control_points=d)[0]
+
+
+def test_pinched_hemisphere_converges_near_the_reference():
+    quarter, w16 = pinched_hemisphere(16)
+    assert quarter.fit_error < 1e-5
+    _, w12 = pinched_hemisphere(12)
+    # converged: 12 → 16 cells changes 0.4 % (measured 0.09305, 0.09341; 0.09350 at 24)
+    assert abs(w16 - w12) < 0.005 * w16
+    # the converged value lies 1.2 % above the published 0.0924 (see docs/physics.md)
+    assert w16 == pytest.approx(0.0924, rel=0.015)
+
+
+def test_shell_bad_input():
+    with pytest.raises(InputError, match="Poisson"):
+        ShellMaterial(1.0, 0.5, 0.1)
+    roof = sd.shapes.tile(cells=4)
+    twisted = sd.shapes.from_function(lambda u, v: np.stack([u, v + 0.3 * u * u, u * v], -1),
+                                      cells=4)
+    with pytest.raises(InputError, match="edge v1 .* spreads"):
+        ShellModel(twisted, ShellMaterial(1.0, 0.3, 0.1), {"v1": "symmetry"})
+    with pytest.raises(InputError, match="kind one of"):
+        ShellModel(roof, ShellMaterial(1.0, 0.3, 0.1), {"u0": "hinged"})
