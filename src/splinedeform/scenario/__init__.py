@@ -17,19 +17,25 @@ Arrays of tables and array elements are counted from 1: ``load[2].force`` is the
 
 Modules, one idea each:
 
-- :mod:`.locate` — the line of every key path in a TOML text, and problems reported there;
-- :mod:`.checks` — value checkers (number, integer, choice, vector, …);
-- :mod:`.keys` — the documented keys of every table: checker, default, meaning;
-- :mod:`.spec` — the validated scenario (one frozen dataclass per table);
-- :mod:`.read` — TOML text → validated :class:`Scenario`, with the cross-field rules;
+- :mod:`.schema` — the scenario as typed pydantic models: every key's type, constraints,
+  default and description, written once; ``splinedeform schema`` prints its JSON Schema;
+- :mod:`.checks` — one key checked with pydantic, and what it allows said in words;
+- :mod:`.keys` — the per-table key lists the reader walks, derived from the models;
+- :mod:`.locate` — the line of every key path in a TOML text, problems reported there;
+- :mod:`.validate` — every key checked, then the cross-field rules of the physics;
+- :mod:`.spec` — the validated scenario (one frozen dataclass per table, used downstream);
+- :mod:`.read` — TOML text (or file) → validated :class:`Scenario`;
 - :mod:`.write` — a scenario back as TOML, every default filled in;
 - :mod:`.build` — scenario → surface, model, load.
 
-Adding a key: declare it in the table of :mod:`.keys` (checker, default, doc line), add
-the field to the dataclass of :mod:`.spec`, document it in ``docs/scenario.md``, and, if it
-only applies to some kinds, list it in the ``*_KIND_KEYS`` of :mod:`.keys`. A new shape is
-one entry of ``SHAPE_PARAMETERS`` (its parameters are passed to ``splinedeform.shapes``);
-a new time integrator is one entry of ``splinedeform.model.METHODS``.
+Adding a key: one field (type, constraints, default, ``description``) on the model of its
+table in :mod:`.schema`; the field of the dataclass in :mod:`.spec` that carries it
+downstream; its row in ``docs/scenario.md``; a cross-field rule in :mod:`.validate` if it
+depends on other keys. A new shape is one model in ``schema.SHAPE_MODELS`` (its fields
+are passed to the function of ``splinedeform.shapes`` of that name), a load or solve kind
+one model in ``LOAD_MODELS`` / ``SOLVE_MODELS``, a time integrator one name in
+``splinedeform.model.METHODS``; a choice between variants (such as a physics model) is a
+``Literal`` field.
 """
 
 from __future__ import annotations

@@ -1,10 +1,21 @@
-"""Value checkers of scenario keys: each returns the normalised value or raises :class:`_Invalid`."""
+"""Checking one key's value with pydantic, and saying in words what the key allows.
+
+Each key's type and constraints are declared once, as a field of the models in
+:mod:`.schema`; :func:`key_of` turns such a field into a :class:`Key` whose checker
+validates with a pydantic ``TypeAdapter`` and, on failure, raises :class:`_Invalid` with
+``expected <allowed>, got <value>``, where ``<allowed>`` is written from the field's JSON
+Schema (:func:`allowed`), e.g. "an integer >= 1 and <= 7" or "an array of 3 numbers
+[fx, fy, fz]".
+"""
 
 from __future__ import annotations
 
-import math
+import types
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Annotated, Any, Callable, Literal, Union, get_args, get_origin
+
+from pydantic import TypeAdapter, ValidationError
+from pydantic.fields import FieldInfo
 
 from .locate import _describe
 
@@ -18,137 +29,6 @@ class _Invalid(Exception):
     def __init__(self, message: str, sub: str = "") -> None:
         super().__init__(message)
         self.sub = sub
-
-
-# -- value checkers: return the normalised value or raise _Invalid -------------------------
-def _is_number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
-
-
-def number(low: float | None = None, high: float | None = None, *, open_low: bool = False,
-           allow_inf: bool = False) -> Callable[[Any], float]:
-    """Checker of a finite real (``inf`` only if allowed) in ``[low, high]`` (``(low`` if open)."""
-    parts = []
-    if low is not None:
-        parts.append(f"{'>' if open_low else '>='} {low:g}")
-    if high is not None:
-        parts.append(f"<= {high:g}")
-    allowed = "a number" + (" " + " and ".join(parts) if parts else "")
-
-    def check(value: Any) -> float:
-        if not _is_number(value):
-            raise _Invalid(f"expected {allowed}, got {_describe(value)}")
-        x = float(value)
-        if math.isnan(x) or (math.isinf(x) and not (allow_inf and x > 0)):
-            raise _Invalid(f"expected {allowed}, got {x}")
-        if low is not None and (x < low or (open_low and x == low)):
-            raise _Invalid(f"expected {allowed}, got {value!r}")
-        if high is not None and x > high:
-            raise _Invalid(f"expected {allowed}, got {value!r}")
-        return x
-    check.allowed = allowed  # type: ignore[attr-defined]
-    return check
-
-
-def integer(low: int | None = None, high: int | None = None) -> Callable[[Any], int]:
-    """Checker of an integer in ``[low, high]``."""
-    bounds = " ".join(([f">= {low}"] if low is not None else [])
-                      + ([f"<= {high}"] if high is not None else []))
-    allowed = "an integer" + (" " + bounds.replace(" <=", " and <=") if bounds else "")
-
-    def check(value: Any) -> int:
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise _Invalid(f"expected {allowed}, got {_describe(value)}")
-        if (low is not None and value < low) or (high is not None and value > high):
-            raise _Invalid(f"expected {allowed}, got {value}")
-        return int(value)
-    check.allowed = allowed  # type: ignore[attr-defined]
-    return check
-
-
-def choice(*options: str) -> Callable[[Any], str]:
-    """Checker of one string among ``options``."""
-    allowed = "one of " + ", ".join(f'"{o}"' for o in options)
-
-    def check(value: Any) -> str:
-        if not isinstance(value, str) or value not in options:
-            raise _Invalid(f"expected {allowed}, got {_describe(value)}")
-        return value
-    check.allowed = allowed  # type: ignore[attr-defined]
-    return check
-
-
-def text(value: Any) -> str:
-    """Checker of a string."""
-    if not isinstance(value, str):
-        raise _Invalid(f"expected a string, got {_describe(value)}")
-    return value
-
-
-text.allowed = "a string"  # type: ignore[attr-defined]
-
-
-def vector(length: int, item: Callable[[Any], Any], name: str) -> Callable[[Any], tuple]:
-    """Checker of an array of exactly ``length`` items, each checked by ``item``."""
-    allowed = f"an array of {length} {getattr(item, 'allowed', 'values')[2:]}s {name}"
-    allowed = allowed.replace("a numbers", "numbers").replace("an integers", "integers")
-
-    def check(value: Any) -> tuple:
-        if not isinstance(value, list) or len(value) != length:
-            raise _Invalid(f"expected {allowed}, got {_describe(value)}")
-        try:
-            return tuple(item(v) for v in value)
-        except _Invalid as exc:
-            raise _Invalid(f"expected {allowed}; {exc}") from None
-    check.allowed = allowed  # type: ignore[attr-defined]
-    return check
-
-
-def scalar_or_pair(item: Callable[[Any], Any], name: str) -> Callable[[Any], tuple]:
-    """Checker of one value for both directions or a pair ``[u, v]``."""
-    pair = vector(2, item, name)
-    pair_allowed = getattr(pair, "allowed", "a pair")
-    allowed = f"{getattr(item, 'allowed', 'a value')} or {pair_allowed}"
-
-    def check(value: Any) -> tuple:
-        if isinstance(value, list):
-            return pair(value)
-        try:
-            v = item(value)
-        except _Invalid:
-            raise _Invalid(f"expected {allowed}, got {_describe(value)}") from None
-        return (v, v)
-    check.allowed = allowed  # type: ignore[attr-defined]
-    return check
-
-
-def one_or_pair(item: Callable[[Any], Any], name: str) -> Callable[[Any], Any]:
-    """Like :func:`scalar_or_pair` but a single value is kept as given (not doubled)."""
-    both = scalar_or_pair(item, name)
-
-    def check(value: Any) -> Any:
-        pair = both(value)
-        return pair if isinstance(value, list) else pair[0]
-    check.allowed = both.allowed  # type: ignore[attr-defined]
-    return check
-
-
-def array_of(item: Callable[[Any], Any], name: str, min_length: int = 0) -> Callable[[Any], tuple]:
-    """Checker of an array (at least ``min_length`` long) of items."""
-    allowed = f"an array of {name}" + (f" (at least {min_length})" if min_length else "")
-
-    def check(value: Any) -> tuple:
-        if not isinstance(value, list) or len(value) < min_length:
-            raise _Invalid(f"expected {allowed}, got {_describe(value)}")
-        out = []
-        for i, v in enumerate(value, start=1):
-            try:
-                out.append(item(v))
-            except _Invalid as exc:
-                raise _Invalid(str(exc), sub=f"[{i}]{exc.sub}") from None
-        return tuple(out)
-    check.allowed = allowed  # type: ignore[attr-defined]
-    return check
 
 
 _REQUIRED = object()
@@ -171,3 +51,97 @@ class Key:
         return getattr(self.check, "allowed", "")
 
 
+def _bound(x: float) -> str:
+    return f"{x:g}"
+
+
+def allowed(schema: dict[str, Any], title: str = "") -> str:
+    """What a JSON Schema allows, in words ("a number > 0", 'one of "a", "b"', …)."""
+    if "anyOf" in schema:
+        return " or ".join(allowed(s, title) for s in schema["anyOf"] if s.get("type") != "null")
+    if "enum" in schema:
+        return "one of " + ", ".join(f'"{o}"' for o in schema["enum"])
+    if "const" in schema:
+        return f'"{schema["const"]}"'
+    kind = schema.get("type")
+    if kind in ("number", "integer"):
+        parts = [f"{op} {_bound(schema[k])}" for k, op in
+                 (("minimum", ">="), ("exclusiveMinimum", ">"), ("maximum", "<="),
+                  ("exclusiveMaximum", "<")) if k in schema]
+        return ("a number" if kind == "number" else "an integer") + \
+            ("" if not parts else " " + " and ".join(parts))
+    if kind == "string":
+        return "a string"
+    if kind == "array" and "prefixItems" in schema:
+        items = schema["prefixItems"]
+        return f"an array of {len(items)} {_plural(allowed(items[0]))}" + \
+            (f" {title}" if title else "")
+    if kind == "array":
+        text = f"an array of {title or _plural(allowed(schema.get('items', {})))}"
+        return text + (f" (at least {schema['minItems']})" if schema.get("minItems") else "")
+    return "a value"
+
+
+def _plural(text: str) -> str:
+    for one, many in (("a number", "numbers"), ("an integer", "integers"),
+                      ("an array", "arrays"), ("a string", "strings"), ("one of", "names among")):
+        if text.startswith(one):
+            return many + text[len(one):]
+    return text
+
+
+def _without_none(annotation: Any) -> Any:
+    if get_origin(annotation) in (Union, types.UnionType):
+        args = tuple(a for a in get_args(annotation) if a is not type(None))
+        return args[0] if len(args) == 1 else Union[args]
+    return annotation
+
+
+def _frozen(value: Any) -> Any:
+    return tuple(_frozen(v) for v in value) if isinstance(value, (list, tuple)) else value
+
+
+def checker(annotation: Any, title: str = "", pair: bool = False) -> Callable[[Any], Any]:
+    """Checker of one value of type ``annotation`` (with its constraints), via pydantic.
+
+    Arrays come back as tuples; with ``pair`` a single value ``x`` becomes ``(x, x)``.
+    """
+    adapter = TypeAdapter(annotation)
+    schema = adapter.json_schema()
+    text = allowed(schema, title)
+    listed = schema.get("type") == "array" and "prefixItems" not in schema
+
+    def check(value: Any) -> Any:
+        try:
+            out = _frozen(adapter.validate_python(value))
+        except ValidationError as exc:
+            loc = exc.errors()[0]["loc"]
+            if listed and isinstance(value, list) and loc and isinstance(loc[0], int):
+                element = value[loc[0]]
+                raise _Invalid(f"expected {allowed(schema['items'])}, got {_describe(element)}",
+                               sub=f"[{loc[0] + 1}]") from None
+            raise _Invalid(f"expected {text}, got {_describe(value)}") from None
+        return (out, out) if pair and not isinstance(out, tuple) else out
+    check.allowed = text  # type: ignore[attr-defined]
+    return check
+
+
+def key_of(field: FieldInfo, default: Any = _REQUIRED, pair: bool = False) -> Key:
+    """The :class:`Key` of a model field: its checker, default and description.
+
+    ``default`` overrides the field's (keys that are required only in some cases have
+    the default None here and a cross-field rule in :mod:`.validate`).
+    """
+    annotation = _without_none(field.annotation)
+    if field.metadata:
+        annotation = Annotated[(annotation, *field.metadata)]
+    if default is _REQUIRED and not field.is_required():
+        default = _frozen(field.get_default(call_default_factory=True))
+        if pair and default is not None and not isinstance(default, tuple):
+            default = (default, default)
+    return Key(checker(annotation, field.title or "", pair), default, field.description or "")
+
+
+def choice(*options: str) -> Callable[[Any], str]:
+    """Checker of one string among ``options`` (a discriminator such as ``shape``)."""
+    return checker(Literal[options])

@@ -1,16 +1,18 @@
-"""The scenario file as typed pydantic models: the source of its JSON Schema.
+"""The scenario file as typed pydantic models: the one declaration of every key.
 
-One model per table; a discriminated union where a key selects the other keys that apply
+Each key's type, constraints, default and description are written here once; the reader
+checks values with them (:mod:`.checks`, :mod:`.keys`) and ``splinedeform schema`` prints
+their JSON Schema. One model per table; a discriminated union where a key selects the other keys that apply
 (``surface.shape``, ``load.kind``, ``solve.kind``). ``splinedeform schema`` prints
 :func:`json_schema`, which editors (taplo, "Even Better TOML") use to complete and check
 scenario files while they are written; ``tests/test_scenario_schema.py`` validates every
-example against it and checks that these models and the reader's keys
-(:mod:`.keys`) agree key for key, default for default.
+example against it. The rules tying keys together (bending needs degree >= 2, t_off > t_on,
+...) live in :mod:`.validate`.
 
 Extending
 ---------
 - a shape: one model with ``shape: Literal["name"]`` and its parameters, added to
-  :data:`SHAPE_MODELS` (and its entry in ``keys.SHAPE_PARAMETERS``);
+  :data:`SHAPE_MODELS`;
 - a solve method: one name in ``splinedeform.model.METHODS`` (the literal below follows it);
 - a load kind / solve kind: one model added to :data:`LOAD_MODELS` / :data:`SOLVE_MODELS`;
 - a key: one field with its type, constraints, default and ``description``.
@@ -25,9 +27,20 @@ from pydantic import BaseModel, ConfigDict, Field, Strict
 
 from ..basis import KNOT_KINDS
 from ..boundary import PRESETS
-from ..model import METHODS
+from ..model import METHODS, STEP_METHODS
 from ..shapes import FIT_METHODS
-from .keys import FORMAT_ALIASES, FORMATS, MASS_MATRICES, PROFILES, TIME_MAX
+
+PROFILES = ("constant", "step", "piecewise", "harmonic")
+IVP_METHODS = ("rk45", "dop853", "radau", "bdf")
+MASS_MATRICES = ("consistent", "lumped")
+FORMATS = ("obj", "stl", "ply", "vtu", "json", "npz", "report", "images", "gif", "mp4",
+           "viewer")
+#: shorthand names accepted in ``output.formats``
+FORMAT_ALIASES = {"pvd": ("vtu",), "nets": ("json", "npz"), "animation": ("gif",),
+                  "all": ("obj", "stl", "ply", "vtu", "json", "npz", "report", "images", "gif",
+                          "viewer")}
+#: latest time a scenario may ask for: beyond it the phase ω t of a vibration keeps no digits
+TIME_MAX = 1e12
 
 Real = Annotated[float, Strict(), Field(allow_inf_nan=False)]
 Positive = Annotated[float, Strict(), Field(gt=0, allow_inf_nan=False)]
@@ -48,11 +61,11 @@ class _Table(BaseModel):
 # -- [surface] ---------------------------------------------------------------------------------
 class _Fitted(_Table):
     cells: Optional[Union[Cells, tuple[Cells, Cells]]] = Field(
-        None, description="knot spans per direction, one or [m_u, m_v] (default: the shape's own)")
+        None, title="[m_u, m_v]", description="knot spans per direction, one or [m_u, m_v] (default: the shape's own)")
     degree: Annotated[int, Strict(), Field(ge=1, le=7)] = Field(
         3, description="polynomial degree of the B-splines")
     knots: Optional[Union[Knots, tuple[Knots, Knots]]] = Field(
-        None, description="knot layout per direction (default: the shape's own)")
+        None, title="[u, v]", description="knot layout per direction (default: the shape's own)")
     method: Literal[FIT_METHODS] = Field(  # type: ignore[valid-type]
         "interpolate", description="how control points are fitted to the shape")
 
@@ -63,7 +76,7 @@ SIZE_DOC = "side lengths [L_u, L_v] (or one for both); the domain is [0, L_u] ×
 
 class Plane(_Fitted):
     shape: Literal["plane"]
-    size: Size = Field(1.0, description=SIZE_DOC)
+    size: Size = Field(1.0, title="[L_u, L_v]", description=SIZE_DOC)
 
 
 class Tile(_Fitted):
@@ -93,7 +106,7 @@ class Torus(_Fitted):
 
 class Saddle(_Fitted):
     shape: Literal["saddle"]
-    size: Size = Field(1.0, description=SIZE_DOC)
+    size: Size = Field(1.0, title="[L_u, L_v]", description=SIZE_DOC)
     height: Real = Field(0.25, description="z = height (ξ² - η²), ξ, η in [-1, 1]")
 
 
@@ -106,6 +119,7 @@ class FromFile(_Fitted):
 
 #: every ``surface.shape``; a new shape is one model here
 SHAPE_MODELS = (Plane, Tile, HalfSphere, Cylinder, Torus, Saddle, FromFile)
+SHAPES = tuple(m.model_fields["shape"].annotation.__args__[0] for m in SHAPE_MODELS)
 Surface = Annotated[Union[SHAPE_MODELS], Field(discriminator="shape")]  # type: ignore[valid-type]
 
 
@@ -124,8 +138,8 @@ class Material(_Table):
 
 
 class FreeRegion(_Table):
-    u: Optional[Pair] = Field(None, description="parameter range [low, high] in u")
-    v: Optional[Pair] = Field(None, description="parameter range [low, high] in v")
+    u: Optional[Pair] = Field(None, title="[low, high]", description="parameter range [low, high] in u")
+    v: Optional[Pair] = Field(None, title="[low, high]", description="parameter range [low, high] in v")
 
 
 class Boundary(_Table):
@@ -144,7 +158,7 @@ class _Profiled(_Table):
     t_on: Time = Field(0.0, description="step: switch-on time")
     t_off: Optional[Annotated[float, Strict(), Field(ge=0)]] = Field(
         None, description="step: switch-off time (default: never, inf)")
-    points: Optional[list[Pair]] = Field(None, min_length=1,
+    points: Optional[list[Pair]] = Field(None, min_length=1, title="[t, s] pairs",
                                          description="piecewise: scale s from time t on, [t, s]")
     omega: Optional[Positive] = Field(None, description="harmonic: angular frequency ω")
     phase: Real = Field(0.0, description="harmonic: phase φ in sin(ωt + φ)")
@@ -152,13 +166,13 @@ class _Profiled(_Table):
 
 class PointLoad(_Profiled):
     kind: Literal["point"]
-    at: Pair = Field(description="parameters [u, v] of the point")
-    force: tuple[Real, Real, Real] = Field(description="force [fx, fy, fz]")
+    at: Pair = Field(title="[u, v]", description="parameters [u, v] of the point")
+    force: tuple[Real, Real, Real] = Field(title="[fx, fy, fz]", description="force")
 
 
 class UniformLoad(_Profiled):
     kind: Literal["uniform"]
-    force: tuple[Real, Real, Real] = Field(description="force per area [fx, fy, fz]")
+    force: tuple[Real, Real, Real] = Field(title="[fx, fy, fz]", description="force per area")
 
 
 class PressureLoad(_Profiled):
@@ -168,6 +182,7 @@ class PressureLoad(_Profiled):
 
 #: every ``load.kind``; a new kind is one model here
 LOAD_MODELS = (PointLoad, UniformLoad, PressureLoad)
+LOAD_KINDS = tuple(m.model_fields["kind"].annotation.__args__[0] for m in LOAD_MODELS)
 Load = Annotated[Union[LOAD_MODELS], Field(discriminator="kind")]  # type: ignore[valid-type]
 
 
@@ -195,29 +210,31 @@ class DynamicSolve(_Table):
     t_end: Optional[Annotated[float, Strict(), Field(gt=0, le=TIME_MAX)]] = Field(
         None, description="end time (required unless times is given)")
     frames: Frames = Field(50, description=FRAMES_DOC + " in [0, t_end]")
-    times: Optional[list[Time]] = Field(None, min_length=1,
+    times: Optional[list[Time]] = Field(None, min_length=1, title="times >= 0",
                                         description="explicit increasing frame times")
     modes: Annotated[int, Strict(), Field(ge=0, le=1000)] = Field(
         6, description="number of vibration modes to report")
     rtol: Annotated[float, Strict(), Field(gt=0, le=1)] = Field(
         1e-8, description="relative tolerance (rk45, dop853, radau, bdf)")
     atol: Positive = Field(1e-10, description="absolute tolerance (rk45, dop853, radau, bdf)")
-    dt: Optional[Positive] = Field(None, description="time step (newmark)")
+    dt: Optional[Positive] = Field(None, description="time step (" + ", ".join(STEP_METHODS)
+                                   + "); default t_end / (20 (frames - 1))")
     function_samples: Annotated[int, Strict(), Field(ge=1, le=100000)] = Field(
         400, description="analytic: samples of a time-dependent load profile")
 
 
 #: every ``solve.kind``
 SOLVE_MODELS = (StaticSolve, ModesSolve, DynamicSolve)
+SOLVE_KINDS = tuple(m.model_fields["kind"].annotation.__args__[0] for m in SOLVE_MODELS)
 Solve = Annotated[Union[SOLVE_MODELS], Field(discriminator="kind")]  # type: ignore[valid-type]
 
 
 class Output(_Table):
     formats: list[Literal[FORMATS + tuple(FORMAT_ALIASES)]] = Field(  # type: ignore[misc]
-        ["report"], description="what to write")
+        ["report"], title="format names", description="what to write")
     resolution: Annotated[int, Strict(), Field(ge=2, le=1024)] = Field(
         32, description="tessellation samples per direction")
-    probes: list[Pair] = Field([], description="[u, v] points whose displacement is reported")
+    probes: list[Pair] = Field([], title="[u, v] pairs", description="[u, v] points whose displacement is reported")
     time: Optional[Time] = Field(None, description="state written as a mesh (dynamic)")
 
 
