@@ -140,3 +140,29 @@ def test_anisotropic_weights_and_unknown_physics_are_refused():
         sd.Model(plane, sd.Material(w10=1, w01=2), physics="intrinsic")
     with pytest.raises(InputError, match="physics must be one of"):
         sd.Model(plane, PLATE, physics="membrane")
+
+
+def test_scenario_selects_the_physics_and_names_a_bad_value():
+    from splinedeform.errors import ScenarioError
+    from splinedeform.scenario import build, parse_scenario
+
+    text = """
+[surface]
+shape = "half_sphere"
+cells = [8, 4]
+[material]
+w10 = 1.0
+w01 = 1.0
+physics = "{physics}"
+[boundary]
+v0 = "clamped"
+[[load]]
+kind = "pressure"
+q = 1.0
+[solve]
+kind = "static"
+"""
+    model = build(parse_scenario(text.format(physics="intrinsic"))).model
+    assert model.physics == "intrinsic"
+    with pytest.raises(ScenarioError, match=r"case\.toml:8: material\.physics: expected one of"):
+        parse_scenario(text.format(physics="shell"), source="case.toml")

@@ -41,6 +41,7 @@ w20 = 0.0
 w11 = 0.0
 w02 = 0.0
 mass_matrix = "lumped"
+physics = "parametric"
 
 [boundary]
 u0 = "clamped"

@@ -179,7 +179,8 @@ def build(scenario: Scenario) -> Built:
         material = Material(**scenario.material.weights())
     with _located(scenario, "boundary"):
         model = Model(surface, material, boundary=scenario.boundary.edges(), fixed=fixed,
-                      mass_matrix=scenario.material.mass_matrix)
+                      mass_matrix=scenario.material.mass_matrix,
+                      physics=scenario.material.physics)
     return Built(surface=surface, model=model, load=build_load(scenario), fixed=fixed)
 
 

@@ -33,6 +33,7 @@ from ..shapes import FIT_METHODS
 PROFILES = ("constant", "step", "piecewise", "harmonic")
 IVP_METHODS = ("rk45", "dop853", "radau", "bdf")
 MASS_MATRICES = ("consistent", "lumped")
+PHYSICS = ("parametric", "intrinsic")
 FORMATS = ("obj", "stl", "ply", "vtu", "json", "npz", "report", "images", "gif", "mp4",
            "viewer")
 #: shorthand names accepted in ``output.formats``
@@ -135,6 +136,9 @@ class Material(_Table):
     w02: NonNegative = Field(0.0, description="bending in v")
     mass_matrix: Literal[MASS_MATRICES] = Field(  # type: ignore[valid-type]
         "consistent", description="consistent or lumped mass")
+    physics: Literal[PHYSICS] = Field(  # type: ignore[valid-type]
+        "parametric", description="energy per parameter area (the paper's) or measured on "
+                                  "the surface (intrinsic)")
 
 
 class FreeRegion(_Table):

@@ -40,9 +40,10 @@ class MaterialSpec:
     w11: float = 0.0
     w02: float = 0.0
     mass_matrix: str = "consistent"
+    physics: str = "parametric"
 
     def weights(self) -> dict[str, float]:
-        return {k: getattr(self, k) for k in MATERIAL_KEYS if k != "mass_matrix"}
+        return {k: getattr(self, k) for k in MATERIAL_KEYS if k not in ("mass_matrix", "physics")}
 
 
 @dataclass(frozen=True)
