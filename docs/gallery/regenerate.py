@@ -77,6 +77,11 @@ def main() -> None:
                      *description(example), "",
                      f"`splinedeform run examples/{example.name} -o out/{example.stem}`", ""]
             print(f"{target.relative_to(ROOT)}: {target.stat().st_size} bytes")
+    sys.path.insert(0, str(GALLERY))
+    import physics_figure
+
+    shrink(physics_figure.main(), GALLERY / "physics_compare.png")
+    page += physics_figure.TEXT
     PAGE.write_text("\n".join(page).rstrip() + "\n", encoding="utf-8")
     shutil.rmtree(GALLERY / "__pycache__", ignore_errors=True)
 
