@@ -112,3 +112,23 @@ def test_the_command_prints_the_schema():
     result = typer_testing.CliRunner().invoke(cli.app, ["schema"])
     assert result.exit_code == 0, result.output
     assert json.loads(result.output) == json.loads(json.dumps(schema_module.json_schema()))
+
+
+def test_the_key_reference_of_the_docs_is_generated_from_the_models():
+    from splinedeform.scenario import reference
+
+    text = (ROOT / "docs" / "scenario.md").read_text(encoding="utf-8")
+    assert sorted(reference.blocks(text)) == sorted(reference.tables())
+    assert reference.update(text) == text, (
+        "docs/scenario.md differs from the models: run "
+        "python -m splinedeform.scenario.reference docs/scenario.md")
+
+
+def test_the_reference_follows_a_changed_description(monkeypatch):
+    from splinedeform.scenario import keys, reference
+
+    text = (ROOT / "docs" / "scenario.md").read_text(encoding="utf-8")
+    changed = dict(keys.MATERIAL_KEYS)
+    changed["mass"] = type(changed["mass"])(changed["mass"].check, 2.0, "heavier")
+    monkeypatch.setattr(reference, "MATERIAL_KEYS", changed)
+    assert "| `material.mass` | a number > 0 | `2.0` | heavier |" in reference.update(text)

@@ -41,6 +41,7 @@ class Key:
     check: Callable[[Any], Any]
     default: Any = _REQUIRED
     doc: str = ""
+    shown_default: str | None = None    # the default as documented, when not the value itself
 
     @property
     def required(self) -> bool:
@@ -139,7 +140,9 @@ def key_of(field: FieldInfo, default: Any = _REQUIRED, pair: bool = False) -> Ke
         default = _frozen(field.get_default(call_default_factory=True))
         if pair and default is not None and not isinstance(default, tuple):
             default = (default, default)
-    return Key(checker(annotation, field.title or "", pair), default, field.description or "")
+    extra = field.json_schema_extra if isinstance(field.json_schema_extra, dict) else {}
+    return Key(checker(annotation, field.title or "", pair), default, field.description or "",
+               extra.get("doc_default"))  # type: ignore[arg-type]
 
 
 def choice(*options: str) -> Callable[[Any], str]:

@@ -24,6 +24,13 @@ def _keys(model: type, names: tuple[str, ...] | None = None, **defaults: object)
             for name in (tuple(fields) if names is None else names)}
 
 
+def _table_value(value: object) -> object:
+    """The free region is checked key by key as a table of its own (FREE_REGION_KEYS)."""
+    return value
+
+
+_table_value.allowed = "an inline table"  # type: ignore[attr-defined]
+
 _FITTED = tuple(S._Fitted.model_fields)
 
 #: parameters of each built-in shape (passed to the function of ``splinedeform.shapes``)
@@ -33,7 +40,8 @@ SHAPE_PARAMETERS: dict[str, dict[str, Key]] = {
     for shape, model in zip(SHAPES, S.SHAPE_MODELS)}
 
 SURFACE_KEYS: dict[str, Key] = {
-    "shape": Key(choice(*SHAPES), doc="built-in shape, or a net / point grid from a file"),
+    "shape": Key(choice(*SHAPES), doc="a built-in shape, or a control net / point grid read "
+                                      "from `path`"),
     **_keys(S.FromFile, (*_FITTED, "path", "frame"), path=None),
 }
 
@@ -43,12 +51,13 @@ FREE_REGION_KEYS: dict[str, Key] = _keys(S.FreeRegion)
 
 BOUNDARY_KEYS: dict[str, Key] = {
     **_keys(S.Boundary, EDGES),
-    "free_region": Key(lambda v: v, None, S.Boundary.model_fields["free_region"].description),
+    "free_region": Key(_table_value, None, S.Boundary.model_fields["free_region"].description),
 }
 
 _PROFILED = tuple(S._Profiled.model_fields)
 LOAD_KEYS: dict[str, Key] = {
-    "kind": Key(choice(*LOAD_KINDS), doc="point force, uniform force per area, or pressure"),
+    "kind": Key(choice(*LOAD_KINDS), doc="a point force, a uniform force per area (gravity-like), a "
+                                          "pressure along the initial normal"),
     **_keys(S.PointLoad, ("at", "force"), at=None, force=None),
     **_keys(S.PressureLoad, ("q",), q=None),
     **_keys(S._Profiled, _PROFILED, t_off=math.inf),
@@ -61,7 +70,8 @@ PROFILE_KEYS = {"constant": (), "step": ("t_on", "t_off"), "piecewise": ("points
                 "harmonic": ("omega", "phase")}
 
 SOLVE_KEYS: dict[str, Key] = {
-    "kind": Key(choice(*SOLVE_KINDS), doc="static equilibrium, free vibration modes, or motion"),
+    "kind": Key(choice(*SOLVE_KINDS), doc="equilibrium `K d = F`, free vibration modes, or the "
+                                           "motion from rest"),
     **_keys(S.DynamicSolve, tuple(n for n in S.DynamicSolve.model_fields if n != "kind")),
 }
 
