@@ -221,3 +221,12 @@ def test_info_reports_a_missing_extra(monkeypatch):
     assert result.exit_code == 0
     row = next(line for line in result.stdout.splitlines() if "pyvista" in line)
     assert "missing" in row
+
+
+def test_physics_option_selects_the_energy_and_names_a_bad_value(scenario, tmp_path):
+    result = runner.invoke(cli.app, ["run", str(scenario), "-o", str(tmp_path / "o"),
+                                     "--physics", "intrinsic", "-q"])
+    assert result.exit_code == 0, result.output
+    result = runner.invoke(cli.app, ["run", str(scenario), "--physics", "shell", "-q"])
+    assert result.exit_code == 2
+    assert "tiny.toml (--physics): material.physics: expected one of" in result.stderr

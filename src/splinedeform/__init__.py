@@ -12,6 +12,8 @@ from .errors import InputError, ScenarioError, SingularSystemError
 from .loads import Constant, Function, Harmonic, Piecewise, Point, Pressure, Step, Uniform
 from .material import Material
 from .model import Model
+from .physics.shell import ShellMaterial
+from .physics.shell_model import AreaForce, ShellModel
 from .solution import Energy, Solution, StaticSolution
 from .surface import Surface
 
@@ -22,7 +24,7 @@ except ImportError:  # pragma: no cover - during development only
 
 __version__ = "0.1.0"
 
-__all__ = ["BSplineBasis", "Constant", "Energy", "Function", "Harmonic", "InputError",
+__all__ = ["AreaForce", "ShellMaterial", "ShellModel", "BSplineBasis", "Constant", "Energy", "Function", "Harmonic", "InputError",
            "Material", "Model", "Piecewise", "Point", "Pressure", "ScenarioError",
            "SingularSystemError", "Solution", "StaticSolution", "Step", "Surface", "Uniform",
            "loads", "shapes", "__version__"]

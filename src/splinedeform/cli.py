@@ -125,6 +125,9 @@ def run_command(scenario: Path = SCENARIO_ARG, outdir: Optional[Path] = OUTDIR_O
                                            "dop853, radau, bdf."),
                 frames: Optional[int] = typer.Option(
                     None, "--frames", help="Override solve.frames (replaces solve.times)."),
+                physics: Optional[str] = typer.Option(
+                    None, "--physics", help="Override material.physics: parametric (the "
+                                            "paper's energy) or intrinsic (on the surface)."),
                 allow_outside_paths: bool = OUTSIDE_OPT,
                 quiet: bool = QUIET_OPT, debug: bool = DEBUG_OPT) -> None:
     """Run a scenario file: build, solve, sample frames and write its outputs."""
@@ -137,6 +140,8 @@ def run_command(scenario: Path = SCENARIO_ARG, outdir: Optional[Path] = OUTDIR_O
         if frames is not None:
             loaded = with_overrides(loaded, {"solve.frames": frames, "solve.times": None},
                                     origin="--frames")
+        if physics is not None:
+            loaded = with_overrides(loaded, {"material.physics": physics}, origin="--physics")
         _run(loaded, outdir or Path(f"{loaded.name}-output"), quiet)
 
 

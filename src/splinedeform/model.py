@@ -106,6 +106,10 @@ class Model:
             raise InputError(f"mass_matrix must be 'consistent' or 'lumped', got {mass_matrix!r}")
         if rest not in ("initial", "none"):
             raise InputError(f"rest must be 'initial' or 'none', got {rest!r}")
+        if physics == "shell":
+            raise InputError("physics 'shell' couples x, y and z and has its own material: use "
+                             "splinedeform.ShellModel(surface, ShellMaterial(E, nu, thickness, "
+                             "density), boundary)")
         if physics not in PHYSICS:
             raise InputError(f"physics must be one of {PHYSICS}, got {physics!r}")
         for name, basis, weight in (("u", surface.basis_u, material.w20),
