@@ -184,3 +184,16 @@ def test_fastest_of_a_row_is_the_quickest_finished_run():
             bench.Row("clamped", 8, 10, "radau7", "ok", 1.0),
             bench.Row("clamped", 8, 10, "genalpha", "over budget", 0.5)]
     assert bench.fastest(rows).solver == "radau7"
+
+
+def test_goal_regimes_run_and_report_their_settings():
+    from splinedeform import bench_goals
+
+    lines = []
+    result = bench_goals.goals(say=lines.append, quick=True)
+    assert "threads" in result["threads"] and lines[0] == result["threads"]
+    for key in ("light", "load_case", "single"):
+        r = result[key]
+        assert r["radau7"]["status"] == "ok" and r["radau7"]["error"] <= 1e-4
+        assert math.isclose(r["ratio"], r["radau7"]["seconds"] / r["analytic_s"], rel_tol=1e-12)
+    assert {h["name"] for h in result["horizons"]} == {"light", "plate"}

@@ -247,9 +247,11 @@ def _register_bench() -> None:
                                                   help="Output folder."),
                       quiet: bool = QUIET_OPT, debug: bool = DEBUG_OPT) -> None:
         """Cost study: analytic against numerical solvers, cost against net size."""
-        from . import bench
+        from . import bench, bench_goals
 
-        with _reported_errors(debug):
+        with _reported_errors(debug), bench_goals.blas_threads(1) as threads:
+            if not quiet:
+                typer.echo(threads)
             parsed = None
             if sizes is not None:
                 try:
