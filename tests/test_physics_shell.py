@@ -82,3 +82,22 @@ def test_shell_bad_input():
         ShellModel(twisted, ShellMaterial(1.0, 0.3, 0.1), {"v1": "symmetry"})
     with pytest.raises(InputError, match="kind one of"):
         ShellModel(roof, ShellMaterial(1.0, 0.3, 0.1), {"u0": "hinged"})
+
+
+def test_dynamic_step_load_settles_on_the_static_answer_and_averages_to_it():
+    # Independent reference: the sparse direct static solve. Damped with c = 2ω₁ (critical
+    # for the first mode, faster decay for the others) the motion has settled at t = 40/ω₁:
+    # (1 + ω₁t) exp(-ω₁t) ≈ 2e-16, so the tolerance is the modal round-off (1e-8).
+    # Undamped, each mode's step response (1 - cos ωt) g/λ averages to the static one over
+    # many periods (5 % covers the unfinished last period of the slowest mode).
+    plate = sd.shapes.plane(cells=6)
+    model = ShellModel(plate, ShellMaterial(1e4, 0.3, 0.01), {e: "pinned" for e in ALL})
+    load = sd.loads.Point(0.5, 0.5, (0, 0, -1.0))
+    static = model.static(load)
+    omega1 = model.frequencies(1)[0]
+    settled = model.dynamic(load, [40 / omega1], damping=2 * omega1)[0]
+    np.testing.assert_allclose(settled, static, atol=1e-8 * np.abs(static).max())
+    # the step response of every mode is (1 - cos ω t) g/λ: its time average is the static one
+    t = np.linspace(0, 200 / omega1, 4001)[1:]
+    mean = model.dynamic(load, t).mean(axis=0)
+    assert np.abs(mean - static).max() < 0.05 * np.abs(static).max()

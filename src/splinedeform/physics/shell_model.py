@@ -27,8 +27,9 @@ import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError, SingularSystemError
-from ..loads import Constant, Load, Profile, as_load
+from ..loads import Constant, Harmonic, Load, Profile, as_load
 from ..solvers import modal_basis
+from ..solvers.analytic import ModalResponse
 from ..surface import Surface
 from . import metric
 from .shell import ShellMaterial, matrices
@@ -184,3 +185,42 @@ class ShellModel:
         """Lowest ``k`` angular frequencies ``ω = √λ`` of ``K_r φ = λ M_r φ`` (rigid ones 0)."""
         basis = modal_basis.sparse_basis(self._K, self._M, k, None, self.rigid.shape[1] > 0)
         return np.sqrt(basis.lam[:k])
+
+    def dynamic(self, load: Load | None, times: ArrayLike, damping: float = 0.0,
+                modes: int | None = None) -> Array:
+        """Control net displacements ``(F, n_u, n_v, 3)`` at ``times``, from rest, in closed form.
+
+        ``M_r d'' + C_r d' + K_r d = Tᵀ F(t)`` with ``C_r = damping · M_r`` (modal damping
+        ``c_i = damping``), solved mode by mode (:class:`~splinedeform.solvers.analytic.ModalResponse`)
+        for piecewise-constant and harmonic load profiles. All modes by dense ``eigh`` or,
+        with ``modes=k``, the lowest ``k`` by sparse Lanczos (no static correction).
+        """
+        damping = float(damping)
+        if not np.isfinite(damping) or damping < 0:
+            raise InputError(f"shell damping must be finite and >= 0, got {damping!r}")
+        if modes is None:
+            basis = modal_basis.dense_basis(self._K, self._M)
+        else:
+            basis = modal_basis.sparse_basis(self._K, self._M, int(modes), None,
+                                             self.rigid.shape[1] > 0)
+        jumps, harmonics = [], []
+        for term in as_load(load).terms():
+            if term.time_dependent_field:
+                raise InputError("the shell's dynamic solve takes loads whose spatial field "
+                                 "does not change with time")
+            g = basis.project(np.asarray(self.T.T @ term.field_vector(self.surface).ravel()))
+            if isinstance(term.profile, Harmonic):
+                harmonics.append((term.profile.omega, term.profile.phase, g[:, None]))
+                continue
+            steps = term.profile.jumps()
+            if steps is None:
+                raise InputError(f"load profile {type(term.profile).__name__} is neither "
+                                 "piecewise constant nor harmonic")
+            jumps += [(t_j, ds * g[:, None]) for t_j, ds in steps]
+        n = basis.lam.size
+        response = ModalResponse(basis.lam, np.full(n, damping), np.zeros((n, 1)),
+                                 np.zeros((n, 1)), jumps, harmonics)
+        Q, _ = response(np.asarray(times, dtype=float).ravel())
+        d = np.einsum("ij,fj->fi", basis.phi, Q[..., 0])
+        full = np.asarray(self.T @ d.T).T
+        return full.reshape((-1,) + self.surface.shape + (3,))
