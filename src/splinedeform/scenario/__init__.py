@@ -43,8 +43,8 @@ from __future__ import annotations
 from .build import Built, _located, build, build_load, build_surface, describe, free_region_mask
 from .checks import Key
 from .keys import (FORMAT_ALIASES, FORMATS, IVP_METHODS, LOAD_KIND_KEYS, LOAD_KINDS,
-                   MASS_MATRICES, PROFILE_KEYS, PROFILES, SHAPE_PARAMETERS, SHAPES, SOLVE_KIND_KEYS,
-                   SOLVE_KINDS, TABLES, TOP_KEYS, documented_keys)
+                   MASS_MATRICES, PROFILE_KEYS, PROFILES, SHAPE_PARAMETERS, SHAPES,
+                   SOLVE_KIND_KEYS, SOLVE_KINDS, TABLES, TOP_KEYS, documented_keys)
 from .locate import key_lines
 from .read import load_scenario, parse_scenario, with_overrides
 from .spec import (BoundarySpec, LoadSpec, MaterialSpec, OutputSpec, Scenario, SolveSpec,

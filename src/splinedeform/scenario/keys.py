@@ -56,8 +56,8 @@ BOUNDARY_KEYS: dict[str, Key] = {
 
 _PROFILED = tuple(S._Profiled.model_fields)
 LOAD_KEYS: dict[str, Key] = {
-    "kind": Key(choice(*LOAD_KINDS), doc="a point force, a uniform force per area (gravity-like), a "
-                                          "pressure along the initial normal"),
+    "kind": Key(choice(*LOAD_KINDS), doc="a point force, a uniform force per area "
+                                          "(gravity-like), a pressure along the initial normal"),
     **_keys(S.PointLoad, ("at", "force"), at=None, force=None),
     **_keys(S.PressureLoad, ("q",), q=None),
     **_keys(S._Profiled, _PROFILED, t_off=math.inf),

@@ -1,9 +1,10 @@
 """The scenario file as typed pydantic models: the one declaration of every key.
 
 Each key's type, constraints, default and description are written here once; the reader
-checks values with them (:mod:`.checks`, :mod:`.keys`) and ``splinedeform schema`` prints
-their JSON Schema. One model per table; a discriminated union where a key selects the other keys that apply
-(``surface.shape``, ``load.kind``, ``solve.kind``). ``splinedeform schema`` prints
+checks values with them (:mod:`.checks`, :mod:`.keys`), ``docs/scenario.md``'s key
+reference is written from them (:mod:`.reference`) and ``splinedeform schema`` prints their
+JSON Schema. One model per table; a discriminated union where a key selects the other keys
+that apply (``surface.shape``, ``load.kind``, ``solve.kind``). ``splinedeform schema`` prints
 :func:`json_schema`, which editors (taplo, "Even Better TOML") use to complete and check
 scenario files while they are written; ``tests/test_scenario_schema.py`` validates every
 example against it. The rules tying keys together (bending needs degree >= 2, t_off > t_on,
@@ -62,19 +63,21 @@ class _Table(BaseModel):
 # -- [surface] ---------------------------------------------------------------------------------
 class _Fitted(_Table):
     cells: Optional[Union[Cells, tuple[Cells, Cells]]] = Field(
-        None, title="[m_u, m_v]", description=("knot spans per direction (the net has `cells + degree` control points per "
-        "open/uniform direction, `cells` per periodic one)"),
+        None, title="[m_u, m_v]", description=(
+            "knot spans per direction (the net has `cells + degree` control points per "
+            "open/uniform direction, `cells` per periodic one)"),
         json_schema_extra={"doc_default": "the shape's own (see below)"})
     degree: Annotated[int, Strict(), Field(ge=1, le=7)] = Field(
         3, description="polynomial degree of the B-splines (bending weights need ≥ 2)")
     knots: Optional[Union[Knots, tuple[Knots, Knots]]] = Field(
-        None, title="[u, v]", description=("knot layout per direction, one for both or [u, v]; closed shapes are periodic "
-        "around"),
+        None, title="[u, v]", description=(
+            "knot layout per direction, one for both or [u, v]; closed shapes are periodic "
+            "around"),
         json_schema_extra={"doc_default": "the shape's own"})
     method: Literal[FIT_METHODS] = Field(  # type: ignore[valid-type]
-        "interpolate", description=("how control points are fitted to the shape (collocation at Greville points, L2"
-        " projection, local quasi-interpolant); a point grid allows `interpolate` and "
-        "`l2`"))
+        "interpolate", description=(
+            "how control points are fitted to the shape (collocation at Greville points, L2 "
+            "projection, local quasi-interpolant); a point grid allows `interpolate` and `l2`"))
 
 
 Size = Union[Positive, tuple[Positive, Positive]]
@@ -83,7 +86,8 @@ SIZE_DOC = "side lengths [L_u, L_v] (or one for both); the domain is [0, L_u] ×
 
 class Plane(_Fitted):
     shape: Literal["plane"]
-    size: Size = Field(1.0, title="[L_u, L_v]", description="side lengths; the domain is `[0, L_u] × [0, L_v]`")
+    size: Size = Field(1.0, title="[L_u, L_v]", description=(
+            "side lengths; the domain is `[0, L_u] × [0, L_v]`"))
 
 
 class Tile(_Fitted):
@@ -114,19 +118,23 @@ class Torus(_Fitted):
 
 class Saddle(_Fitted):
     shape: Literal["saddle"]
-    size: Size = Field(1.0, title="[L_u, L_v]", description="side lengths; the domain is `[0, L_u] × [0, L_v]`")
-    height: Real = Field(0.25, description="`z = height (ξ² − η²)` with `ξ = 2u/L_u − 1`, `η = 2v/L_v − 1`")
+    size: Size = Field(1.0, title="[L_u, L_v]", description=(
+            "side lengths; the domain is `[0, L_u] × [0, L_v]`"))
+    height: Real = Field(0.25, description=(
+            "`z = height (ξ² − η²)` with `ξ = 2u/L_u − 1`, `η = 2v/L_v − 1`"))
 
 
 class FromFile(_Fitted):
     shape: Literal["file"]
     path: Text = Field(
-        description=("`.json` / `.npz` control net written by `splinedeform` (`output.formats` "
-        "`json`/`npz`), or a point grid `(N_u, N_v, 3)` in `.npy` (or `.npz` with one "
-        "array or an array `points`); relative to the scenario file, and inside its "
-        "folder (see below)"),
+        description=(
+            "`.json` / `.npz` control net written by `splinedeform` (`output.formats` "
+            "`json`/`npz`), or a point grid `(N_u, N_v, 3)` in `.npy` (or `.npz` with one array "
+            "or an array `points`); relative to the scenario file, and inside its folder (see "
+            "below)"),
         json_schema_extra={"doc_default": "required for `file`"})
-    frame: Integer = Field(-1, description="which frame of a control net file (negative counts from the end)")
+    frame: Integer = Field(-1, description=(
+            "which frame of a control net file (negative counts from the end)"))
 
 
 #: every ``surface.shape``; a new shape is one model here
@@ -138,12 +146,15 @@ Surface = Annotated[Union[SHAPE_MODELS], Field(discriminator="shape")]  # type: 
 # -- [material], [boundary] --------------------------------------------------------------------
 class Material(_Table):
     mass: Positive = Field(1.0, description="mass per unit parameter area μ")
-    damping: NonNegative = Field(0.0, description="viscous damping γ; mode i is critically damped at `γ/μ = 2 ω_i`")
-    rayleigh: NonNegative = Field(0.0, description="stiffness-proportional damping β; modal damping `c_i = γ/μ + β ω_i²`")
+    damping: NonNegative = Field(0.0, description=(
+            "viscous damping γ; mode i is critically damped at `γ/μ = 2 ω_i`"))
+    rayleigh: NonNegative = Field(0.0, description=(
+            "stiffness-proportional damping β; modal damping `c_i = γ/μ + β ω_i²`"))
     w10: NonNegative = Field(0.0, description="tension in u")
     w01: NonNegative = Field(0.0, description="tension in v")
     w20: NonNegative = Field(0.0, description="bending in u")
-    w11: NonNegative = Field(0.0, description="twist (mixed bending); `w20 = w11 = w02 = D` is a Kirchhoff plate")
+    w11: NonNegative = Field(0.0, description=(
+            "twist (mixed bending); `w20 = w11 = w02 = D` is a Kirchhoff plate"))
     w02: NonNegative = Field(0.0, description="bending in v")
     mass_matrix: Literal[MASS_MATRICES] = Field(  # type: ignore[valid-type]
         "consistent", description="Galerkin mass `μ G0⊗G0`, or its row sums on the diagonal "
@@ -155,36 +166,42 @@ class Material(_Table):
 
 
 class FreeRegion(_Table):
-    u: Optional[Pair] = Field(None, title="[low, high]", description="u range of the box, low < high",
+    u: Optional[Pair] = Field(None, title="[low, high]", description=(
+            "u range of the box, low < high"),
         json_schema_extra={"doc_default": 'whole range'})
-    v: Optional[Pair] = Field(None, title="[low, high]", description="v range of the box, low < high",
+    v: Optional[Pair] = Field(None, title="[low, high]", description=(
+            "v range of the box, low < high"),
         json_schema_extra={"doc_default": 'whole range'})
 
 
 class Boundary(_Table):
-    u0: Preset = Field("free", description=("edge `u = 0`: pinned holds it (`d = 0`), clamped also holds its slope (`∂n d ="
-        " 0`), pole makes a collapsed edge (open knots) move as one point"))
+    u0: Preset = Field("free", description=(
+            "edge `u = 0`: pinned holds it (`d = 0`), clamped also holds its slope (`∂n d = 0`), "
+            "pole makes a collapsed edge (open knots) move as one point"))
     u1: Preset = Field("free", description="edge `u = L_u` (presets as `u0`)")
     v0: Preset = Field("free", description="edge `v = 0` (presets as `u0`)")
     v1: Preset = Field("free", description="edge `v = L_v` (presets as `u0`)")
     free_region: Optional[FreeRegion] = Field(
-        None, description=("inline table `{ u = [a, b], v = [c, d] }`: only control points whose Greville "
-        "abscissae lie in this box move; all others are fixed at rest (the paper's "
-        "reduced set of moving control points)"),
+        None, description=(
+            "inline table `{ u = [a, b], v = [c, d] }`: only control points whose Greville "
+            "abscissae lie in this box move; all others are fixed at rest (the paper's reduced set"
+            " of moving control points)"),
         json_schema_extra={"doc_default": 'none (all move)'})
 
 
 # -- [[load]] ----------------------------------------------------------------------------------
 class _Profiled(_Table):
     profile: Literal[PROFILES] = Field(  # type: ignore[valid-type]
-        "constant", description="time profile s(t) multiplying the load; `constant` is 1 for all t ≥ 0")
+        "constant", description=(
+            "time profile s(t) multiplying the load; `constant` is 1 for all t ≥ 0"))
     t_on: Time = Field(0.0, description="`step`: s = 1 from `t_on` …")
     t_off: Optional[Annotated[float, Strict(), Field(ge=0)]] = Field(
         None, description="`step`: … until `t_off` (> `t_on`, or `inf`), then 0",
         json_schema_extra={"doc_default": 'inf'})
     points: Optional[list[Pair]] = Field(None, min_length=1, title="[t, s] pairs",
-                                         description=("`piecewise`: [t, s] pairs, t ≥ 0 increasing; s is the value of the last point "
-        "with `t_i ≤ t` (0 before the first)"),
+                                         description=(
+            "`piecewise`: [t, s] pairs, t ≥ 0 increasing; s is the value of the last point with "
+            "`t_i ≤ t` (0 before the first)"),
         json_schema_extra={"doc_default": 'required for `piecewise`'})
     omega: Optional[Positive] = Field(None, description="`harmonic`: `s = sin(ω t + φ)`",
         json_schema_extra={"doc_default": 'required for `harmonic`'})
@@ -195,20 +212,23 @@ class PointLoad(_Profiled):
     kind: Literal["point"]
     at: Pair = Field(title="[u, v]", description="where a point force acts",
         json_schema_extra={"doc_default": 'required for `point`'})
-    force: tuple[Real, Real, Real] = Field(title="[fx, fy, fz]", description="the force (point) or force per parameter area (uniform)",
+    force: tuple[Real, Real, Real] = Field(title="[fx, fy, fz]", description=(
+            "the force (point) or force per parameter area (uniform)"),
         json_schema_extra={"doc_default": 'required for `point`, `uniform`'})
 
 
 class UniformLoad(_Profiled):
     kind: Literal["uniform"]
-    force: tuple[Real, Real, Real] = Field(title="[fx, fy, fz]", description="the force (point) or force per parameter area (uniform)",
+    force: tuple[Real, Real, Real] = Field(title="[fx, fy, fz]", description=(
+            "the force (point) or force per parameter area (uniform)"),
         json_schema_extra={"doc_default": 'required for `point`, `uniform`'})
 
 
 class PressureLoad(_Profiled):
     kind: Literal["pressure"]
-    q: Real = Field(description=("pressure; the force density is `q x0_u × x0_v`, so a positive `q` pushes along"
-        " the normal `x_u × x_v`"),
+    q: Real = Field(description=(
+            "pressure; the force density is `q x0_u × x0_v`, so a positive `q` pushes along the "
+            "normal `x_u × x_v`"),
         json_schema_extra={"doc_default": 'required for `pressure`'})
 
 
@@ -238,15 +258,18 @@ class ModesSolve(_Table):
 class DynamicSolve(_Table):
     kind: Literal["dynamic"]
     method: Literal[METHODS] = Field(  # type: ignore[valid-type]
-        "analytic", description="dynamic: the closed-form modal solution, or a numerical reference integrator")
+        "analytic", description=(
+            "dynamic: the closed-form modal solution, or a numerical reference integrator"))
     t_end: Optional[Annotated[float, Strict(), Field(gt=0, le=TIME_MAX)]] = Field(
         None, description="end time",
         json_schema_extra={"doc_default": 'required for dynamic (or from `times`)'})
-    frames: Frames = Field(50, description=("number of frames: equally spaced times in `[0, t_end]` (dynamic), load factors"
-        " in `[0, 1]` (static: `λ d`, the problem is linear), phases over one period of"
-        " the lowest mode (modes)"))
+    frames: Frames = Field(50, description=(
+            "number of frames: equally spaced times in `[0, t_end]` (dynamic), load factors in "
+            "`[0, 1]` (static: `λ d`, the problem is linear), phases over one period of the lowest"
+            " mode (modes)"))
     times: Optional[list[Time]] = Field(None, min_length=1, title="times >= 0",
-                                        description="dynamic: explicit increasing frame times instead of `frames`")
+                                        description=(
+            "dynamic: explicit increasing frame times instead of `frames`"))
     modes: Annotated[int, Strict(), Field(ge=0, le=1000)] = Field(
         6, description="number of lowest vibration modes reported (`modes.png`, report); 0 "
                        "skips them in a dynamic solve")
@@ -256,10 +279,11 @@ class DynamicSolve(_Table):
         1e-10, description="`rk45`, `dop853`, `radau`, `bdf`: absolute tolerance")
     dt: Optional[Positive] = Field(
         None, description=", ".join(f"`{m}`" for m in STEP_METHODS) + ": largest time step",
-        json_schema_extra={"doc_default": "`t_end / (20 (frames - 1))`; Radau: one step per frame"})
+        json_schema_extra={
+            "doc_default": "`t_end / (20 (frames - 1))`; Radau: one step per frame"})
     function_samples: Annotated[int, Strict(), Field(ge=1, le=100000)] = Field(
-        400, description=("`analytic`: samples of a time-dependent load profile (applied piecewise "
-        "constant)"))
+        400, description=(
+            "`analytic`: samples of a time-dependent load profile (applied piecewise constant)"))
 
 
 #: every ``solve.kind``
@@ -270,10 +294,13 @@ Solve = Annotated[Union[SOLVE_MODELS], Field(discriminator="kind")]  # type: ign
 
 class Output(_Table):
     formats: list[Literal[FORMATS + tuple(FORMAT_ALIASES)]] = Field(  # type: ignore[misc]
-        ["report"], title="format names", description="files to write in the output folder (names below)")
+        ["report"], title="format names", description=(
+            "files to write in the output folder (names below)"))
     resolution: Annotated[int, Strict(), Field(ge=2, le=1024)] = Field(
-        32, description="tessellation samples per direction for meshes, pictures, animation, viewer")
-    probes: list[Pair] = Field([], title="[u, v] pairs", description="points whose displacement is reported (`report`) and plotted (`probes.png`)",
+        32, description=(
+            "tessellation samples per direction for meshes, pictures, animation, viewer"))
+    probes: list[Pair] = Field([], title="[u, v] pairs", description=(
+            "points whose displacement is reported (`report`) and plotted (`probes.png`)"),
         json_schema_extra={"doc_default": 'the domain centre'})
     time: Optional[Time] = Field(None, description="dynamic: the state written as OBJ / STL / PLY",
         json_schema_extra={"doc_default": 'the last frame'})
