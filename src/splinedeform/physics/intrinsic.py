@@ -47,13 +47,6 @@ def coefficients(material: Material) -> tuple[float, float]:
     return m.w10, m.w20
 
 
-def _assemble(index: NDArray[np.int64], blocks: Array, size: int) -> sp.csr_matrix:
-    rows = np.broadcast_to(index[..., :, None], blocks.shape).ravel()
-    cols = np.broadcast_to(index[..., None, :], blocks.shape).ravel()
-    A = sp.coo_matrix((blocks.ravel(), (rows, cols)), shape=(size, size)).tocsr()
-    return ((A + A.T) * 0.5).tocsr()
-
-
 def laplace_beltrami(G: metric.Grid, N: dict[tuple[int, int], Array]) -> Array:
     """``Δ_S N_k = g^αβ (N_k,αβ − Γ^γ_αβ N_k,γ)`` at every grid point, ``(Qu, Qv, pu·pv)``."""
     gi = G.g_inv
@@ -90,7 +83,7 @@ def matrices(surface: Surface, material: Material, lumped: bool = False
         L = laplace_beltrami(G, N)
         K += (D * dA)[..., None, None] * L[..., :, None] * L[..., None, :]
     M = (material.mass * dA)[..., None, None] * N[0, 0][..., :, None] * N[0, 0][..., None, :]
-    K_full, M_full = _assemble(index, K, size), _assemble(index, M, size)
+    K_full, M_full = metric.assemble(index, K, size), metric.assemble(index, M, size)
     if lumped:
         M_full = sp.diags(np.asarray(M_full.sum(axis=1)).ravel(), format="csr")
     return K_full, M_full

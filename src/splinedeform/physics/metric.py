@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from ..errors import InputError
@@ -122,3 +123,14 @@ def global_index(G: Grid, n_v: int) -> NDArray[np.int64]:
     """Flat control point index ``k n_v + l`` of each local function, ``(Qu, Qv, pu·pv)``."""
     idx = G.index_u[:, None, :, None] * n_v + G.index_v[None, :, None, :]
     return idx.reshape(idx.shape[0], idx.shape[1], -1)
+
+
+def assemble(index: NDArray[np.int64], blocks: Array, size: int) -> sp.csr_matrix:
+    """Sum per-point dense blocks ``blocks[..., k, l]`` into a symmetric sparse ``size²`` matrix.
+
+    ``index[..., k]`` is the global unknown of local ``k``; duplicates add (COO → CSR).
+    """
+    rows = np.broadcast_to(index[..., :, None], blocks.shape).ravel()
+    cols = np.broadcast_to(index[..., None, :], blocks.shape).ravel()
+    A = sp.coo_matrix((blocks.ravel(), (rows, cols)), shape=(size, size)).tocsr()
+    return ((A + A.T) * 0.5).tocsr()

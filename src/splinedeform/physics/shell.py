@@ -119,11 +119,4 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
          + np.einsum("abik,abij,abjl->abkl", Bb, bending, Bb, optimize=True))
     mass = (material.density * t * dA)[..., None, None] * N[0, 0][..., :, None] * N[0, 0][..., None, :]
     M = np.einsum("abkl,cd->abkcld", mass, np.eye(3)).reshape(K.shape)
-    return _assemble(dofs, K, size), _assemble(dofs, M, size)
-
-
-def _assemble(index: NDArray[np.int64], blocks: Array, size: int) -> sp.csr_matrix:
-    rows = np.broadcast_to(index[..., :, None], blocks.shape).ravel()
-    cols = np.broadcast_to(index[..., None, :], blocks.shape).ravel()
-    A = sp.coo_matrix((blocks.ravel(), (rows, cols)), shape=(size, size)).tocsr()
-    return ((A + A.T) * 0.5).tocsr()
+    return metric.assemble(dofs, K, size), metric.assemble(dofs, M, size)

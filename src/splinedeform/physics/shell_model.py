@@ -27,7 +27,7 @@ import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError, SingularSystemError
-from ..loads import Constant, Harmonic, Load, Profile, as_load
+from ..loads import Constant, Harmonic, Load, Profile, _profile, _vector3, as_load
 from ..solvers import modal_basis
 from ..solvers.analytic import ModalResponse
 from ..surface import Surface
@@ -45,6 +45,10 @@ class AreaForce(Load):
 
     force: ArrayLike = (0.0, 0.0, 0.0)
     profile: Profile = field(default_factory=Constant)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "force", _vector3(self.force, "AreaForce.force"))
+        object.__setattr__(self, "profile", _profile(self.profile))
 
     def field_vector(self, surface: Surface, t: float = 0.0) -> Array:
         G = metric.grid(surface, extra_points=1)
