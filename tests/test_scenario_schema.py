@@ -132,3 +132,17 @@ def test_the_reference_follows_a_changed_description(monkeypatch):
     changed["mass"] = type(changed["mass"])(changed["mass"].check, 2.0, "heavier")
     monkeypatch.setattr(reference, "MATERIAL_KEYS", changed)
     assert "| `material.mass` | a number > 0 | `2.0` | heavier |" in reference.update(text)
+
+
+def test_the_editor_example_of_the_docs_is_a_valid_scenario(validator):
+    import re
+
+    from splinedeform.scenario import parse_scenario
+
+    text = (ROOT / "docs" / "scenario.md").read_text(encoding="utf-8")
+    blocks = [b for b in re.findall(r"```toml\n(.*?)```", text, re.S) if "#:schema" in b]
+    assert blocks, "docs/scenario.md shows no #:schema line"
+    for block in blocks:
+        assert block.startswith("#:schema ")          # taplo reads it on the first line only
+        assert not list(validator.iter_errors(tomllib.loads(block)))
+        assert parse_scenario(block).solve.kind == "modes"
