@@ -1,0 +1,5 @@
+"""Interactive sculpting: a modal basis sent once, pushes superposed in closed form."""
+
+from .modal import Push, SculptBasis, sculpt_basis
+
+__all__ = ["Push", "SculptBasis", "sculpt_basis"]
