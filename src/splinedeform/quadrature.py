@@ -1,6 +1,6 @@
 """Exact one-dimensional Gram matrices of a B-spline basis.
 
-``(G_a)_{kl} = ∫_0^L D^a b_k(x) · D^a b_l(x) dx`` for ``a = 0, 1, 2`` (any ``a <= n``).
+``(G_a)_{kl} = ∫ D^a b_k(x) · D^a b_l(x) dx`` for ``a = 0, 1, 2`` (any ``a <= n``).
 The integrand is a polynomial of degree ``2(n - a) <= 2n`` on every knot span, so
 Gauss–Legendre with ``n + 1`` points per span integrates it exactly (up to round-off).
 """
@@ -13,15 +13,19 @@ from numpy.typing import NDArray
 
 from .basis import BSplineBasis
 from .errors import InputError
+from .knots import KnotVectorBasis
+
+Basis = BSplineBasis | KnotVectorBasis
 
 
-def gauss_points(basis: BSplineBasis, points_per_cell: int | None = None
+def gauss_points(basis: Basis, points_per_cell: int | None = None
                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Gauss–Legendre points and weights on every cell of ``basis``.
 
     Parameters
     ----------
-    basis : BSplineBasis
+    basis : BSplineBasis or KnotVectorBasis
+        For a general knot vector the cells are its non-empty knot spans.
     points_per_cell : int, optional
         Defaults to ``n + 1``, exact for polynomials of degree ``2n + 1`` per cell.
 
@@ -31,6 +35,11 @@ def gauss_points(basis: BSplineBasis, points_per_cell: int | None = None
     """
     q = basis.degree + 1 if points_per_cell is None else int(points_per_cell)
     ref_x, ref_w = np.polynomial.legendre.leggauss(q)
+    if isinstance(basis, KnotVectorBasis):
+        # general knot vector: one Gauss–Legendre rule per non-empty knot span
+        left, width = basis.breaks[:-1, None], np.diff(basis.breaks)[:, None]
+        x = left + 0.5 * width * (ref_x + 1.0)
+        return x.ravel(), (0.5 * width * ref_w).ravel()
     h = basis.h
     left = np.arange(basis.cells)[:, None] * h
     x = left + 0.5 * h * (ref_x + 1.0)
@@ -38,7 +47,7 @@ def gauss_points(basis: BSplineBasis, points_per_cell: int | None = None
     return x.ravel(), w.ravel().copy()
 
 
-def weighted_products(basis: BSplineBasis, x: NDArray[np.float64], w: NDArray[np.float64],
+def weighted_products(basis: Basis, x: NDArray[np.float64], w: NDArray[np.float64],
                       order_left: int, order_right: int) -> sp.csr_matrix:
     """Sparse ``Σ_q w_q D^{a} b_k(x_q) D^{c} b_l(x_q)`` with ``a = order_left``, ``c = order_right``.
 
@@ -54,7 +63,7 @@ def weighted_products(basis: BSplineBasis, x: NDArray[np.float64], w: NDArray[np
     return sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(basis.size, basis.size))
 
 
-def gram_matrix(basis: BSplineBasis, order: int) -> sp.csr_matrix:
+def gram_matrix(basis: Basis, order: int) -> sp.csr_matrix:
     """Exact Gram matrix ``(G_a)_{kl} = ∫_0^L D^a b_k D^a b_l dx`` (sparse, banded, symmetric).
 
     Parameters
@@ -78,7 +87,7 @@ def gram_matrix(basis: BSplineBasis, order: int) -> sp.csr_matrix:
     return ((G + G.T) * 0.5).tocsr()
 
 
-def integrals(basis: BSplineBasis) -> NDArray[np.float64]:
+def integrals(basis: Basis) -> NDArray[np.float64]:
     """``∫_0^L b_k dx`` for every basis function (exact)."""
     x, w = gauss_points(basis)
     index, values = basis.nonzero(x)

@@ -1,0 +1,144 @@
+"""B-spline bases over a general (non-uniform, clamped) knot vector.
+
+A knot vector ``t_0 <= t_1 <= … <= t_{N+n}`` of degree ``n`` defines ``N`` B-splines
+``N_{k,n}`` by the Cox–de Boor recurrence
+
+.. math:: N_{k,p}(x) = \\frac{x - t_k}{t_{k+p} - t_k} N_{k,p-1}(x)
+          + \\frac{t_{k+p+1} - x}{t_{k+p+1} - t_{k+1}} N_{k+1,p-1}(x)
+
+on the parameter domain ``[t_n, t_N]``. Interior knots may be repeated up to ``n``
+times (a knot of multiplicity ``μ`` leaves the spline ``C^{n-μ}`` there). This is the
+layout CAD programs write; the uniform / open / periodic layouts of
+:class:`splinedeform.basis.BSplineBasis` are its fast special cases.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import ArrayLike, NDArray
+
+from .basis import _check_degree, _cox_de_boor
+from .errors import InputError
+
+
+@dataclass(frozen=True)
+class KnotVectorBasis:
+    """B-spline basis of degree ``n`` from a knot vector (splipy / openNURBS style).
+
+    Parameters
+    ----------
+    degree : int
+        Polynomial degree ``n >= 1``.
+    knots : array_like
+        Non-decreasing knots ``t_0 … t_{N+n}`` (``N + n + 1`` values, ``N >= n + 1``),
+        interior multiplicity at most ``n``; the domain is ``[t_n, t_N]``.
+
+    Examples
+    --------
+    >>> b = KnotVectorBasis(2, [0, 0, 0, 0.5, 0.5, 1, 1, 1])
+    >>> b.size, b.domain
+    (5, (0.0, 1.0))
+    >>> round(float(b([0.3]).sum()), 12)
+    1.0
+    """
+
+    degree: int
+    knots: NDArray[np.float64]
+    breaks: NDArray[np.float64] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        _check_degree(self.degree)
+        t = np.asarray(self.knots, dtype=float).ravel()
+        n = self.degree
+        if t.size < 2 * n + 2:
+            raise InputError(f"a degree-{n} knot vector needs at least {2 * n + 2} knots, "
+                             f"got {t.size}")
+        if not np.all(np.isfinite(t)) or np.any(np.diff(t) < 0):
+            raise InputError("knots must be finite and non-decreasing")
+        lo, hi = t[n], t[t.size - n - 1]
+        if not hi > lo:
+            raise InputError(f"knot vector has an empty domain [t_n, t_N] = [{lo:g}, {hi:g}]")
+        inner = t[(t > lo) & (t < hi)]
+        if inner.size:
+            _, mult = np.unique(inner, return_counts=True)
+            if mult.max() > n:
+                raise InputError(f"an interior knot is repeated {mult.max()} times; "
+                                 f"at most the degree ({n}) keeps the basis continuous")
+        t.setflags(write=False)
+        object.__setattr__(self, "knots", t)
+        object.__setattr__(self, "breaks", np.unique(t[n:t.size - n]))
+
+    @property
+    def size(self) -> int:
+        """Number of basis functions ``N = len(knots) - n - 1``."""
+        return self.knots.size - self.degree - 1
+
+    @property
+    def domain(self) -> tuple[float, float]:
+        """Parameter domain ``[t_n, t_N]``."""
+        return float(self.breaks[0]), float(self.breaks[-1])
+
+    @property
+    def periodic(self) -> bool:
+        return False
+
+    def greville(self) -> NDArray[np.float64]:
+        """Greville abscissae ``ξ_k = (t_{k+1} + … + t_{k+n}) / n``."""
+        n = self.degree
+        window = np.lib.stride_tricks.sliding_window_view(self.knots[1:-1], n)[: self.size]
+        return window.mean(axis=1)
+
+    def span(self, x: ArrayLike) -> NDArray[np.int64]:
+        """Knot index ``μ`` with ``t_μ <= x < t_{μ+1}``, ``n <= μ <= N-1`` (last span closed)."""
+        x = self._check_points(x)
+        n, t = self.degree, self.knots
+        mu = np.searchsorted(t, x, side="right") - 1
+        return np.clip(mu, n, self.size - 1)
+
+    def _check_points(self, x: ArrayLike) -> NDArray[np.float64]:
+        x = np.asarray(x, dtype=float)
+        lo, hi = self.domain
+        if not np.all(np.isfinite(x)):
+            raise InputError("parameters must be finite numbers")
+        tol = 1e-12 * (hi - lo)
+        if x.size and (x.min() < lo - tol or x.max() > hi + tol):
+            raise InputError(f"parameter outside the domain [{lo:g}, {hi:g}]: "
+                             f"got values in [{x.min():g}, {x.max():g}]")
+        return np.clip(x, lo, hi)
+
+    def nonzero_derivatives(self, x: ArrayLike, max_derivative: int = 0
+                            ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+        """Indices ``μ-n … μ`` and ``D^j N_k(x)`` for ``j = 0..max_derivative``.
+
+        Same shapes as :meth:`splinedeform.basis.BSplineBasis.nonzero_derivatives`.
+        """
+        if not isinstance(max_derivative, (int, np.integer)) or max_derivative < 0:
+            raise InputError(f"derivative order must be an integer >= 0, got {max_derivative!r}")
+        x = self._check_points(x)
+        n = self.degree
+        mu = self.span(x)
+        jmax = min(max_derivative, n)
+        values = _cox_de_boor(self.knots, n, mu, x, jmax)
+        if max_derivative > jmax:
+            values = np.concatenate([values, np.zeros((max_derivative - jmax,) + values.shape[1:])])
+        return mu[..., None] - n + np.arange(n + 1), values
+
+    def nonzero(self, x: ArrayLike, derivative: int = 0
+                ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+        """Indices and values of the ``n+1`` functions not vanishing at each parameter."""
+        index, values = self.nonzero_derivatives(x, derivative)
+        return index, values[derivative]
+
+    def matrix(self, x: ArrayLike, derivative: int = 0) -> sp.csr_matrix:
+        """Sparse collocation matrix ``A_{ij} = D^derivative N_j(x_i)``."""
+        x = np.atleast_1d(np.asarray(x, dtype=float)).ravel()
+        index, values = self.nonzero(x, derivative)
+        indptr = np.arange(0, x.size * (self.degree + 1) + 1, self.degree + 1)
+        return sp.csr_matrix((values.ravel(), index.ravel(), indptr), shape=(x.size, self.size))
+
+    def __call__(self, x: ArrayLike, derivative: int = 0) -> NDArray[np.float64]:
+        """Dense collocation matrix."""
+        return self.matrix(x, derivative).toarray()
