@@ -6,7 +6,7 @@ from scipy.interpolate import splev
 
 from splinedeform.basis import BSplineBasis
 from splinedeform.errors import InputError
-from splinedeform.knots import KnotVectorBasis
+from splinedeform.knots import KnotVectorBasis, RationalBasis
 from splinedeform.quadrature import gram_matrix, integrals
 
 # Round-off tolerance: both paths evaluate the same polynomials with O(n) operations
@@ -103,3 +103,48 @@ def test_bad_knot_vectors_are_refused(degree, knots, message):
 def test_parameters_outside_the_domain_are_refused():
     with pytest.raises(InputError, match="outside the domain"):
         KnotVectorBasis(2, [0, 0, 0, 1, 1, 1])([1.5])
+
+
+QUARTER = KnotVectorBasis(2, [0, 0, 0, 1, 1, 1])
+CIRCLE_POINTS = np.array([[1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+
+
+def test_rational_quarter_circle_is_exact():
+    # exact NURBS circle: radius 1 up to round-off of a few operations (1e-12 leaves margin)
+    r = RationalBasis(QUARTER, [1.0, np.sqrt(0.5), 1.0])
+    x = np.linspace(0.0, 1.0, 10_000)
+    point, tangent, second = (r(x, j) @ CIRCLE_POINTS for j in range(3))
+    assert np.abs(np.hypot(*point.T) - 1.0).max() <= 1e-12
+    # first and second derivatives checked against the circle: p·p' = 0, p·p'' = -|p'|²
+    assert np.abs((point * tangent).sum(1)).max() <= 1e-12
+    curvature_check = (point * second).sum(1) + (tangent ** 2).sum(1)
+    assert np.abs(curvature_check).max() <= 1e-11 * (tangent ** 2).sum(1).max()
+
+
+@pytest.mark.parametrize("order", [0, 1, 2])
+def test_rational_basis_with_equal_weights_is_the_polynomial_basis(order):
+    knots = [0, 0, 0, 0, 0.3, 0.3, 1, 1, 1, 1]
+    poly = KnotVectorBasis(3, knots)
+    rational = RationalBasis(poly, np.full(poly.size, 2.5))
+    _close(gram_matrix(rational, order), gram_matrix(poly, order))
+
+
+def test_rational_gram_converges_under_quadrature_refinement():
+    # R_k is rational, so Gauss–Legendre converges geometrically instead of being exact:
+    # measured relative errors of G2 for 4, 6, 8, 10, 12 points: 2e-3, 2e-5, 1e-7, 4e-10, 1e-12
+    w = [1.0, np.sqrt(0.5), 1.0]
+    reference = gram_matrix(RationalBasis(QUARTER, w, points_per_cell=60), 2).toarray()
+    scale = np.abs(reference).max()
+    errors = [np.abs(gram_matrix(RationalBasis(QUARTER, w, points_per_cell=q), 2).toarray()
+                     - reference).max() / scale for q in (4, 6, 8, 10, 12)]
+    assert all(b <= a / 50 for a, b in zip(errors, errors[1:]))
+    # default rule (2n+10 = 14 points): round-off level; 1e-13 leaves margin over ~1e-15
+    assert np.abs(gram_matrix(RationalBasis(QUARTER, w), 2).toarray()
+                  - reference).max() <= 1e-13 * scale
+
+
+def test_bad_weights_are_refused():
+    with pytest.raises(InputError, match="3 weights"):
+        RationalBasis(QUARTER, [1.0, 1.0])
+    with pytest.raises(InputError, match="> 0"):
+        RationalBasis(QUARTER, [1.0, 0.0, 1.0])

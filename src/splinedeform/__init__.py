@@ -8,7 +8,7 @@
 
 from . import loads
 from .basis import BSplineBasis
-from .knots import KnotVectorBasis
+from .knots import KnotVectorBasis, RationalBasis
 from .errors import InputError, ScenarioError, SingularSystemError
 from .loads import Constant, Function, Harmonic, Piecewise, Point, Pressure, Step, Uniform
 from .material import Material
@@ -25,7 +25,7 @@ except ImportError:  # pragma: no cover - during development only
 
 __version__ = "0.1.0"
 
-__all__ = ["AreaForce", "ShellMaterial", "ShellModel", "BSplineBasis", "KnotVectorBasis", "Constant", "Energy", "Function", "Harmonic", "InputError",
+__all__ = ["AreaForce", "ShellMaterial", "ShellModel", "BSplineBasis", "KnotVectorBasis", "RationalBasis", "Constant", "Energy", "Function", "Harmonic", "InputError",
            "Material", "Model", "Piecewise", "Point", "Pressure", "ScenarioError",
            "SingularSystemError", "Solution", "StaticSolution", "Step", "Surface", "Uniform",
            "loads", "shapes", "__version__"]

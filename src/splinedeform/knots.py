@@ -15,6 +15,7 @@ layout CAD programs write; the uniform / open / periodic layouts of
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from math import comb
 
 import numpy as np
 import scipy.sparse as sp
@@ -142,3 +143,70 @@ class KnotVectorBasis:
     def __call__(self, x: ArrayLike, derivative: int = 0) -> NDArray[np.float64]:
         """Dense collocation matrix."""
         return self.matrix(x, derivative).toarray()
+
+
+@dataclass(frozen=True)
+class RationalBasis:
+    """Weighted (NURBS) basis ``R_k = w_k N_k / W`` with ``W = Σ_j w_j N_j``.
+
+    Derivatives follow from Leibniz' rule applied to ``W R_k = w_k N_k``:
+
+    .. math:: D^j R_k = \\Big(w_k D^j N_k - \\sum_{i=1}^{j} \\binom{j}{i} D^i W\\, D^{j-i} R_k\\Big) / W.
+
+    ``R_k`` is not a polynomial on a knot span, so Gram matrices of this basis are
+    computed by quadrature with :attr:`points_per_cell` Gauss points per span (exact
+    when all weights are equal, where ``R_k = N_k``).
+
+    Parameters
+    ----------
+    basis : KnotVectorBasis
+    weights : array_like, shape ``(basis.size,)``
+        Positive weights ``w_k``.
+
+    Examples
+    --------
+    >>> r = RationalBasis(KnotVectorBasis(2, [0, 0, 0, 1, 1, 1]), [1, 0.5 ** 0.5, 1])
+    >>> x, y = r([0.3]) @ [[1, 0], [1, 1], [0, 1]] @ [1, 0], r([0.3]) @ [0, 1, 1]
+    >>> round(float(x[0] ** 2 + y[0] ** 2), 12)   # a quarter of the unit circle
+    1.0
+    """
+
+    basis: KnotVectorBasis
+    weights: NDArray[np.float64]
+    points_per_cell: int = 0
+
+    def __post_init__(self) -> None:
+        w = np.asarray(self.weights, dtype=float).ravel()
+        if w.shape != (self.basis.size,):
+            raise InputError(f"a rational basis needs {self.basis.size} weights (one per "
+                             f"function), got {w.size}")
+        if not np.all(np.isfinite(w)) or np.any(w <= 0):
+            raise InputError("NURBS weights must be finite and > 0")
+        w.setflags(write=False)
+        object.__setattr__(self, "weights", w)
+        if not self.points_per_cell:
+            object.__setattr__(self, "points_per_cell", 2 * self.basis.degree + 10)
+
+    degree = property(lambda self: self.basis.degree)
+    size = property(lambda self: self.basis.size)
+    breaks = property(lambda self: self.basis.breaks)
+    domain = property(lambda self: self.basis.domain)
+    periodic = property(lambda self: False)
+
+    def nonzero_derivatives(self, x: ArrayLike, max_derivative: int = 0
+                            ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+        """Indices and ``D^j R_k(x)``, ``j = 0..max_derivative`` (shapes as the polynomial basis)."""
+        index, b = self.basis.nonzero_derivatives(x, max_derivative)
+        wb = b * self.weights[index]                 # w_k D^j N_k
+        W = wb.sum(axis=-1, keepdims=True)           # D^j W
+        R = np.empty_like(wb)
+        for j in range(max_derivative + 1):
+            acc = wb[j].copy()
+            for i in range(1, j + 1):
+                acc -= comb(j, i) * W[i] * R[j - i]
+            R[j] = acc / W[0]
+        return index, R
+
+    nonzero = KnotVectorBasis.nonzero
+    matrix = KnotVectorBasis.matrix
+    __call__ = KnotVectorBasis.__call__

@@ -13,9 +13,9 @@ from numpy.typing import NDArray
 
 from .basis import BSplineBasis
 from .errors import InputError
-from .knots import KnotVectorBasis
+from .knots import KnotVectorBasis, RationalBasis
 
-Basis = BSplineBasis | KnotVectorBasis
+Basis = BSplineBasis | KnotVectorBasis | RationalBasis
 
 
 def gauss_points(basis: Basis, points_per_cell: int | None = None
@@ -27,15 +27,17 @@ def gauss_points(basis: Basis, points_per_cell: int | None = None
     basis : BSplineBasis or KnotVectorBasis
         For a general knot vector the cells are its non-empty knot spans.
     points_per_cell : int, optional
-        Defaults to ``n + 1``, exact for polynomials of degree ``2n + 1`` per cell.
+        Defaults to ``n + 1``, exact for polynomials of degree ``2n + 1`` per cell
+        (a rational basis sets its own, larger default: its functions are not polynomials).
 
     Returns
     -------
     x, w : ndarray, shape ``(cells * points_per_cell,)``
     """
-    q = basis.degree + 1 if points_per_cell is None else int(points_per_cell)
+    default = getattr(basis, "points_per_cell", basis.degree + 1)
+    q = default if points_per_cell is None else int(points_per_cell)
     ref_x, ref_w = np.polynomial.legendre.leggauss(q)
-    if isinstance(basis, KnotVectorBasis):
+    if isinstance(basis, (KnotVectorBasis, RationalBasis)):
         # general knot vector: one Gauss–Legendre rule per non-empty knot span
         left, width = basis.breaks[:-1, None], np.diff(basis.breaks)[:, None]
         x = left + 0.5 * width * (ref_x + 1.0)
