@@ -1,0 +1,143 @@
+"""NURBS surfaces to and from openNURBS ``.3dm`` files (through ``rhino3dm``).
+
+A surface is held as :class:`NurbsPatch`: degrees ``(n_u, n_v)``, full clamped knot
+vectors (``N + n + 1`` knots each, our convention and splipy's/geomdl's), control points
+``P_ij`` of shape ``(N_u, N_v, 3)`` and weights ``w_ij``. The point is
+
+.. math:: S(u, v) = \\frac{\\sum_{ij} w_{ij} N_i(u) N_j(v) P_{ij}}{\\sum_{ij} w_{ij} N_i(u) N_j(v)}.
+
+openNURBS stores ``N + n - 1`` knots (the first and last are implied) and homogeneous
+control points ``(w x, w y, w z, w)``. Needs the ``cad`` extra.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .errors import InputError
+from .knots import KnotVectorBasis
+
+
+@dataclass(frozen=True)
+class NurbsPatch:
+    """A rational tensor-product B-spline surface (see the module docstring)."""
+
+    degrees: tuple[int, int]
+    knots_u: NDArray[np.float64]
+    knots_v: NDArray[np.float64]
+    points: NDArray[np.float64]
+    weights: NDArray[np.float64]
+
+    def __post_init__(self) -> None:
+        bu = KnotVectorBasis(self.degrees[0], self.knots_u)
+        bv = KnotVectorBasis(self.degrees[1], self.knots_v)
+        shape = (bu.size, bv.size)
+        if np.shape(self.points) != shape + (3,) or np.shape(self.weights) != shape:
+            raise InputError(f"a NURBS patch with these knots needs {shape} control points "
+                             f"(x, y, z) and weights, got points {np.shape(self.points)} and "
+                             f"weights {np.shape(self.weights)}")
+        if np.any(np.asarray(self.weights) <= 0):
+            raise InputError("NURBS weights must be > 0")
+
+    def evaluate(self, u: NDArray[np.float64], v: NDArray[np.float64]) -> NDArray[np.float64]:
+        """``S(u_a, v_b)`` on the grid ``u × v``, shape ``(len(u), len(v), 3)``."""
+        Bu = KnotVectorBasis(self.degrees[0], self.knots_u)(u)
+        Bv = KnotVectorBasis(self.degrees[1], self.knots_v)(v)
+        w = np.asarray(self.weights)
+        num = np.einsum("ai,ij,ijk,bj->abk", Bu, w, self.points, Bv)
+        return num / (Bu @ w @ Bv.T)[..., None]
+
+
+def _rhino3dm():
+    try:
+        import rhino3dm
+    except ImportError as exc:  # pragma: no cover - depends on the installation
+        raise InputError("reading or writing .3dm files needs the 'cad' extra: "
+                         "pip install 'splinedeform[cad]'") from exc
+    return rhino3dm
+
+
+def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch]) -> Path:
+    """Write ``patches`` as NURBS surfaces to a ``.3dm`` file (atomically); return its path."""
+    r3 = _rhino3dm()
+    path = Path(path)
+    model = r3.File3dm()
+    for patch in patches:
+        (nu, nv), w = patch.degrees, np.asarray(patch.weights)
+        cu, cv = w.shape
+        srf = r3.NurbsSurface.Create(3, True, nu + 1, nv + 1, cu, cv)
+        for i, k in enumerate(np.asarray(patch.knots_u)[1:-1]):
+            srf.KnotsU[i] = float(k)
+        for i, k in enumerate(np.asarray(patch.knots_v)[1:-1]):
+            srf.KnotsV[i] = float(k)
+        hom = np.concatenate([patch.points * w[..., None], w[..., None]], axis=-1)
+        for i, j in np.ndindex(cu, cv):  # rhino3dm sets control points one at a time
+            srf.Points[i, j] = r3.Point4d(*map(float, hom[i, j]))
+        model.Objects.AddSurface(srf)
+    fd, tmp = tempfile.mkstemp(suffix=".3dm", dir=path.parent)
+    os.close(fd)
+    try:
+        if not model.Write(tmp, 7):
+            raise InputError(f"{path}: openNURBS could not write the file")
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+    return path
+
+
+def _patch_from_rhino(srf, source: str) -> NurbsPatch:
+    nu, nv = srf.OrderU - 1, srf.OrderV - 1
+    if nu < 1 or nv < 1:
+        raise InputError(f"{source}: surface of degree ({nu}, {nv}); degree 0 is not supported")
+    ku = [srf.KnotsU[i] for i in range(len(srf.KnotsU))]
+    kv = [srf.KnotsV[i] for i in range(len(srf.KnotsV))]
+    cu, cv = srf.Points.CountU, srf.Points.CountV
+    hom = np.array([[list(_xyzw(srf.Points[i, j])) for j in range(cv)] for i in range(cu)])
+    w = hom[..., 3]
+    return NurbsPatch((nu, nv), np.r_[ku[0], ku, ku[-1]], np.r_[kv[0], kv, kv[-1]],
+                      hom[..., :3] / w[..., None], w)
+
+
+def _xyzw(p) -> tuple[float, float, float, float]:
+    return p.X, p.Y, p.Z, p.W
+
+
+def read_3dm(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
+    """Surface number ``face`` of a ``.3dm`` file (surfaces and Brep faces, in file order).
+
+    A Brep face is read as its underlying (untrimmed) surface, with a warning.
+    """
+    r3 = _rhino3dm()
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{path}: no such file")
+    model = r3.File3dm.Read(str(path))
+    if model is None:
+        raise InputError(f"{path}: not a .3dm (openNURBS) file")
+    found = []
+    for obj in model.Objects:
+        geometry = obj.Geometry
+        if isinstance(geometry, r3.Brep):
+            found += [(f, True) for f in geometry.Faces]
+        elif isinstance(geometry, r3.Surface):
+            found.append((geometry, False))
+    if not found:
+        raise InputError(f"{path}: the file holds no surface")
+    if not isinstance(face, int) or not 0 <= face < len(found):
+        raise InputError(f"{path}: face {face!r} out of range; the file holds "
+                         f"{len(found)} surface(s), numbered 0..{len(found) - 1}")
+    surface, in_brep = found[face]
+    if in_brep:
+        warnings.warn(f"{path}: face {face} is a Brep face; its underlying surface is used "
+                      "and any trimming is dropped", stacklevel=2)
+        surface = surface.UnderlyingSurface()
+    return _patch_from_rhino(surface.ToNurbsSurface(), f"{path} face {face}")
+
