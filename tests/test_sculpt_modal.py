@@ -36,3 +36,20 @@ def test_free_surface_refused():
     model = sd.Model(surf, sd.Material(w10=1, w01=1), boundary="free")
     with pytest.raises(sd.InputError, match="rigid-body"):
         sculpt_basis(model)
+
+
+def test_payload_round_trip():
+    from splinedeform.sculpt.export import decode, payload
+
+    surf = sd.shapes.plane(cells=(4, 4))
+    model = sd.Model(surf, sd.Material(w10=1, w01=1, damping=0.5), boundary="clamped")
+    basis = sculpt_basis(model, resolution=6)
+    data = payload(basis)
+    assert data["grid"] == [6, 6] and data["modes"] == model.n_free
+    # lam and damping travel as float64: exact copies of the same numbers
+    assert np.allclose(decode(data["lam"], "<f8"), basis.lam, rtol=1e-15, atol=0)
+    # phi travels as float32: relative rounding 2**-24 of each entry
+    phi = decode(data["phi"]).reshape(36, -1)
+    assert np.allclose(phi, basis.phi_samples, rtol=2**-23, atol=1e-30)
+    rest = decode(data["rest"]).reshape(6, 6, 3)
+    assert np.allclose(rest[-1, -1], surf.evaluate(np.array([1.0]), np.array([1.0]))[0], rtol=1e-6)
