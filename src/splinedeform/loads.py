@@ -187,6 +187,10 @@ class Load:
     def breakpoints(self) -> list[float]:
         return sorted({b for term in self.terms() for b in term.profile.breakpoints()})
 
+    def time_dependent(self) -> bool:
+        """True when some term's profile is not ``s(t) = 1`` for every ``t >= 0``."""
+        return any(term.profile.jumps() != [(0.0, 1.0)] for term in self.terms())
+
 
 @dataclass(frozen=True)
 class LoadSum(Load):
@@ -318,7 +322,29 @@ def as_load(load: Load | Iterable[Load] | None) -> Load:
     return LoadSum(parts)
 
 
+def static_time(load: Load, t: float | None) -> float:
+    """The time at which a static solve evaluates ``load``: ``t``, or 0 for a constant load.
+
+    Raises
+    ------
+    InputError
+        When the load varies in time and no ``t`` is given, or ``t`` is not a finite ``>= 0``.
+    """
+    if t is None:
+        if load.time_dependent():
+            profiles = sorted({type(term.profile).__name__ for term in load.terms()} - {"Constant"})
+            raise InputError(
+                f"the load varies in time ({', '.join(profiles)} profile), so a static solve "
+                "has no single answer: give the time of the equilibrium wanted, "
+                "static(load, t=...), or use a Constant profile")
+        return 0.0
+    value = _finite(t, "static time t")
+    if value < 0:
+        raise InputError(f"static time t must be >= 0, got {t}")
+    return value
+
+
 __all__ = ["Constant", "Function", "Harmonic", "Load", "LoadSum", "Piecewise", "Point",
-           "Pressure", "Profile", "Step", "Uniform", "as_load", "project"]
+           "Pressure", "Profile", "Step", "Uniform", "as_load", "project", "static_time"]
 
 

@@ -10,6 +10,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
+import numpy as np
+
 from .errors import InputError
 
 WEIGHTS = ("w10", "w01", "w20", "w11", "w02")
@@ -51,7 +53,9 @@ class Material:
     def __post_init__(self) -> None:
         for f in fields(self):
             value = getattr(self, f.name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
+            if isinstance(value, (bool, np.bool_, str, bytes)):
+                raise InputError(f"material.{f.name} must be a real number, got {value!r}")
+            if not isinstance(value, (int, float)):
                 try:
                     value = float(value)
                 except (TypeError, ValueError):

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .boundary import Constraints, build_constraints
 from .errors import InputError, SingularSystemError
-from .loads import Load, as_load
+from .loads import Load, as_load, static_time
 from .material import Material
 from .physics import PHYSICS, intrinsic
 from .quadrature import gram_matrix
@@ -169,8 +169,12 @@ class Model:
         return np.asarray(self.constraints.T.T @ F_full)
 
     # -- static ----------------------------------------------------------------------
-    def static(self, load: Load | None) -> StaticSolution:
-        """Equilibrium ``K_r d = Tᵀ F`` by a sparse direct solve.
+    def static(self, load: Load | None, t: float | None = None) -> StaticSolution:
+        """Equilibrium ``K_r d = Tᵀ F(t)`` by a sparse direct solve.
+
+        A load whose profile varies in time (a step switched on later, a harmonic) needs
+        the time ``t`` at which its equilibrium is wanted; it is never taken at ``t = 0``
+        silently.
 
         Raises
         ------
@@ -185,7 +189,7 @@ class Model:
                 "point is fixed, so rigid translations cost no energy and K is singular. "
                 "Fix an edge (boundary='clamped' or e.g. {'u0': 'pinned'}) or some control "
                 "points (fixed=mask)")
-        F = self.load_vector(as_load(load))
+        F = self.load_vector(as_load(load), static_time(as_load(load), t))
         d = self._solve_stiffness(F)
         return StaticSolution(self, d, F, {"static": time.perf_counter() - start})
 
