@@ -137,8 +137,53 @@ def _solve(scenario: Scenario, built: Built, stages: _Stages) -> RunResult:
         nets = _frames(scenario, built, solution, times, shapes)
     result = RunResult(scenario=scenario, built=built, solution=solution, times=times,
                        nets=nets, omegas=omegas, mode_shapes=shapes)
-    _measure(result)
+    with np.errstate(over="ignore", invalid="ignore"):
+        _measure(result)
+    _require_finite(result)
     return result
+
+
+def _extreme_inputs(scenario: Scenario) -> list[tuple[str, float]]:
+    """Numeric inputs of extreme magnitude (``|x| > 1e100`` or ``0 < |x| < 1e-100``) by key path."""
+    import math
+
+    values: list[tuple[str, Any]] = [(f"material.{name}", getattr(scenario.material, name))
+                                     for name in ("mass", "damping", "rayleigh", "w10", "w01",
+                                                  "w20", "w11", "w02")]
+    for i, spec in enumerate(scenario.loads, start=1):
+        values.append((f"load[{i}].q", spec.q))
+        values.append((f"load[{i}].omega", spec.omega))
+        values.extend((f"load[{i}].force[{j}]", f) for j, f in enumerate(spec.force or (), start=1))
+    extreme = []
+    for path, value in values:
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            size = abs(float(value))
+            if not math.isfinite(size) or size > 1e100 or 0.0 < size < 1e-100:
+                extreme.append((path, float(value)))
+    return extreme
+
+
+def _require_finite(result: RunResult) -> None:
+    """Refuse a solution, energy or probe that overflowed to NaN or inf before anything is written."""
+    import numpy as np
+
+    arrays = [result.nets, result.max_displacement, *result.probes.values(),
+              *(result.energy or {}).values()]
+    if result.omegas is not None:
+        arrays.append(result.omegas)
+    if all(np.all(np.isfinite(np.asarray(a, dtype=float))) for a in arrays):
+        return
+    scenario = result.scenario
+    extreme = _extreme_inputs(scenario)
+    if extreme:
+        path = extreme[0][0]
+        named = ", ".join(f"{key} = {value:g}" for key, value in extreme)
+        cause = f"inputs of extreme magnitude made it so: {named}; bring them to a scale " \
+                "where the products of force, mass, damping and stiffness stay below ~1e300"
+    else:
+        path, cause = "solve", "no single input is extreme; the combination of scales overflows"
+    raise scenario.error(path, "the solution is not finite (NaN or inf) and nothing was "
+                         f"written: {cause}")
 
 
 def _method_options(solve: SolveSpec, times: Any, mesh_time: float | None) -> dict[str, Any]:
