@@ -46,3 +46,22 @@ def test_static_refuses_a_bad_time(t):
 def test_material_refuses_non_real_values_naming_the_parameter(value):
     with pytest.raises(InputError, match="material.w10"):
         sd.Material(mass=1.0, w10=value, w01=1.0)
+
+
+HOSTILE = ('__SPLINEDEFORM_DATA__ </script><img src=x onerror="document.title=1"> '
+           '/*__SPLINEDEFORM_THREE__*/ & \u2028 __SPLINEDEFORM_TITLE__')
+
+
+def test_viewer_page_keeps_a_hostile_name_inert_and_round_trips_it():
+    import json
+    import re
+
+    from splinedeform.viz import viewer_html
+    data = {"name": HOSTILE, "frames": []}
+    page = viewer_html(data)
+    assert "<img" not in page                       # neither the title nor the data opens a tag
+    block = re.search(r'<script type="application/json" id="splinedeform-data">(.*?)</script>',
+                      page, re.S)
+    assert block is not None
+    assert json.loads(block.group(1)) == data       # the JSON decodes to exactly the data given
+    assert page.count('id="splinedeform-data"') == 1

@@ -16,6 +16,7 @@ import base64
 import html
 import json
 import os
+import re
 from collections.abc import Callable, Mapping, Sequence
 from importlib import resources
 from pathlib import Path
@@ -472,10 +473,20 @@ def viewer_html(data: Mapping[str, Any]) -> str:
     three = _vendor_text("three-orbit.min.js")
     if "</script" in three.lower():
         raise RuntimeError("the vendored three.js contains '</script' and cannot be inlined")
-    payload = json.dumps(data, separators=(",", ":")).replace("</", "<\\/")
-    return (template.replace("__SPLINEDEFORM_TITLE__", html.escape(str(data["name"])))
-            .replace("/*__SPLINEDEFORM_THREE__*/", three)
-            .replace("__SPLINEDEFORM_DATA__", payload))
+    fills = {"__SPLINEDEFORM_TITLE__": html.escape(str(data["name"])),
+             "/*__SPLINEDEFORM_THREE__*/": three,
+             "__SPLINEDEFORM_DATA__": script_json(data)}
+    # One pass: text put in by one placeholder is never searched for another.
+    pattern = re.compile("|".join(re.escape(key) for key in fills))
+    return pattern.sub(lambda match: fills[match.group(0)], template)
+
+
+def script_json(data: Any) -> str:
+    """JSON safe inside ``<script>``: ``<``, ``>``, ``&``, U+2028 and U+2029 as ``\\uXXXX``."""
+    text = json.dumps(data, separators=(",", ":"))
+    for char in ("<", ">", "&", "\u2028", "\u2029"):
+        text = text.replace(char, f"\\u{ord(char):04x}")
+    return text
 
 
 def write_viewer(path: str | os.PathLike[str], surface: Surface, rest_net: ArrayLike,
