@@ -65,3 +65,11 @@ def test_viewer_page_keeps_a_hostile_name_inert_and_round_trips_it():
     assert block is not None
     assert json.loads(block.group(1)) == data       # the JSON decodes to exactly the data given
     assert page.count('id="splinedeform-data"') == 1
+
+
+def test_report_markdown_escapes_a_hostile_title():
+    from splinedeform.export import report_markdown
+    text = report_markdown({}, title='<img src=x onerror="alert(1)">\n# injected')
+    first = text.splitlines()[0]
+    assert "<img" not in text and first.startswith("# &lt;img")
+    assert "\n# injected" not in text                 # a newline cannot start a new heading

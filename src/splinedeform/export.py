@@ -15,6 +15,7 @@ meshio is imported lazily (it is part of the ``tool`` extra).
 
 from __future__ import annotations
 
+import html
 import json
 import math
 import os
@@ -492,7 +493,7 @@ def section_markdown(section: Any) -> list[str]:
 def report_markdown(report: Mapping[str, Any], title: str = "splinedeform report") -> str:
     """report.md: a heading and a table (see :func:`section_markdown`) per top-level key."""
     doc = plain(report)
-    lines = [f"# {title}", ""]
+    lines = [f"# {html.escape(' '.join(str(title).split()))}", ""]
     for name, section in doc.items():
         lines += [f"## {name.replace('_', ' ').capitalize()}", "", *section_markdown(section), ""]
     return "\n".join(lines)
