@@ -205,7 +205,11 @@ def test_frames_in_chunks_equal_frames_at_once(monkeypatch):
     sol = model.dynamic(LOAD, 1.0, eigensolver="separable")
     whole = sol.control_points(TIMES)
     monkeypatch.setattr(type(sol), "chunk_entries", 1)
-    assert np.array_equal(sol.control_points(TIMES), whole)
+    # Chunking changes the shapes of the BLAS products, and BLAS may then sum in another
+    # order (blocking/SIMD kernels differ by CPU and library): equal only to rounding,
+    # a few ulps of the largest entry, never bit for bit.
+    np.testing.assert_allclose(sol.control_points(TIMES), whole,
+                               rtol=0, atol=1e-13 * np.abs(whole).max())
     v = sol.state(TIMES)[1]
     vr = model.dynamic(LOAD, 1.0, eigensolver="dense").state(TIMES)[1]
     assert np.abs(v - vr).max() <= 1e-10 * np.abs(vr).max()
@@ -219,7 +223,9 @@ def test_frames_sample_the_surface_by_one_sparse_product():
     for f, t in enumerate(TIMES):
         surf = model.surface.with_control_points(sol.control_points(t))
         assert np.allclose(frames.points[f], surf.evaluate_grid(u, v), atol=1e-14, rtol=0)
-    assert np.array_equal(frames.control_points, sol.control_points(TIMES))
+    # same formula, possibly other product shapes (chunks): equal to rounding, not bitwise
+    cp = sol.control_points(TIMES)
+    np.testing.assert_allclose(frames.control_points, cp, rtol=0, atol=1e-13 * np.abs(cp).max())
     assert sol.frames(TIMES).points is None
 
 
