@@ -100,9 +100,8 @@ def test_a_denormal_mass_is_a_located_error():
     from splinedeform.pipeline import run
 
     text = DYNAMIC.replace("[material]\n", "[material]\nmass = 1e-320\n")
-    s = parse_scenario(text + "[output]\nformats = []\n", source="case.toml")
-    with pytest.raises(ScenarioError, match=r"^case\.toml:\d+: "):
-        run(s)
+    with pytest.raises(ScenarioError, match=r"^case\.toml:\d+: "):   # refused on reading or later
+        run(parse_scenario(text + "[output]\nformats = []\n", source="case.toml"))
 
 
 # -- files outside the scenario's folder ----------------------------------------------------
