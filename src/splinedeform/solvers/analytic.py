@@ -16,8 +16,12 @@ Responses built on it (all exact):
 * unit step from ``τ = 0``: ``S(τ) = (1 - P_11(τ))/λ``, ``S'(τ) = P_12(τ)``; for ``λ = 0``
   ``S = τ² φ_2(-cτ)``, ``S' = τ φ_1(-cτ)`` with ``φ_1(z) = (e^z-1)/z``, ``φ_2(z) = (e^z-1-z)/z²``;
 * ``sin(Ωt + φ)`` from ``t = 0``: particular ``Im(e^{i(Ωt+φ)}/Z)``, ``Z = λ - Ω² + icΩ``, plus the
-  free response that cancels its initial values; at undamped resonance (``Z = 0``) the secular
-  particular ``-t cos(Ωt+φ)/(2Ω)``.
+  free response that cancels its initial values. Near resonance ``1/Z`` is huge and the two
+  parts cancel, so under-damped modes with ``ω_d ≥ ω/2`` use instead the Duhamel integral in
+  divided-difference form: with ``μ_± = -a ± iω_d``,
+  ``q = Im e^{iφ} (E(μ_+) - E(μ_-))/(μ_+ - μ_-)``, ``q' = Im e^{iφ} (μ_+E(μ_+) - μ_-E(μ_-))/(μ_+ - μ_-)``,
+  ``E(μ) = ∫_0^t e^{μ(t-s)} e^{iΩs} ds = t e^{μt} φ_1((iΩ-μ)t) = (e^{iΩt} - e^{μt})/(iΩ-μ)``,
+  the first form where ``|(iΩ-μ)t| < 1``; nothing cancels for any detuning, resonance included.
 """
 
 from __future__ import annotations
@@ -91,6 +95,27 @@ def phi2(z: Array) -> Array:
     return np.where(small, series, (np.expm1(safe) - safe) / (safe * safe))
 
 
+def _phi1_complex(z: NDArray[np.complex128]) -> NDArray[np.complex128]:
+    """``φ_1(z) = (e^z - 1)/z`` for complex ``|z| <= 1`` without cancellation.
+
+    ``e^{x+iy} - 1 = expm1(x) cos y - 2 sin²(y/2) + i e^x sin y``.
+    """
+    x, y = z.real, z.imag
+    num = np.expm1(x) * np.cos(y) - 2.0 * np.sin(0.5 * y) ** 2 + 1j * np.exp(x) * np.sin(y)
+    zero = z == 0
+    return np.where(zero, 1.0 + 0j, num / np.where(zero, 1.0, z))
+
+
+def _duhamel_exp(mu: NDArray[np.complex128], omega: float, t: Array) -> NDArray[np.complex128]:
+    """``E(μ) = ∫_0^t e^{μ(t-s)} e^{iΩs} ds`` (``Re μ <= 0``, ``t >= 0``) without cancellation."""
+    w = 1j * omega - mu
+    wt = w * t
+    small = np.abs(wt) < 1.0
+    near = t * np.exp(mu * np.where(small, t, 0.0)) * _phi1_complex(np.where(small, wt, 0.0))
+    far = (np.exp(1j * omega * t) - np.exp(mu * t)) / np.where(small, 1.0, w)
+    return np.where(small, near, far)
+
+
 def step_response(lam: Array, c: Array, tau: Array) -> tuple[Array, Array]:
     """Response ``(q, q')`` to a unit force switched on at ``τ = 0`` from rest; 0 for ``τ < 0``."""
     lam, c, tau = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (lam, c, tau)))
@@ -126,6 +151,18 @@ def harmonic_response(lam: Array, c: Array, omega: float, phase: float, t: Array
     p11, p12, p21, p22 = propagator(lam, c, t)
     q = qp - (p11 * qp0 + p12 * vp0)
     v = vp - (p21 * qp0 + p22 * vp0)
+    # under-damped with ω_d >= ω/2: divided-difference Duhamel form, exact across resonance
+    a = 0.5 * c
+    wd2 = lam - a * a
+    dd = (lam > 0) & (wd2 >= 0.25 * lam)
+    if np.any(dd):
+        wd = np.sqrt(np.where(dd, wd2, 1.0))
+        mu_p, mu_m = -a + 1j * wd, -a - 1j * wd
+        e_p, e_m = _duhamel_exp(mu_p, omega, t), _duhamel_exp(mu_m, omega, t)
+        rot0 = np.exp(1j * phase)
+        den = 2j * wd
+        q = np.where(dd, np.imag(rot0 * (e_p - e_m) / den), q)
+        v = np.where(dd, np.imag(rot0 * (mu_p * e_p - mu_m * e_m) / den), v)
     return np.where(on, q, 0.0), np.where(on, v, 0.0)
 
 
