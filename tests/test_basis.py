@@ -112,7 +112,10 @@ def test_partition_of_unity_and_vanishing_derivatives(data, basis):
 def test_basis_values_are_non_negative_with_n_plus_one_non_zero(data, basis):
     x = unit_points(data.draw) * basis.length
     B = basis(x)
-    assert np.all(B >= -1e-15)
+    # Mathematically B >= 0; the recurrences evaluate each value with O(degree) roundings
+    # of O(1) terms, so round-off may leave a few ulps below zero (-1.2e-15 was seen at the
+    # right end of an open knot vector): allow 64 ulps of 1.
+    assert np.all(B >= -64 * np.finfo(float).eps)
     assert np.all((np.abs(B) > 1e-300).sum(axis=1) <= basis.degree + 1)
 
 
