@@ -10,6 +10,13 @@ scenario files while they are written; ``tests/test_scenario_schema.py`` validat
 example against it. The rules tying keys together (bending needs degree >= 2, t_off > t_on,
 ...) live in :mod:`.validate`.
 
+Why pydantic (v2) rather than msgspec: both validate and emit a JSON Schema, but pydantic's
+schema carries each field's ``description``, bounds and discriminators the way editors and
+``jsonschema`` read them, its errors report the location and the constraint broken (which
+:mod:`.checks` rewords with the file's line), and it is already the common dependency of
+the ASGI stack the sculpting server uses; msgspec's speed does not matter for files of a
+few hundred bytes.
+
 Extending
 ---------
 - a shape: one model with ``shape: Literal["name"]`` and its parameters, added to

@@ -29,7 +29,10 @@ class SurfaceSpec:
 
 @dataclass(frozen=True)
 class MaterialSpec:
-    """``[material]``: the :class:`~splinedeform.material.Material` arguments and the mass matrix."""
+    """``[material]``: the :class:`~splinedeform.material.Material` arguments and the mass.
+
+    The mass density ``mass`` scales the mass matrix.
+    """
 
     mass: float = 1.0
     damping: float = 0.0

@@ -7,9 +7,9 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping
 
 from .checks import Key, _Invalid
-from .keys import (STEP_METHODS, BOUNDARY_KEYS, FORMAT_ALIASES, FREE_REGION_KEYS, IVP_METHODS, LOAD_KEYS,
-                   LOAD_KIND_KEYS, MATERIAL_KEYS, PROFILE_KEYS, SHAPE_PARAMETERS, SOLVE_KEYS,
-                   SOLVE_KIND_KEYS, SURFACE_KEYS, TABLES, TOP_KEYS, OUTPUT_KEYS)
+from .keys import (STEP_METHODS, BOUNDARY_KEYS, FORMAT_ALIASES, FREE_REGION_KEYS, IVP_METHODS,
+                   LOAD_KEYS, LOAD_KIND_KEYS, MATERIAL_KEYS, PROFILE_KEYS, SHAPE_PARAMETERS,
+                   SOLVE_KEYS, SOLVE_KIND_KEYS, SURFACE_KEYS, TABLES, TOP_KEYS, OUTPUT_KEYS)
 from .locate import _describe, _Problems
 from .spec import (BoundarySpec, LoadSpec, MaterialSpec, OutputSpec, Scenario, SolveSpec,
                    SurfaceSpec)

@@ -8,7 +8,8 @@ from pathlib import Path
 from typing import Any, Iterable
 
 from ..boundary import EDGES
-from .keys import STEP_METHODS, IVP_METHODS, LOAD_KIND_KEYS, MATERIAL_KEYS, OUTPUT_KEYS, PROFILE_KEYS, TOP_KEYS
+from .keys import (STEP_METHODS, IVP_METHODS, LOAD_KIND_KEYS, MATERIAL_KEYS, OUTPUT_KEYS,
+                   PROFILE_KEYS, TOP_KEYS)
 from .spec import LoadSpec, Scenario, SolveSpec
 
 
