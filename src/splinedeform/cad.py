@@ -21,8 +21,13 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from .basis import BSplineBasis
 from .errors import InputError
-from .knots import KnotVectorBasis
+from .knots import KnotVectorBasis, RationalBasis
+from .surface import Basis, Surface
+
+#: relative tolerance for weights to count as a product ``a_i b_j`` (or as all equal)
+WEIGHT_TOL = 1e-12
 
 
 @dataclass(frozen=True)
@@ -53,6 +58,88 @@ class NurbsPatch:
         w = np.asarray(self.weights)
         num = np.einsum("ai,ij,ijk,bj->abk", Bu, w, self.points, Bv)
         return num / (Bu @ w @ Bv.T)[..., None]
+
+
+def refine(patch: NurbsPatch, splits: int) -> NurbsPatch:
+    """The same surface with every knot span split into ``splits`` equal spans.
+
+    Knot insertion in homogeneous coordinates ``(w P, w)``: the coarse B-splines lie in
+    the span of the fine ones, ``N_coarse = N_fine S``, and ``S`` is found by collocation
+    at the fine Greville points (exact up to round-off; Schoenberg–Whitney holds there).
+    The new weights stay a product ``a_i b_j`` when the old ones were.
+    """
+    if isinstance(splits, bool) or not isinstance(splits, (int, np.integer)) or splits < 1:
+        raise InputError(f"splits must be an integer >= 1, got {splits!r}")
+    maps = []
+    for n, knots in zip(patch.degrees, (patch.knots_u, patch.knots_v)):
+        coarse = KnotVectorBasis(n, knots)
+        br = coarse.breaks
+        new = (br[:-1, None] + np.diff(br)[:, None] * np.arange(1, splits) / splits).ravel()
+        fine = KnotVectorBasis(n, np.sort(np.concatenate([coarse.knots, new])))
+        g = fine.greville()
+        maps.append((fine, np.linalg.solve(fine(g), coarse(g))))
+    (fu, Su), (fv, Sv) = maps
+    w = np.asarray(patch.weights, dtype=float)
+    hom = np.concatenate([patch.points * w[..., None], w[..., None]], axis=-1)
+    hom = np.einsum("ai,ijc,bj->abc", Su, hom, Sv)
+    return NurbsPatch(patch.degrees, fu.knots, fv.knots, hom[..., :3] / hom[..., 3:],
+                      hom[..., 3])
+
+
+def surface_from_patch(patch: NurbsPatch, name: str = "cad surface",
+                       source: str = "NURBS patch") -> Surface:
+    """The deformable :class:`~splinedeform.surface.Surface` of a NURBS patch.
+
+    Knots are translated so the parameter domain starts at 0 (their spacing, hence the
+    parametrisation, is kept). Equal weights give polynomial :class:`KnotVectorBasis`
+    directions (exact Gram matrices). Otherwise the weights must be a product
+    ``w_ij = a_i b_j`` (surfaces of revolution, extrusions and ruled conics are): then
+    ``R_ij = R_i(u) R_j(v)`` with ``R_i = a_i N_i / Σ a_k N_k``, and the Kronecker
+    structure of the model survives. Other weights are refused.
+    """
+    bu = KnotVectorBasis(patch.degrees[0], patch.knots_u)
+    bv = KnotVectorBasis(patch.degrees[1], patch.knots_v)
+    bu, bv = bu.shifted(bu.domain[0]), bv.shifted(bv.domain[0])
+    a, b = weight_factors(np.asarray(patch.weights, dtype=float), source)
+    basis_u: Basis = bu if np.ptp(a) <= WEIGHT_TOL * a.max() else RationalBasis(bu, a)
+    basis_v: Basis = bv if np.ptp(b) <= WEIGHT_TOL * b.max() else RationalBasis(bv, b)
+    return Surface(np.asarray(patch.points, dtype=float), basis_u, basis_v, name=name)
+
+
+def weight_factors(w: NDArray[np.float64], source: str = "NURBS patch"
+                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Factors ``a, b`` with ``w = a bᵀ`` (one ``b_j`` is 1); refuse weights of higher rank."""
+    j = int(np.argmax(w.max(axis=0)))
+    a = w[:, j].copy()
+    b = w[int(np.argmax(a))] / a.max()
+    if np.abs(w - np.outer(a, b)).max() > WEIGHT_TOL * w.max():
+        raise InputError(f"{source}: its weights are not a product w_ij = a_i b_j (as for "
+                         "surfaces of revolution and extrusions); a surface with general "
+                         "weights cannot be deformed on the tensor-product model")
+    return a, b
+
+
+def patch_from_surface(surface: Surface, control_points: NDArray[np.float64] | None = None
+                       ) -> NurbsPatch:
+    """The NURBS patch of ``surface`` (or of another net ``control_points`` on its bases).
+
+    Open, uniform and general knot vectors are written as they are (Höllig's uniform
+    layout is an unclamped knot vector); a periodic direction is unwrapped into the
+    uniform layout on the same cells with its first ``n`` control points repeated at
+    the end. Weights are ``a_i b_j`` from rational directions, 1 elsewhere.
+    """
+    P = surface.control_points if control_points is None else np.asarray(control_points, float)
+    knots, weights = [], []
+    for axis, basis in enumerate((surface.basis_u, surface.basis_v)):
+        if isinstance(basis, BSplineBasis) and basis.periodic:
+            n, m = basis.degree, basis.cells
+            P = np.take(P, np.mod(np.arange(m + n) - n, m), axis=axis)
+            basis = BSplineBasis(n, m, basis.length, "uniform")
+        knots.append(np.asarray(basis.knots, dtype=float))
+        weights.append(np.asarray(basis.weights) if isinstance(basis, RationalBasis)
+                       else np.ones(basis.size))
+    return NurbsPatch((surface.basis_u.degree, surface.basis_v.degree), knots[0], knots[1],
+                      P, np.outer(*weights))
 
 
 def _rhino3dm():

@@ -86,6 +86,24 @@ class KnotVectorBasis:
     def periodic(self) -> bool:
         return False
 
+    #: layout name, as :attr:`splinedeform.basis.BSplineBasis.kind`
+    kind = "general"
+
+    @property
+    def length(self) -> float:
+        """Right end ``t_N`` of the domain; a :class:`~splinedeform.surface.Surface` needs
+        ``t_n = 0`` (its parameters run over ``[0, L]``), so this is ``L`` there."""
+        return float(self.breaks[-1])
+
+    @property
+    def cells(self) -> int:
+        """Number of non-empty knot spans."""
+        return self.breaks.size - 1
+
+    def shifted(self, origin: float) -> KnotVectorBasis:
+        """The same basis over the knots ``t_i - origin`` (domain moved by ``-origin``)."""
+        return KnotVectorBasis(self.degree, self.knots - origin)
+
     def greville(self) -> NDArray[np.float64]:
         """Greville abscissae ``ξ_k = (t_{k+1} + … + t_{k+n}) / n``."""
         n = self.degree
@@ -192,6 +210,17 @@ class RationalBasis:
     breaks = property(lambda self: self.basis.breaks)
     domain = property(lambda self: self.basis.domain)
     periodic = property(lambda self: False)
+    length = property(lambda self: self.basis.length)
+    cells = property(lambda self: self.basis.cells)
+    knots = property(lambda self: self.basis.knots)
+    kind = "rational"
+
+    def greville(self) -> NDArray[np.float64]:
+        """Greville abscissae of the polynomial basis (the weights do not move them)."""
+        return self.basis.greville()
+
+    def span(self, x: ArrayLike) -> NDArray[np.int64]:
+        return self.basis.span(x)
 
     def nonzero_derivatives(self, x: ArrayLike, max_derivative: int = 0
                             ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:

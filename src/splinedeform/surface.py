@@ -16,6 +16,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from .basis import BSplineBasis
 from .errors import InputError
+from .knots import KnotVectorBasis, RationalBasis
+
+#: the 1-D bases a surface composes: the fast layouts, a general knot vector, a weighted one
+Basis = BSplineBasis | KnotVectorBasis | RationalBasis
 
 
 @dataclass(frozen=True)
@@ -26,8 +30,10 @@ class Surface:
     ----------
     control_points : array_like, shape ``(n_u, n_v, 3)``
         The control net; ``n_u = basis_u.size`` and ``n_v = basis_v.size``.
-    basis_u, basis_v : BSplineBasis
-        The bases in the two parameter directions.
+    basis_u, basis_v : BSplineBasis, KnotVectorBasis or RationalBasis
+        The bases in the two parameter directions. A general knot vector must start its
+        domain at 0 (``t_n = 0``; see :meth:`KnotVectorBasis.shifted`). Two rational bases
+        with weights ``a_k`` and ``b_l`` make the NURBS surface with weights ``a_k b_l``.
     fit_error : float or None
         Maximum distance to the map the net was fitted to (set by :mod:`splinedeform.shapes`).
     name : str
@@ -35,13 +41,19 @@ class Surface:
     """
 
     control_points: NDArray[np.float64]
-    basis_u: BSplineBasis
-    basis_v: BSplineBasis
+    basis_u: Basis
+    basis_v: Basis
     fit_error: float | None = None
     name: str = "surface"
     _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
+        for name, basis in (("u", self.basis_u), ("v", self.basis_v)):
+            start = getattr(basis, "domain", (0.0,))[0]
+            if start != 0.0:
+                raise InputError(f"the parameter domain in {name} must start at 0, got a knot "
+                                 f"vector starting its domain at {start:g}; shift it "
+                                 "(KnotVectorBasis.shifted)")
         P = np.array(self.control_points, dtype=float)
         expected = (self.basis_u.size, self.basis_v.size, 3)
         if P.shape != expected:
