@@ -73,3 +73,78 @@ def test_report_markdown_escapes_a_hostile_title():
     first = text.splitlines()[0]
     assert "<img" not in text and first.startswith("# &lt;img")
     assert "\n# injected" not in text                 # a newline cannot start a new heading
+
+
+# -- periodic directions, coincident and complex point grids ---------------------------------
+@pytest.mark.parametrize("call, direction, gap", [
+    (lambda: sd.shapes.plane(size=(2.0, 1.0), knots="periodic"), "u", 2.0),
+    (lambda: sd.shapes.plane(size=(2.0, 1.0), knots=("open", "periodic")), "v", 1.0),
+    (lambda: sd.shapes.tile(angle=1.0, knots=("periodic", "open")), "u", 2 * np.sin(0.5)),
+    (lambda: sd.shapes.half_sphere(knots=("periodic", "periodic")), "v", np.sqrt(2.0)),
+    (lambda: sd.shapes.cylinder(height=3.0, knots="periodic"), "v", 3.0),
+])
+def test_a_periodic_direction_on_an_open_shape_is_refused_naming_direction_and_gap(call, direction, gap):
+    # The gap is a closed form of the shape (plane side, tile chord 2R sin(angle/2), the
+    # rim-to-pole chord R√2 of the half sphere, cylinder height), printed to 3 digits.
+    with pytest.raises(InputError) as info:
+        call()
+    message = str(info.value)
+    assert f"not closed in {direction}" in message
+    assert f"{gap:.3g} apart" in message
+
+
+@pytest.mark.parametrize("call", [
+    lambda: sd.shapes.cylinder(cells=(8, 4)),
+    lambda: sd.shapes.torus(cells=(8, 6)),
+    lambda: sd.shapes.half_sphere(cells=(8, 4)),
+])
+def test_closed_shapes_keep_their_periodic_knots(call):
+    assert call().basis_u.periodic
+
+
+def test_a_periodic_point_grid_must_go_round():
+    u = np.linspace(0.0, 1.0, 12)
+    grid = np.stack(np.broadcast_arrays(u[:, None], u[None, :], 0.0 * u[:, None]), -1)
+    with pytest.raises(InputError, match=r"point grid is not closed in u: .* 1 apart"):
+        sd.shapes.from_points(grid, cells=(5, 4), knots=("periodic", "open"))
+
+
+@pytest.mark.parametrize("grid, words", [
+    (np.zeros((6, 6, 3)), "all 36 points coincide"),
+    (np.ones((5, 7, 3)) * [1.0, 2.0, 3.0], "all 35 points coincide"),
+])
+def test_coincident_points_are_refused(grid, words):
+    with pytest.raises(InputError, match=words):
+        sd.shapes.from_points(grid, cells=2, degree=2)
+
+
+def test_a_repeated_row_of_a_point_grid_is_refused_naming_it():
+    u = np.array([0.0, 0.25, 0.5, 0.5, 1.0])
+    v = np.linspace(0.0, 1.0, 5)
+    grid = np.stack(np.broadcast_arrays(u[:, None], v[None, :], 0.0 * u[:, None]), -1)
+    with pytest.raises(InputError, match=r"rows 2 and 3 \(u direction\) coincide"):
+        sd.shapes.from_points(grid, cells=2, degree=2)
+    with pytest.raises(InputError, match=r"columns 2 and 3 \(v direction\) coincide"):
+        sd.shapes.from_points(grid.transpose(1, 0, 2)[..., [1, 0, 2]], cells=2, degree=2)
+
+
+def test_a_pole_row_is_not_a_coincidence():
+    # a half sphere sampled on a grid: its last column is the pole, all points equal
+    t, p = np.linspace(0, 2 * np.pi, 17), np.linspace(0, np.pi / 2, 6)
+    grid = np.stack([np.cos(p)[None, :] * np.cos(t)[:, None], np.cos(p)[None, :] * np.sin(t)[:, None],
+                     np.broadcast_to(np.sin(p)[None, :], (17, 6))], -1)
+    surf = sd.shapes.from_points(grid, cells=(8, 3), knots=("periodic", "open"),
+                                 domain=((0, 2 * np.pi), (0, np.pi / 2)))
+    assert surf.fit_error < 0.05
+
+
+def test_complex_input_is_refused_not_truncated():
+    u = np.linspace(0.0, 1.0, 6)
+    grid = np.stack(np.broadcast_arrays(u[:, None], u[None, :], 0.0 * u[:, None]), -1)
+    with pytest.raises(InputError, match="complex"):
+        sd.shapes.from_points(grid + 1j, cells=2, degree=2)
+    with pytest.raises(InputError, match="complex"):
+        sd.shapes.from_function(lambda a, b: np.stack([a, b, 1j * a], -1), cells=2, degree=2)
+    surf = sd.shapes.plane(cells=2, degree=2)
+    with pytest.raises(InputError, match="complex"):
+        sd.Surface(surf.control_points + 0j, surf.basis_u, surf.basis_v)

@@ -96,8 +96,9 @@ def _check_method(method: str, allowed: tuple[str, ...] = FIT_METHODS) -> str:
 def _knot_kinds(knots: Any) -> tuple[str, str]:
     """Resolve ``knots`` (one layout or a pair) into ``(kind_u, kind_v)``.
 
-    Any layout is accepted in any direction: ``"periodic"`` in a direction where the map
-    is not closed closes the surface up, and the mismatch shows in ``fit_error``.
+    Any layout is accepted in any direction here; ``"periodic"`` additionally needs the
+    map (or point grid) to be closed in that direction, which :func:`_check_closed` and
+    :func:`_check_grid_closed` verify once the map is known.
     """
     kinds = _pair(knots, "knots")
     for direction, kind in zip("uv", kinds):
@@ -128,7 +129,11 @@ def _sample_map(f: Map, u: NDArray[np.float64], v: NDArray[np.float64],
     """``f`` on the tensor grid ``u × v`` (shifted by ``origin``) as ``(len(u), len(v), 3)``."""
     U, V = np.meshgrid(origin[0] + u, origin[1] + v, indexing="ij")
     try:
-        X = np.asarray(f(U, V), dtype=float)
+        values = f(U, V)
+        if np.iscomplexobj(values):
+            raise InputError("the map f(u, v) returned complex values; a surface is real "
+                             "(take .real explicitly if the imaginary part is meant to go)")
+        X = np.asarray(values, dtype=float)
     except InputError:
         raise
     except Exception as exc:  # the user's map failed: say so without a deep traceback
@@ -289,7 +294,7 @@ def from_function(f: Map, cells: int | tuple[int, int] = DEFAULT_CELLS, degree: 
         Polynomial degree ``n >= 1`` in both directions.
     knots : str or (str, str)
         ``"open"``, ``"uniform"`` or ``"periodic"`` per direction. ``"periodic"`` needs
-        ``f`` periodic over that side of ``domain``.
+        ``f`` periodic over that side of ``domain`` (refused, naming the gap, otherwise).
     domain : ((a, b), (c, d))
         Where ``f`` is sampled. The surface's own parameters are ``[0, b-a] × [0, d-c]``:
         surface parameter ``(u, v)`` is ``f``'s ``(a + u, c + v)``.
@@ -329,8 +334,40 @@ def _domain(domain: Any) -> Domain:
     return (a, b), (c, d)
 
 
+#: a periodic direction is closed when the seam gap is below this fraction of the extent
+CLOSURE_TOLERANCE = 1e-8
+
+
+def _check_closed(f: Map, basis_u: BSplineBasis, basis_v: BSplineBasis,
+                  origin: tuple[float, float] = (0.0, 0.0)) -> None:
+    """Refuse a periodic direction in which ``f`` is not closed.
+
+    Closed in ``u`` means ``x(0, v) = x(L_u, v)`` for every ``v``: the gap
+    ``max_v |f(u0 + L_u, v) - f(u0, v)|`` (on :func:`error_samples`) must stay below
+    ``CLOSURE_TOLERANCE`` times the extent of the sampled map; likewise in ``v``.
+    """
+    if not (basis_u.periodic or basis_v.periodic):
+        return
+    u, v = error_samples(basis_u), error_samples(basis_v)
+    X = _sample_map(f, u, v, origin)
+    extent = float(np.ptp(X.reshape(-1, 3), axis=0).max())
+    for axis, (basis, other, names) in enumerate(((basis_u, v, "uv"), (basis_v, u, "vu"))):
+        if not basis.periodic:
+            continue
+        gaps = np.linalg.norm(np.take(X, -1, axis=axis) - np.take(X, 0, axis=axis), axis=-1)
+        worst = int(np.argmax(gaps))
+        if gaps[worst] > CLOSURE_TOLERANCE * max(extent, np.finfo(float).tiny):
+            d, o = names
+            raise InputError(
+                f"knots in {d} are 'periodic' but the shape is not closed in {d}: x({d} = 0) "
+                f"and x({d} = {basis.length:g}) are {gaps[worst]:.3g} apart at {o} = "
+                f"{other[worst]:g} (shape extent {extent:.3g}); use 'open' or 'uniform' knots "
+                f"in {d}, or a map that is periodic over that side")
+
+
 def _fitted(f: Map, basis_u: BSplineBasis, basis_v: BSplineBasis, method: str, name: str,
             origin: tuple[float, float] = (0.0, 0.0)) -> Surface:
+    _check_closed(f, basis_u, basis_v, origin)
     P = fit_control_points(f, basis_u, basis_v, method, origin)
     surface = Surface(P, basis_u, basis_v, name=name)
     return Surface(P, basis_u, basis_v, fit_error=fit_error(surface, f, origin), name=name)
@@ -367,7 +404,14 @@ def from_points(grid: ArrayLike, cells: int | tuple[int, int] = DEFAULT_CELLS, d
         parameters and the given points.
     """
     _check_method(method, POINT_METHODS)
-    X = np.asarray(grid, dtype=float)
+    if np.iscomplexobj(grid):
+        raise InputError("point grid is complex; a surface is real (take .real explicitly if "
+                         "the imaginary part is meant to go)")
+    try:
+        X = np.asarray(grid, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"a point grid must be an array of real numbers of shape "
+                         f"(N_u, N_v, 3): {exc}") from None
     if X.ndim != 3 or X.shape[2] != 3 or X.shape[0] < 2 or X.shape[1] < 2:
         raise InputError(f"a point grid must have shape (N_u, N_v, 3) with N_u, N_v >= 2, "
                          f"got {X.shape}")
@@ -381,10 +425,54 @@ def from_points(grid: ArrayLike, cells: int | tuple[int, int] = DEFAULT_CELLS, d
     X, v = _grid_parameters(X, bv, axis=1)
     Au = _least_squares_operator(bu, u, method, "u")
     Av = _least_squares_operator(bv, v, method, "v")
+    _check_distinct(X)
+    _check_grid_closed(X, bu, bv)
     P = _apply_both(Au, Av, X)
     surface = Surface(P, bu, bv, name=name or "points")
     error = float(np.linalg.norm(surface.evaluate_grid(u, v) - X, axis=-1).max())
     return Surface(P, bu, bv, fit_error=error, name=surface.name)
+
+
+def _check_distinct(X: NDArray[np.float64]) -> None:
+    """Refuse a grid of coincident points: all in one place, or a row/column repeated.
+
+    A row ``X[i]`` equal to ``X[i + 1]`` (every point of it) gives two samples at different
+    parameters at one place, so ``x_u = 0`` all along it; a single degenerate row (a pole,
+    its points coinciding with each other) is allowed.
+    """
+    extent = float(np.ptp(X.reshape(-1, 3), axis=0).max())
+    if extent == 0.0:
+        raise InputError(f"point grid: all {X.shape[0] * X.shape[1]} points coincide at "
+                         f"{X[0, 0].tolist()}; a surface needs points spread over an area")
+    for axis, direction in ((0, "u"), (1, "v")):
+        step = np.abs(np.diff(X, axis=axis)).max(axis=(1 - axis, 2))
+        same = np.flatnonzero(step <= 1e-14 * extent)
+        if same.size:
+            i = int(same[0])
+            what = "rows" if axis == 0 else "columns"
+            raise InputError(f"point grid: {what} {i} and {i + 1} ({direction} direction) "
+                             f"coincide point for point; remove the repeated samples")
+
+
+def _check_grid_closed(X: NDArray[np.float64], basis_u: BSplineBasis,
+                       basis_v: BSplineBasis) -> None:
+    """Refuse a periodic direction on an open grid (seam already dropped).
+
+    The step from the last sample back to the first must look like any other step: it
+    may not exceed 3 times the largest step between neighbouring samples.
+    """
+    for axis, basis, direction in ((0, basis_u, "u"), (1, basis_v, "v")):
+        if not basis.periodic:
+            continue
+        steps = np.linalg.norm(np.diff(X, axis=axis), axis=-1).max()
+        gap = np.linalg.norm(np.take(X, 0, axis=axis) - np.take(X, -1, axis=axis),
+                             axis=-1).max()
+        if gap > 3 * steps:
+            raise InputError(
+                f"knots in {direction} are 'periodic' but the point grid is not closed in "
+                f"{direction}: its last and first samples are {gap:.3g} apart, against at "
+                f"most {steps:.3g} between neighbours; use 'open' or 'uniform' knots in "
+                f"{direction}, or a grid that goes round")
 
 
 def _grid_parameters(X: NDArray[np.float64], basis: BSplineBasis, axis: int

@@ -54,6 +54,9 @@ class Surface:
                 raise InputError(f"the parameter domain in {name} must start at 0, got a knot "
                                  f"vector starting its domain at {start:g}; shift it "
                                  "(KnotVectorBasis.shifted)")
+        if np.iscomplexobj(self.control_points):
+            raise InputError("control points are complex; a surface is real (take .real "
+                             "explicitly if the imaginary part is meant to go)")
         P = np.array(self.control_points, dtype=float)
         expected = (self.basis_u.size, self.basis_v.size, 3)
         if P.shape != expected:

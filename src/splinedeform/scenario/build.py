@@ -49,8 +49,19 @@ def build_surface(scenario: Scenario) -> Any:
         return _surface_from_file(scenario)
     from .. import shapes
 
-    with _located(scenario, "surface"):
+    with _located(scenario, "surface"), _periodic_at_knots(scenario):
         return getattr(shapes, spec.shape)(**spec.parameters, **_fit_options(spec))
+
+
+@contextmanager
+def _periodic_at_knots(scenario: Scenario) -> Iterator[None]:
+    """A periodic direction refused on an open shape is located at ``surface.knots``."""
+    try:
+        yield
+    except InputError as exc:
+        if "'periodic' but" in str(exc) and "knots" in scenario.raw.get("surface", {}):
+            raise scenario.error("surface.knots", str(exc)) from None
+        raise
 
 
 def _fit_options(spec: SurfaceSpec) -> dict[str, Any]:
