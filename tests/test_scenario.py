@@ -197,10 +197,11 @@ def file_scenario(path: str, extra: str = "") -> str:
 
 
 SHAPE_TEXTS = {shape: shape_scenario(shape, {k: key.default for k, key in params.items()})
-               for shape, params in SHAPE_PARAMETERS.items() if shape != "file"}
+               for shape, params in SHAPE_PARAMETERS.items() if shape not in ("file", "cad")}
 FILE_TEXTS = [file_scenario("net.json", "frame = 0"),
               file_scenario("grid.npy", 'cells = 3\ndegree = 2\nknots = ["open", "open"]\n'
-                                        'method = "l2"')]
+                                        'method = "l2"'),
+              file_scenario("patch.3dm", "face = 1").replace('"file"', '"cad"')]
 
 
 def all_test_texts() -> list[str]:
@@ -495,7 +496,7 @@ def test_shape_parameters_match_the_shape_functions(shapes):
     import inspect
 
     for shape, params in SHAPE_PARAMETERS.items():
-        if shape == "file":
+        if shape in ("file", "cad"):
             continue
         signature = inspect.signature(getattr(shapes, shape)).parameters
         # knots_v of the cylinder is covered by knots (a single layout sets v for a cylinder)

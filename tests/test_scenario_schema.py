@@ -81,7 +81,8 @@ def test_models_and_reader_keys_agree_key_for_key():
     for model in S.SHAPE_MODELS:
         shape = model.model_fields["shape"].annotation.__args__[0]
         own = fields(model, without=fitted | {"shape"})
-        expected = set(SHAPE_PARAMETERS[shape]) | ({"path", "frame"} if shape == "file" else set())
+        expected = set(SHAPE_PARAMETERS[shape]) | {"file": {"path", "frame"},
+                                                   "cad": {"path"}}.get(shape, set())
         assert set(own) == expected, shape
         same_defaults(own, {**SHAPE_PARAMETERS[shape], **SURFACE_KEYS}, own)
     assert {m.model_fields["shape"].annotation.__args__[0] for m in S.SHAPE_MODELS} == \

@@ -142,6 +142,23 @@ def patch_from_surface(surface: Surface, control_points: NDArray[np.float64] | N
                       P, np.outer(*weights))
 
 
+#: CAD file suffixes and what reads them
+CAD_SUFFIXES = {".3dm": "openNURBS", ".igs": "IGES", ".iges": "IGES", ".stp": "STEP",
+                ".step": "STEP"}
+
+
+def read_cad(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
+    """Surface number ``face`` of a CAD file, chosen by its suffix (see :data:`CAD_SUFFIXES`)."""
+    path = Path(path)
+    kind = CAD_SUFFIXES.get(path.suffix.lower())
+    if kind is None:
+        raise InputError(f"{path}: not a CAD file (expected one of "
+                         f"{', '.join(CAD_SUFFIXES)}), got suffix {path.suffix or 'none'!r}")
+    if kind == "openNURBS":
+        return read_3dm(path, face)
+    raise InputError(f"{path}: {kind} files are not read yet; convert the surface to .3dm")
+
+
 def _rhino3dm():
     try:
         import rhino3dm

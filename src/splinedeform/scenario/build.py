@@ -47,6 +47,8 @@ def build_surface(scenario: Scenario) -> Any:
     spec = scenario.surface
     if spec.shape == "file":
         return _surface_from_file(scenario)
+    if spec.shape == "cad":
+        return _surface_from_cad(scenario)
     from .. import shapes
 
     with _located(scenario, "surface"), _periodic_at_knots(scenario):
@@ -72,6 +74,19 @@ def _fit_options(spec: SurfaceSpec) -> dict[str, Any]:
     if spec.knots is not None:
         options["knots"] = spec.knots
     return options
+
+
+def _surface_from_cad(scenario: Scenario) -> Any:
+    """Surface ``face`` of a CAD file, as a deformable NURBS surface (trimming dropped)."""
+    from ..cad import read_cad, surface_from_patch
+
+    path = scenario.surface.path
+    assert path is not None
+    face = scenario.surface.parameters["face"]
+    with _located(scenario, "surface.path"):
+        patch = read_cad(path, face)
+        return surface_from_patch(patch, name=f"{path.stem} face {face}",
+                                  source=f"{path} face {face}")
 
 
 def _surface_from_file(scenario: Scenario) -> Any:

@@ -40,8 +40,8 @@ SHAPE_PARAMETERS: dict[str, dict[str, Key]] = {
     for shape, model in zip(SHAPES, S.SHAPE_MODELS)}
 
 SURFACE_KEYS: dict[str, Key] = {
-    "shape": Key(choice(*SHAPES), doc="a built-in shape, or a control net / point grid read "
-                                      "from `path`"),
+    "shape": Key(choice(*SHAPES), doc="a built-in shape, or a control net / point grid "
+                                      "(`file`) or a CAD surface (`cad`) read from `path`"),
     **_keys(S.FromFile, (*_FITTED, "path", "frame"), path=None),
 }
 

@@ -137,15 +137,27 @@ class FromFile(_Fitted):
         description=(
             "`.json` / `.npz` control net written by `splinedeform` (`output.formats` "
             "`json`/`npz`), or a point grid `(N_u, N_v, 3)` in `.npy` (or `.npz` with one array "
-            "or an array `points`); relative to the scenario file, and inside its folder (see "
-            "below)"),
-        json_schema_extra={"doc_default": "required for `file`"})
+            "or an array `points`); for `cad` an openNURBS `.3dm` file; relative to the "
+            "scenario file, and inside its folder (see below)"),
+        json_schema_extra={"doc_default": "required for `file` and `cad`"})
     frame: Integer = Field(-1, description=(
             "which frame of a control net file (negative counts from the end)"))
 
 
+class FromCad(_Table):
+    shape: Literal["cad"]
+    path: Text = Field(
+        description=(
+            "CAD file holding NURBS surfaces: openNURBS `.3dm` (the `cad` extra); relative to "
+            "the scenario file, and inside its folder (as for `file`)"),
+        json_schema_extra={"doc_default": "required for `cad`"})
+    face: Annotated[int, Strict(), Field(ge=0)] = Field(0, description=(
+            "which surface of the file, counting plain surfaces and Brep faces in file "
+            "order from 0; a trimmed face is taken untrimmed, with a warning"))
+
+
 #: every ``surface.shape``; a new shape is one model here
-SHAPE_MODELS = (Plane, Tile, HalfSphere, Cylinder, Torus, Saddle, FromFile)
+SHAPE_MODELS = (Plane, Tile, HalfSphere, Cylinder, Torus, Saddle, FromFile, FromCad)
 SHAPES = tuple(m.model_fields["shape"].annotation.__args__[0] for m in SHAPE_MODELS)
 Surface = Annotated[Union[SHAPE_MODELS], Field(discriminator="shape")]  # type: ignore[valid-type]
 

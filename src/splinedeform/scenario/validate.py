@@ -121,9 +121,15 @@ def _validate_surface(raw: Mapping[str, Any], problems: _Problems,
     if shape == "file":
         _require(values, table, ["path"], SURFACE_KEYS, "surface", problems,
                  " (shape = \"file\" reads the net or grid from this file)")
+    elif shape == "cad":
+        _require(values, table, ["path"], SURFACE_KEYS, "surface", problems,
+                 " (shape = \"cad\" reads a NURBS surface from this file)")
+        _not_applicable(table, ["frame", "cells", "degree", "knots", "method"], [], "surface",
+                        problems, "to shape \"cad\" (the file holds the surface's own "
+                                  "degrees, knots and weights)")
     else:
         _not_applicable(table, ["path", "frame"], [], "surface", problems,
-                        f"to shape {shape!r}, only to shape = \"file\"")
+                        f"to shape {shape!r}, only to shape = \"file\" (path also to \"cad\")")
     spec = _with_defaults(SURFACE_KEYS, values, [k for k in SURFACE_KEYS if k != "shape"])
     if spec.get("path") is not None:
         spec["path"] = _inside(directory, spec["path"], allow_outside_paths, problems)
@@ -159,7 +165,8 @@ def _validate_material(raw: Mapping[str, Any], problems: _Problems,
                                  "would have no elastic energy; set a tension weight (w10, "
                                  "w01) or a bending weight (w20, w11, w02) > 0")
     bending = spec.w20 > 0 or spec.w11 > 0 or spec.w02 > 0
-    if bending and surface is not None and surface.shape != "file" and surface.degree < 2:
+    if (bending and surface is not None and surface.shape not in ("file", "cad")
+            and surface.degree < 2):
         problems.add("surface.degree", "bending weights (w20, w11, w02) need second "
                                        "derivatives: degree must be >= 2")
     return spec

@@ -77,6 +77,8 @@ def scenario_to_toml(scenario: Scenario) -> str:
         items += [("path", surface.path)]
         items += [item for item in fitted if grid or item[0] in given]
         items += [("frame", surface.frame)] if "frame" in given else []
+    elif surface.shape == "cad":
+        items += [("path", surface.path)]
     else:
         items += fitted
     out += _toml_table("[surface]", items)
