@@ -174,10 +174,41 @@ def test_info_names_version_extras_and_examples():
     for dist in ("meshio", "matplotlib", "imageio-ffmpeg", "pyvista"):
         assert dist in result.stdout
     examples = cli.examples_directory()
-    assert examples is not None and str(examples) in result.stdout
+    assert examples is not None and _unwrapped(str(examples)) in _unwrapped(result.stdout)
+
+
+def _unwrapped(text: str) -> str:
+    """Text without table borders and line breaks (long values wrap inside their cell)."""
+    return "".join(ch for ch in text if ch not in "│┃┌┐└┘├┤┬┴┼─ \n")
+
+
+def test_info_fits_in_100_columns(monkeypatch):
+    monkeypatch.setattr(cli, "examples_directory",       # a deep checkout: paths wrap
+                        lambda: Path("/" + "/".join(["a-rather-long-folder-name"] * 8)))
+    result = runner.invoke(cli.app, ["info"])
+    assert result.exit_code == 0
+    widths = [len(line) for line in result.stdout.splitlines()]
+    assert max(widths) <= cli.INFO_WIDTH, max(widths)
+    assert "example files" in result.stdout
+
+
+def test_version_prints_the_version():
+    result = runner.invoke(cli.app, ["--version"])
+    assert result.exit_code == 0 and result.stdout == f"splinedeform {__version__}\n"
+
+
+@pytest.mark.parametrize("command", [[], ["run"], ["demo"], ["validate"], ["schema"], ["info"],
+                                     ["bench"]])
+def test_help_shows_flags_bare(command):
+    result = runner.invoke(cli.app, [*command, "--help"])
+    assert result.exit_code == 0, result.output
+    assert "<bool>" not in result.stdout
+    if command in (["run"], ["demo"], ["bench"]):
+        assert "--quiet" in result.stdout
 
 
 def test_bench_is_forwarded_when_the_module_exists(monkeypatch, tmp_path):
+    importlib.import_module("splinedeform.bench_goals")   # reads the real bench on import
     calls = []
     fake = types.ModuleType("splinedeform.bench")
     fake.__spec__ = importlib.machinery.ModuleSpec("splinedeform.bench", None)
@@ -230,3 +261,41 @@ def test_physics_option_selects_the_energy_and_names_a_bad_value(scenario, tmp_p
     result = runner.invoke(cli.app, ["run", str(scenario), "--physics", "shell", "-q"])
     assert result.exit_code == 2
     assert "tiny.toml (--physics): material.physics: expected one of" in result.stderr
+
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+@pytest.mark.parametrize("name, method, dropped", [
+    ("torus_point_rk45", "analytic", ["solve.rtol", "solve.atol"]),
+    ("saddle_gravity_newmark", "analytic", ["solve.dt"]),
+    ("saddle_gravity_newmark", "rk45", ["solve.dt"]),
+    ("torus_point_rk45", "newmark", ["solve.rtol", "solve.atol"]),
+    ("torus_point_rk45", "dop853", []),                  # rtol/atol apply to both
+])
+def test_method_override_drops_the_settings_of_the_old_method(name, method, dropped):
+    from splinedeform.scenario import load_scenario, with_method
+
+    scenario, removed = with_method(load_scenario(EXAMPLES / f"{name}.toml"), method)
+    assert removed == dropped
+    assert scenario.solve.method == method
+    assert not set(k.split(".")[1] for k in dropped) & set(scenario.raw["solve"])
+
+
+def test_method_override_of_an_example_runs_and_says_what_it_dropped(tmp_path):
+    out = tmp_path / "out"
+    args = ["run", str(EXAMPLES / "torus_point_rk45.toml"), "-o", str(out), "--frames", "3",
+            "--method", "analytic"]
+    result = runner.invoke(cli.app, args)
+    assert result.exit_code == 0, result.output
+    notes = [line for line in result.stderr.splitlines() if "dropped" in line]
+    assert len(notes) == 1
+    assert "solve.rtol, solve.atol" in notes[0] and "'rk45'" in notes[0]
+    assert json.loads((out / "report.json").read_text())["solver"]["method"] == "analytic"
+    quiet = runner.invoke(cli.app, args + ["--quiet"])
+    assert quiet.exit_code == 0 and quiet.stderr == "" and quiet.stdout == ""
+
+
+def test_unknown_method_is_refused_not_dropped(scenario):
+    result = runner.invoke(cli.app, ["run", str(scenario), "--method", "euler"])
+    assert result.exit_code == 2 and "dropped" not in result.stderr

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any, Iterator, Optional
 
 import typer
+from typer.core import TyperCommand, TyperGroup
 
 from . import __version__
 from .errors import InputError
@@ -38,12 +39,46 @@ OPTIONAL = {
     "playwright": ("playwright", "viewer test in a headless browser"),
 }
 
-app = typer.Typer(name="splinedeform", no_args_is_help=True, add_completion=False,
+
+
+class _BareFlags:
+    """Help lists on/off flags bare (``--quiet``), without a value type (``<bool>``)."""
+
+    def get_params(self, ctx: Any) -> list[Any]:
+        params: list[Any] = super().get_params(ctx)  # type: ignore[misc]
+        for param in params:
+            if getattr(param, "is_flag", False) and getattr(param, "metavar", None) is None:
+                param.metavar = ""
+        return params
+
+
+class _Command(_BareFlags, TyperCommand):
+    """A command whose help shows flags bare."""
+
+
+class _Group(_BareFlags, TyperGroup):
+    """The command group, its help showing flags bare."""
+
+
+app = typer.Typer(name="splinedeform", cls=_Group, no_args_is_help=True, add_completion=False,
                   pretty_exceptions_enable=False,
                   help="Physical deformation of B-spline surfaces, solved analytically.")
 
-SCENARIO_ARG = typer.Argument(..., help="Scenario file (TOML), see docs/scenario.md.",
-                              show_default=False)
+
+def _print_version(value: bool) -> None:
+    if value:
+        typer.echo(f"splinedeform {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _options(version: bool = typer.Option(False, "--version", is_eager=True,
+                                          callback=_print_version,
+                                          help="Print the version and exit.")) -> None:
+    """Physical deformation of B-spline surfaces, solved analytically."""
+
+SCENARIO_ARG = typer.Argument(..., metavar="SCENARIO.toml", show_default=False,
+                              help="Scenario file (TOML), see docs/scenario.md.")
 OUTDIR_OPT = typer.Option(None, "-o", "--outdir", help="Output folder (created if missing). "
                                                        "[default: <scenario name>-output]")
 QUIET_OPT = typer.Option(False, "--quiet", "-q", help="Print nothing but errors.")
@@ -60,6 +95,10 @@ def _consoles() -> tuple[Any, Any]:
     out_width = None if sys.stdout.isatty() else 250
     err_width = None if sys.stderr.isatty() else 120
     return Console(width=out_width), Console(stderr=True, width=err_width)
+
+
+#: widest line of ``splinedeform info`` (long values wrap inside their cell)
+INFO_WIDTH = 100
 
 
 @contextmanager
@@ -117,7 +156,7 @@ def _run(scenario: Any, outdir: Path, quiet: bool) -> None:
                          summary_rows(result)))
 
 
-@app.command("run")
+@app.command("run", cls=_Command)
 def run_command(scenario: Path = SCENARIO_ARG, outdir: Optional[Path] = OUTDIR_OPT,
                 method: Optional[str] = typer.Option(
                     None, "--method", help="Override solve.method: analytic, newmark, radau3, "
@@ -131,12 +170,18 @@ def run_command(scenario: Path = SCENARIO_ARG, outdir: Optional[Path] = OUTDIR_O
                 allow_outside_paths: bool = OUTSIDE_OPT,
                 quiet: bool = QUIET_OPT, debug: bool = DEBUG_OPT) -> None:
     """Run a scenario file: build, solve, sample frames and write its outputs."""
-    from .scenario import load_scenario, with_overrides
+    from .scenario import load_scenario, with_method, with_overrides
 
     with _reported_errors(debug):
         loaded = load_scenario(scenario, allow_outside_paths=allow_outside_paths)
         if method is not None:
-            loaded = with_overrides(loaded, {"solve.method": method}, origin="--method")
+            old = loaded.solve.method
+            loaded, dropped = with_method(loaded, method, origin="--method")
+            if dropped and not quiet:
+                _, err = _consoles()
+                err.print(f"--method {_escape(method)}: dropped {', '.join(dropped)} of "
+                          f"{_escape(str(scenario))} (settings of method {old!r}, not used by "
+                          f"{_escape(method)})", highlight=False, soft_wrap=True)
         if frames is not None:
             loaded = with_overrides(loaded, {"solve.frames": frames, "solve.times": None},
                                     origin="--frames")
@@ -153,7 +198,7 @@ def demo_scenario() -> Any:
     return parse_scenario(text, source="demo.toml")
 
 
-@app.command("demo")
+@app.command("demo", cls=_Command)
 def demo_command(outdir: Path = typer.Option(Path("demo-output"), "-o", "--outdir",
                                              help="Output folder (created if missing)."),
                  quiet: bool = QUIET_OPT, debug: bool = DEBUG_OPT) -> None:
@@ -162,7 +207,7 @@ def demo_command(outdir: Path = typer.Option(Path("demo-output"), "-o", "--outdi
         _run(demo_scenario(), outdir, quiet)
 
 
-@app.command("validate")
+@app.command("validate", cls=_Command)
 def validate_command(scenario: Path = SCENARIO_ARG, allow_outside_paths: bool = OUTSIDE_OPT,
                      debug: bool = DEBUG_OPT) -> None:
     """Check a scenario file and print what it would run (with every default filled in)."""
@@ -176,7 +221,7 @@ def validate_command(scenario: Path = SCENARIO_ARG, allow_outside_paths: bool = 
         out.print(scenario_to_toml(loaded), markup=False, highlight=False)
 
 
-@app.command("schema")
+@app.command("schema", cls=_Command)
 def schema_command() -> None:
     """Print the JSON Schema of scenario files (for editors: see docs/scenario.md)."""
     import json
@@ -213,10 +258,13 @@ def _optional_rows() -> list[tuple[str, str]]:
     return rows
 
 
-@app.command("info")
+@app.command("info", cls=_Command)
 def info_command() -> None:
     """Version, optional extras that import, and where the examples live."""
-    out, _ = _consoles()
+    from rich.console import Console
+
+    terminal = Console().width if sys.stdout.isatty() else INFO_WIDTH
+    out = Console(width=min(terminal, INFO_WIDTH))
     examples = examples_directory()
     rows = [("splinedeform", __version__),
             ("python", f"{platform.python_version()} ({sys.executable})"),
@@ -239,7 +287,7 @@ def _register_bench() -> None:
     if not available:
         return
 
-    @app.command("bench")
+    @app.command("bench", cls=_Command)
     def bench_command(sizes: Optional[str] = typer.Option(
                           None, "--sizes", help="Comma-separated net sizes, e.g. 8,16,32."),
                       quick: bool = typer.Option(False, "--quick", help="A short run."),

@@ -46,7 +46,7 @@ from .keys import (FORMAT_ALIASES, FORMATS, IVP_METHODS, LOAD_KIND_KEYS, LOAD_KI
                    MASS_MATRICES, PROFILE_KEYS, PROFILES, SHAPE_PARAMETERS, SHAPES,
                    SOLVE_KIND_KEYS, SOLVE_KINDS, TABLES, TOP_KEYS, documented_keys)
 from .locate import key_lines
-from .read import load_scenario, parse_scenario, with_overrides
+from .read import load_scenario, parse_scenario, with_method, with_overrides
 from .spec import (BoundarySpec, LoadSpec, MaterialSpec, OutputSpec, Scenario, SolveSpec,
                    SurfaceSpec)
 from .write import _toml_value, scenario_to_toml
@@ -54,4 +54,4 @@ from .write import _toml_value, scenario_to_toml
 __all__ = ["Built", "Key", "Scenario", "SurfaceSpec", "MaterialSpec", "BoundarySpec", "LoadSpec",
            "SolveSpec", "OutputSpec", "build", "build_load", "build_surface", "describe",
            "documented_keys", "free_region_mask", "key_lines", "load_scenario",
-           "parse_scenario", "scenario_to_toml", "with_overrides"]
+           "parse_scenario", "scenario_to_toml", "with_method", "with_overrides"]

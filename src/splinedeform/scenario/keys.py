@@ -75,6 +75,12 @@ SOLVE_KEYS: dict[str, Key] = {
     **_keys(S.DynamicSolve, tuple(n for n in S.DynamicSolve.model_fields if n != "kind")),
 }
 
+#: keys of [solve] that only some methods use: key -> the methods that use it
+METHOD_SETTINGS: dict[str, tuple[str, ...]] = {
+    "rtol": IVP_METHODS, "atol": IVP_METHODS, "dt": STEP_METHODS,
+    "function_samples": ("analytic",),
+}
+
 #: keys of [solve] used by each kind
 SOLVE_KIND_KEYS = {kind: tuple(n for n in model.model_fields if n != "kind")
                    for kind, model in zip(SOLVE_KINDS, S.SOLVE_MODELS)}

@@ -9,6 +9,8 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from ..errors import InputError, ScenarioError
+from ..model import METHODS
+from .keys import METHOD_SETTINGS
 from .locate import MAX_NESTING, key_lines, nesting_too_deep
 from .spec import Scenario
 from .validate import _validate
@@ -87,6 +89,31 @@ def with_overrides(scenario: Scenario, overrides: Mapping[str, Any],
     origins = {**scenario.origins, **{key: origin for key in overrides}}
     return _validate(raw, scenario.source, scenario.lines, origins, scenario.directory,
                      scenario.allow_outside_paths)
+
+
+def with_method(scenario: Scenario, method: str, origin: str = "--method"
+                ) -> tuple[Scenario, list[str]]:
+    """A copy of ``scenario`` solved with another method, without the old method's settings.
+
+    The keys of ``[solve]`` that only some methods use (``rtol``/``atol`` of the
+    ``solve_ivp`` methods, ``dt`` of the fixed-step methods, ``function_samples`` of the
+    analytic one, see :data:`.keys.METHOD_SETTINGS`) are removed when ``method`` does not
+    use them, so that a file written for one method runs with any other.
+
+    Returns
+    -------
+    scenario : Scenario
+        Validated again; problems are reported as coming from ``origin``.
+    dropped : list of str
+        The key paths removed (``["solve.rtol", "solve.atol"]``), for the caller to say.
+    """
+    solve = scenario.raw.get("solve")
+    dropped = []
+    if isinstance(solve, dict) and method in METHODS:
+        dropped = [f"solve.{key}" for key, methods in METHOD_SETTINGS.items()
+                   if key in solve and method not in methods]
+    overrides: dict[str, Any] = {"solve.method": method, **{key: None for key in dropped}}
+    return with_overrides(scenario, overrides, origin=origin), dropped
 
 
 def _apply_overrides(raw: Mapping[str, Any], overrides: Mapping[str, Any]) -> dict[str, Any]:

@@ -7,9 +7,9 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping
 
 from .checks import Key, _Invalid
-from .keys import (STEP_METHODS, BOUNDARY_KEYS, FORMAT_ALIASES, FREE_REGION_KEYS, IVP_METHODS,
-                   LOAD_KEYS, LOAD_KIND_KEYS, MATERIAL_KEYS, PROFILE_KEYS, SHAPE_PARAMETERS,
-                   SOLVE_KEYS, SOLVE_KIND_KEYS, SURFACE_KEYS, TABLES, TOP_KEYS, OUTPUT_KEYS)
+from .keys import (BOUNDARY_KEYS, FORMAT_ALIASES, FREE_REGION_KEYS, LOAD_KEYS, LOAD_KIND_KEYS,
+                   METHOD_SETTINGS, MATERIAL_KEYS, PROFILE_KEYS, SHAPE_PARAMETERS, SOLVE_KEYS,
+                   SOLVE_KIND_KEYS, SURFACE_KEYS, TABLES, TOP_KEYS, OUTPUT_KEYS)
 from .locate import _describe, _Problems
 from .spec import (BoundarySpec, LoadSpec, MaterialSpec, OutputSpec, Scenario, SolveSpec,
                    SurfaceSpec)
@@ -291,13 +291,10 @@ def _check_dynamic(table: Mapping[str, Any], values: dict[str, Any], problems: _
         values.setdefault("t_end", times[-1] if times[-1] > 0 else None)
         if values["t_end"] is None:
             problems.add("solve.times", "needs a time > 0")
-    _not_applicable(table, ("rtol", "atol"), ("rtol", "atol") if method in IVP_METHODS else (),
-                    "solve", problems, f"to method {method!r} (only to {', '.join(IVP_METHODS)})")
-    _not_applicable(table, ("dt",), ("dt",) if method in STEP_METHODS else (), "solve", problems,
-                    f"to method {method!r} (only to {', '.join(STEP_METHODS)})")
-    _not_applicable(table, ("function_samples",), ("function_samples",)
-                    if method == "analytic" else (), "solve", problems,
-                    f"to method {method!r} (only to analytic)")
+    for keys in (("rtol", "atol"), ("dt",), ("function_samples",)):
+        methods = METHOD_SETTINGS[keys[0]]
+        _not_applicable(table, keys, keys if method in methods else (), "solve", problems,
+                        f"to method {method!r} (only to {', '.join(methods)})")
 
 
 def _validate_output(raw: Mapping[str, Any], problems: _Problems,
