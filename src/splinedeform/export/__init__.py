@@ -1,0 +1,25 @@
+"""Files for other programs: meshes, ParaView time series, control nets and reports.
+
+Every file is written atomically (:mod:`.atomic`): the content goes to a temporary file
+in the target folder, which then replaces the target with :func:`os.replace`.
+
+* :mod:`.frames` — validation of frames, ``X = B_u P B_vᵀ`` for many nets at once;
+* :mod:`.mesh` — triangle meshes (.obj, .stl, .ply, .vtu, .vtk) through meshio;
+* :mod:`.series` — ParaView ``.pvd`` + ``.vtu`` time series;
+* :mod:`.nets` — control nets as JSON / NPZ with their full knot vectors;
+* :mod:`.report` — ``report.json`` and ``report.md``.
+"""
+
+from .atomic import atomic_path, write_text, write_with
+from .frames import check_frames, check_net, tessellate_frames
+from .mesh import MESH_FORMATS, write_mesh
+from .nets import CONTROL_NET_FORMAT, CONTROL_NET_VERSION, read_control_net, write_control_nets
+from .report import (REPORT_TABLE_ROWS, format_value, plain, report_markdown, section_markdown,
+                     write_report)
+from .series import pvd_text, write_time_series
+
+__all__ = ["CONTROL_NET_FORMAT", "CONTROL_NET_VERSION", "MESH_FORMATS", "REPORT_TABLE_ROWS",
+           "atomic_path", "check_frames", "check_net", "format_value", "plain", "pvd_text",
+           "read_control_net", "report_markdown", "section_markdown", "tessellate_frames",
+           "write_control_nets", "write_mesh", "write_report", "write_text", "write_time_series",
+           "write_with"]
