@@ -177,8 +177,15 @@ def test_control_net_json_describes_bases_and_times(tmp_path):
     times, nets = make_motion(s, 3)
     export.write_control_nets(tmp_path, "nets", s, times, nets)
     doc = json.loads((tmp_path / "nets.json").read_text())
-    assert doc["basis"] == {"u": {"degree": 3, "cells": 4, "length": 1.0, "kind": "open"},
-                            "v": {"degree": 2, "cells": 3, "length": 2.0, "kind": "uniform"}}
+    short = {d: {k: doc["basis"][d][k] for k in ("degree", "cells", "length", "kind")}
+             for d in "uv"}
+    assert short == {"u": {"degree": 3, "cells": 4, "length": 1.0, "kind": "open"},
+                     "v": {"degree": 2, "cells": 3, "length": 2.0, "kind": "uniform"}}
+    # open: n zeros, the m + 1 breaks, n ends; uniform: the breaks extended by n cells
+    assert doc["basis"]["u"]["knots"] == [0.0] * 3 + [0.0, 0.25, 0.5, 0.75, 1.0] + [1.0] * 3
+    np.testing.assert_allclose(doc["basis"]["v"]["knots"], np.arange(-2, 6) * 2 / 3,
+                               rtol=0, atol=1e-15)
+    assert doc["domain"] == [[0.0, 1.0], [0.0, 2.0]] and doc["version"] == 2
     assert doc["times"] == times.tolist() and doc["shape"] == [7, 5]
 
 

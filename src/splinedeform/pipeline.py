@@ -302,11 +302,10 @@ def _write_outputs(result: RunResult, folder: Path, stages: _Stages) -> None:
                 folder, name, surface, rest, times, nets, resolution=res)))
     if "json" in formats or "npz" in formats:
         with stages.stage("control nets"):
-            for path in export.write_control_nets(folder, f"{name}_nets", surface, times, nets):
-                if path.suffix[1:] in formats:
-                    result.outputs.append((f"control nets {path.suffix}", path))
-                else:
-                    path.unlink()
+            wanted = [ext for ext in export.CONTROL_NET_FORMATS if ext in formats]
+            for path in export.write_control_nets(folder, f"{name}_nets", surface, times, nets,
+                                                  formats=wanted):
+                result.outputs.append((f"control nets {path.suffix}", path))
     if "images" in formats:
         _write_images(result, folder, stages)
     for ext in ("gif", "mp4"):

@@ -13,12 +13,15 @@ in the target folder, which then replaces the target with :func:`os.replace`.
 from .atomic import atomic_path, write_text, write_with
 from .frames import check_frames, check_net, tessellate_frames
 from .mesh import MESH_FORMATS, write_mesh
-from .nets import CONTROL_NET_FORMAT, CONTROL_NET_VERSION, read_control_net, write_control_nets
+from .nets import (CONTROL_NET_FORMAT, CONTROL_NET_FORMATS, CONTROL_NET_VERSION, CONVENTION,
+                   control_net_document, coefficient_index, read_control_net,
+                   write_control_nets)
 from .report import (REPORT_TABLE_ROWS, format_value, plain, report_markdown, section_markdown,
                      write_report)
 from .series import pvd_text, write_time_series
 
-__all__ = ["CONTROL_NET_FORMAT", "CONTROL_NET_VERSION", "MESH_FORMATS", "REPORT_TABLE_ROWS",
+__all__ = ["CONTROL_NET_FORMAT", "CONTROL_NET_FORMATS", "CONTROL_NET_VERSION", "CONVENTION",
+           "coefficient_index", "control_net_document", "MESH_FORMATS", "REPORT_TABLE_ROWS",
            "atomic_path", "check_frames", "check_net", "format_value", "plain", "pvd_text",
            "read_control_net", "report_markdown", "section_markdown", "tessellate_frames",
            "write_control_nets", "write_mesh", "write_report", "write_text", "write_time_series",

@@ -4,57 +4,137 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
-from ..basis import BSplineBasis
+from ..basis import KNOT_KINDS, BSplineBasis
 from ..errors import InputError
 from ..surface import Surface
 from .atomic import _check_stem, _require_folder, write_text, write_with
 from .frames import check_frames
 
 CONTROL_NET_FORMAT = "splinedeform-control-nets"
-CONTROL_NET_VERSION = 1
+CONTROL_NET_VERSION = 2
+CONTROL_NET_FORMATS: tuple[str, ...] = ("json", "npz")
+#: stated in every file, so that a reader needs neither our source nor our docs
+CONVENTION = (
+    "x(u, v) = sum_i sum_j c[i][j] N_i(u) M_j(v) for u in basis.u.domain, v in basis.v.domain; "
+    "N_i (M_j) is the B-spline of basis.u.degree (basis.v.degree) on the knots "
+    "basis.u.knots[i : i + degree + 2] (Cox-de Boor, knots as given, not normalised), and "
+    "c[i][j] = control_points[frame][basis.u.coefficient_index[i]]"
+    "[basis.v.coefficient_index[j]]. For kind 'open' and 'uniform' coefficient_index is "
+    "0, 1, ..., n - 1 (the control points in order). For kind 'periodic' the n = cells "
+    "control points hold one period: the knots are uniform, extended by degree cells on "
+    "each side of the domain, and coefficient_index = n - degree, ..., n - 1, 0, 1, ..., "
+    "n - 1 (the last degree control points repeated in front), so that x has period "
+    "length in that direction. In the .npz file the same fields are named "
+    "<field>_u and <field>_v.")
+
+
+def coefficient_index(basis: BSplineBasis) -> NDArray[np.int64]:
+    """Control-point row of each coefficient on the full knot vector ``basis.knots``.
+
+    ``basis.knots`` has ``N + n + 1`` knots for ``N`` coefficients. Open and uniform:
+    ``N = m + n`` functions, the identity ``0, …, N - 1``. Periodic: function ``j`` of
+    the basis is ``b^n(x/h - j)`` wrapped modulo ``L``, i.e. the B-spline on the knots
+    ``t_{j+n} … t_{j+2n+1}`` of ``t_i = (i - n) h``; unwrapped, coefficient ``i`` of the
+    ``m + n`` B-splines on those knots is control point ``(i - n) mod m``.
+    """
+    if basis.periodic:
+        return np.mod(np.arange(basis.cells + basis.degree) - basis.degree, basis.cells)
+    return np.arange(basis.size)
 
 
 def _basis_description(basis: BSplineBasis) -> dict[str, Any]:
+    """Everything a reader needs for one direction (see :data:`CONVENTION`)."""
     return {"degree": int(basis.degree), "cells": int(basis.cells),
-            "length": float(basis.length), "kind": str(basis.kind)}
+            "length": float(basis.length), "kind": str(basis.kind),
+            "periodic": bool(basis.periodic), "domain": [0.0, float(basis.length)],
+            "knots": basis.knots.tolist(),
+            "coefficient_index": coefficient_index(basis).tolist()}
+
+
+def control_net_document(surface: Surface, times: ArrayLike, nets: ArrayLike
+                         ) -> dict[str, Any]:
+    """The content of a control-net file as JSON types (one mapping for both formats).
+
+    Keys: ``format``, ``version``, ``convention`` (the text of :data:`CONVENTION`),
+    ``name``, ``shape`` ``[n_u, n_v]``, ``domain`` ``[[0, L_u], [0, L_v]]``, ``basis``
+    (``u`` and ``v``: degree, cells, length, kind, periodic, domain, knots,
+    coefficient_index), ``times`` ``(F,)`` and ``control_points`` ``(F, n_u, n_v, 3)``.
+    A field added later (e.g. rational weights ``(F, n_u, n_v)``) is one more key here.
+    """
+    t, P = check_frames(surface, times, nets)
+    basis = {"u": _basis_description(surface.basis_u), "v": _basis_description(surface.basis_v)}
+    return {"format": CONTROL_NET_FORMAT, "version": CONTROL_NET_VERSION,
+            "convention": CONVENTION, "name": surface.name, "shape": list(surface.shape),
+            "domain": [list(d) for d in surface.domain], "basis": basis,
+            "times": t.tolist(), "control_points": P.tolist()}
+
+
+def _npz_arrays(document: Mapping[str, Any]) -> dict[str, NDArray[Any]]:
+    """The document as flat arrays: ``basis.u.knots`` becomes ``knots_u`` and so on."""
+    arrays = {key: np.asarray(value) for key, value in document.items() if key != "basis"}
+    for d, desc in document["basis"].items():
+        arrays.update({f"{key}_{d}": np.asarray(value) for key, value in desc.items()})
+    return arrays
 
 
 def write_control_nets(directory: str | os.PathLike[str], stem: str, surface: Surface,
-                       times: ArrayLike, nets: ArrayLike) -> list[Path]:
-    """Write every frame's control net as ``stem.json`` and ``stem.npz``.
+                       times: ArrayLike, nets: ArrayLike,
+                       formats: Sequence[str] = CONTROL_NET_FORMATS) -> list[Path]:
+    """Write every frame's control net as ``stem.json`` and/or ``stem.npz``.
 
-    Both hold the times ``(F,)``, the nets ``(F, n_u, n_v, 3)`` and the basis of each
-    direction (degree, cells, length, kind), enough to rebuild the surface with
-    :func:`read_control_net`. JSON floats are written with ``repr`` so they read back
-    bit for bit.
+    Both hold the times ``(F,)``, the nets ``(F, n_u, n_v, 3)``, the full knot vector,
+    parameter domain and index convention of each direction (see
+    :func:`control_net_document` and :data:`CONVENTION`): enough to rebuild the surface
+    with any B-spline library, or with :func:`read_control_net`. JSON floats are written
+    with ``repr`` so they read back bit for bit.
+
+    Parameters
+    ----------
+    formats : sequence of {"json", "npz"}
+        Which files to write (default both), in this order.
     """
     folder = _require_folder(directory)
     _check_stem(stem)
-    t, P = check_frames(surface, times, nets)
-    basis = {"u": _basis_description(surface.basis_u), "v": _basis_description(surface.basis_v)}
-    document = {"format": CONTROL_NET_FORMAT, "version": CONTROL_NET_VERSION,
-                "name": surface.name, "shape": list(surface.shape), "basis": basis,
-                "times": t.tolist(), "control_points": P.tolist()}
-    json_path = write_text(folder / f"{stem}.json", json.dumps(document, indent=None) + "\n")
-    arrays: dict[str, Any] = {"format": np.array(CONTROL_NET_FORMAT),
-                              "version": np.array(CONTROL_NET_VERSION),
-                              "name": np.array(surface.name), "times": t, "control_points": P}
-    for d, desc in basis.items():
-        arrays.update({f"{key}_{d}": np.array(value) for key, value in desc.items()})
+    unknown = [f for f in formats if f not in CONTROL_NET_FORMATS]
+    if unknown or not formats:
+        raise InputError(f"control nets are written as {CONTROL_NET_FORMATS}, got {list(formats)}")
+    document = control_net_document(surface, times, nets)
+    paths = []
+    if "json" in formats:
+        paths.append(write_text(folder / f"{stem}.json", json.dumps(document) + "\n"))
+    if "npz" in formats:
+        arrays = _npz_arrays(document)
+        arrays["control_points"] = np.asarray(document["control_points"], dtype=float)
 
-    def save(tmp: Path) -> None:
-        with open(tmp, "wb") as fh:
-            np.savez(fh, **arrays)
+        def save(tmp: Path) -> None:
+            with open(tmp, "wb") as fh:
+                np.savez(fh, **arrays)
 
-    npz_path = write_with(folder / f"{stem}.npz", save)
-    return [json_path, npz_path]
+        paths.append(write_with(folder / f"{stem}.npz", save))
+    return paths
+
+
+_BASIS_KEYS = ("degree", "cells", "length", "kind")
+
+
+def _check_header(path: Path, fmt: Any, version: Any) -> None:
+    if fmt is not None and str(fmt) != CONTROL_NET_FORMAT:
+        raise InputError(f"{path}: format is {str(fmt)!r}, not {CONTROL_NET_FORMAT!r}")
+    if version is not None:
+        try:
+            number = int(version)
+        except (TypeError, ValueError):
+            raise InputError(f"{path}: version must be an integer, got {version!r}") from None
+        if number > CONTROL_NET_VERSION:
+            raise InputError(f"{path}: control-net file version {number} is newer than this "
+                             f"splinedeform reads ({CONTROL_NET_VERSION}); update splinedeform")
 
 
 def _load_json_nets(path: Path) -> dict[str, Any]:
@@ -65,6 +145,7 @@ def _load_json_nets(path: Path) -> dict[str, Any]:
     if not isinstance(doc, dict) or "control_points" not in doc or "basis" not in doc:
         raise InputError(f"{path}: a control-net file needs the keys 'control_points' and "
                          f"'basis' (with 'u' and 'v': degree, cells, length, kind)")
+    _check_header(path, doc.get("format"), doc.get("version"))
     basis = doc["basis"]
     if not isinstance(basis, dict) or not all(isinstance(basis.get(d), dict) for d in "uv"):
         raise InputError(f"{path}: 'basis' must map 'u' and 'v' to "
@@ -77,31 +158,66 @@ def _load_npz_nets(path: Path) -> dict[str, Any]:
     try:
         with np.load(path, allow_pickle=False) as z:
             data = {key: z[key] for key in z.files}
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError, EOFError) as exc:
         raise InputError(f"{path}: not a valid .npz control-net file: {exc}") from None
-    keys = ("degree", "cells", "length", "kind")
-    missing = [f"{k}_{d}" for d in "uv" for k in keys if f"{k}_{d}" not in data]
+    missing = [f"{k}_{d}" for d in "uv" for k in _BASIS_KEYS if f"{k}_{d}" not in data]
     if "control_points" not in data or missing:
         raise InputError(f"{path}: a control-net .npz needs 'control_points' and "
                          f"{', '.join(missing) or 'the basis arrays'}")
-    return {"control_points": data["control_points"],
-            "u": {k: data[f"{k}_u"].item() for k in keys},
-            "v": {k: data[f"{k}_v"].item() for k in keys},
+    _check_header(path, data["format"].item() if "format" in data else None,
+                  data["version"].item() if "version" in data else None)
+
+    def direction(d: str) -> dict[str, Any]:
+        desc: dict[str, Any] = {}
+        for key in (*_BASIS_KEYS, "knots"):
+            if f"{key}_{d}" in data:
+                value = data[f"{key}_{d}"]
+                desc[key] = value if key == "knots" else \
+                    (value.item() if value.ndim == 0 else value.tolist())
+        return desc
+
+    return {"control_points": data["control_points"], "u": direction("u"), "v": direction("v"),
             "name": str(data["name"]) if "name" in data else path.stem}
 
 
-def _basis_from(desc: Mapping[str, Any], where: str) -> BSplineBasis:
-    missing = [k for k in ("degree", "cells", "length", "kind") if k not in desc]
+def _basis_from(desc: Mapping[str, Any], size: int, where: str) -> BSplineBasis:
+    """The basis a file describes, checked against the net's size ``size`` and its knots."""
+    missing = [k for k in _BASIS_KEYS if k not in desc]
     if missing:
         raise InputError(f"{where} misses {', '.join(missing)}")
-    degree, cells = desc["degree"], desc["cells"]
+    degree, cells, kind = desc["degree"], desc["cells"], desc["kind"]
     if not all(isinstance(x, (int, np.integer)) and not isinstance(x, bool) for x in (degree, cells)):
         raise InputError(f"{where}: degree and cells must be integers, got {degree!r}, {cells!r}")
     try:
         length = float(desc["length"])
     except (TypeError, ValueError):
         raise InputError(f"{where}: length must be a number, got {desc['length']!r}") from None
-    return BSplineBasis(int(degree), int(cells), length, str(desc["kind"]))  # type: ignore[arg-type]
+    if kind not in KNOT_KINDS:
+        raise InputError(f"{where}.kind must be one of {KNOT_KINDS}, got {kind!r}")
+    # check the size before building anything, so a hostile 'cells' allocates nothing
+    expected = int(cells) if kind == "periodic" else int(cells) + int(degree)
+    if expected != size:
+        raise InputError(f"{where}: a {kind} basis of degree {degree} on {cells} cells has "
+                         f"{expected} functions, but control_points has shape {size} in this "
+                         f"direction")
+    basis = BSplineBasis(int(degree), int(cells), length, kind)
+    if "knots" in desc:
+        _check_knots(desc["knots"], basis, where)
+    return basis
+
+
+def _check_knots(knots: Any, basis: BSplineBasis, where: str) -> None:
+    """Stored knots must be those of the layout, to ``1e-12 L`` (they are written by repr)."""
+    try:
+        t = np.asarray(knots, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{where}.knots must be a list of numbers") from None
+    if t.shape != basis.knots.shape or not np.all(np.abs(t - basis.knots)
+                                                  <= 1e-12 * basis.length):
+        raise InputError(f"{where}.knots are not the {basis.kind} knots of degree "
+                         f"{basis.degree} on {basis.cells} cells of [0, {basis.length:g}] "
+                         f"({basis.knots.size} values); this reader takes the open, uniform "
+                         f"and periodic layouts only")
 
 
 def read_control_net(path: str | os.PathLike[str], frame: int = -1) -> Surface:
@@ -111,6 +227,7 @@ def read_control_net(path: str | os.PathLike[str], frame: int = -1) -> Surface:
     ----------
     path : path-like
         ``.json`` or ``.npz``. A JSON file may also hold a single net ``(n_u, n_v, 3)``.
+        Files of version 1 (without knots) are read too.
     frame : int
         Which frame to take; negative counts from the end (default: the last).
 
@@ -126,20 +243,19 @@ def read_control_net(path: str | os.PathLike[str], frame: int = -1) -> Surface:
     if not source.is_file():
         raise InputError(f"control-net file {source} does not exist")
     data = _load_json_nets(source) if suffix == ".json" else _load_npz_nets(source)
-    basis_u = _basis_from(data["u"], f"{source}: basis.u")
-    basis_v = _basis_from(data["v"], f"{source}: basis.v")
     try:
         P = np.asarray(data["control_points"], dtype=float)
     except (TypeError, ValueError):
         raise InputError(f"{source}: control_points must be a numeric array") from None
     if P.ndim == 3:
         P = P[None]
-    if P.ndim != 4 or P.shape[0] == 0:
+    if P.ndim != 4 or P.shape[0] == 0 or P.shape[-1] != 3:
         raise InputError(f"{source}: control_points must have shape (F, n_u, n_v, 3) or "
                          f"(n_u, n_v, 3), got {P.shape}")
+    basis_u = _basis_from(data["u"], P.shape[1], f"{source}: basis.u")
+    basis_v = _basis_from(data["v"], P.shape[2], f"{source}: basis.v")
     if isinstance(frame, bool) or not isinstance(frame, (int, np.integer)) \
             or not -P.shape[0] <= frame < P.shape[0]:
         raise InputError(f"frame must be an integer in [{-P.shape[0]}, {P.shape[0] - 1}] "
                          f"for {source.name} ({P.shape[0]} frame(s)), got {frame!r}")
     return Surface(P[frame], basis_u, basis_v, name=str(data["name"]))
-
