@@ -18,11 +18,11 @@ from .nets import (CONTROL_NET_FORMAT, CONTROL_NET_FORMATS, CONTROL_NET_VERSION,
                    write_control_nets)
 from .report import (REPORT_TABLE_ROWS, format_value, plain, report_markdown, section_markdown,
                      write_report)
-from .series import pvd_text, write_time_series
+from .series import frame_file_names, pvd_text, write_time_series
 
 __all__ = ["CONTROL_NET_FORMAT", "CONTROL_NET_FORMATS", "CONTROL_NET_VERSION", "CONVENTION",
            "coefficient_index", "control_net_document", "MESH_FORMATS", "REPORT_TABLE_ROWS",
-           "atomic_path", "check_frames", "check_net", "format_value", "plain", "pvd_text",
+           "atomic_path", "check_frames", "check_net", "format_value", "frame_file_names", "plain", "pvd_text",
            "read_control_net", "report_markdown", "section_markdown", "tessellate_frames",
            "write_control_nets", "write_mesh", "write_report", "write_text", "write_time_series",
            "write_with"]

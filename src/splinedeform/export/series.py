@@ -25,15 +25,27 @@ def pvd_text(entries: Sequence[tuple[float, str]]) -> str:
             f"  <Collection>\n{rows}\n  </Collection>\n</VTKFile>\n")
 
 
+def frame_file_names(stem: str, count: int) -> list[str]:
+    """Names of the per-frame files: ``stem_0000.vtu`` … (at least 4 digits)."""
+    digits = max(4, len(str(count - 1)))
+    return [f"{stem}_{f:0{digits}d}.vtu" for f in range(count)]
+
+
 def write_time_series(directory: str | os.PathLike[str], stem: str, surface: Surface,
                       rest_net: ArrayLike, times: ArrayLike, nets: ArrayLike,
                       resolution: int = 32) -> Path:
     """Write the motion as a ParaView time series: ``stem.pvd`` plus ``stem_0000.vtu``, ...
 
-    Each frame ``f`` is the surface mesh of ``nets[f]`` with point data
-    ``displacement = B_u (P_f - P_rest) B_vᵀ`` (3 components) and
-    ``displacement_magnitude = |displacement|``. The ``.pvd`` is written last and lists
-    every frame with its time. Returns the ``.pvd`` path.
+    Every frame holds the **rest** geometry ``X_0 = B_u P_rest B_vᵀ`` as its points and
+    the point data
+
+    * ``displacement`` ``= B_u (P_f - P_rest) B_vᵀ`` (3 components): the deformed surface
+      is ``X_0 + displacement``, which is what ParaView's *Warp By Vector* (scale 1) draws;
+    * ``displacement_magnitude`` ``= |displacement|``, for colouring.
+
+    The points are the same in every frame, so a warp by the field is applied exactly
+    once. The ``.pvd`` is written last and lists every frame with its time. Returns the
+    ``.pvd`` path.
     """
     folder = _require_folder(directory)
     _check_stem(stem)
@@ -41,13 +53,9 @@ def write_time_series(directory: str | os.PathLike[str], stem: str, surface: Sur
     rest = check_net(surface, rest_net, "rest net")
     X, faces = tessellate_frames(surface, P, resolution)
     X0, _ = tessellate_frames(surface, rest, resolution)
-    digits = max(4, len(str(t.size - 1)))
-    entries = []
-    for f in range(t.size):
-        name = f"{stem}_{f:0{digits}d}.vtu"
+    names = frame_file_names(stem, t.size)
+    for f, name in enumerate(names):
         d = X[f] - X0
-        write_mesh(folder / name, X[f], faces,
+        write_mesh(folder / name, X0, faces,
                    {"displacement": d, "displacement_magnitude": np.linalg.norm(d, axis=1)})
-        entries.append((float(t[f]), name))
-    return write_text(folder / f"{stem}.pvd", pvd_text(entries))
-
+    return write_text(folder / f"{stem}.pvd", pvd_text(list(zip(t.tolist(), names))))
