@@ -28,8 +28,9 @@ from .material import Material
 from .physics import PHYSICS, intrinsic
 from .quadrature import gram_matrix
 from .solution import ModalSolution, StaticSolution
-from .solvers import modal_basis
+from .solvers import modal_basis, rigid
 from .solvers.analytic import ModalResponse
+from .solvers.rigid import UnresolvedSpectrum
 from .surface import Surface
 
 Array = NDArray[np.float64]
@@ -141,6 +142,7 @@ class Model:
                    + material.rayleigh * self._K).tocsc()
         self._eigen: tuple[Array, Array] | None = None
         self._bases: dict[tuple, modal_basis.ModalBasis] = {}
+        self._rigid: tuple[int | None] | None = None
         self.timings: dict[str, float] = {"assembly": time.perf_counter() - start}
 
     # -- layout --------------------------------------------------------------------
@@ -222,13 +224,13 @@ class Model:
         if k is not None:
             k = _check_count(k, n)
         strategy = modal_basis.choose(self, "auto", truncated=k is not None and k <= n // 2)
-        if strategy == "dense":
-            basis = self.modal_basis("dense")
-            return basis.lam[:k], basis.phi[:, :k]
         if strategy == "sparse":
-            basis = self.modal_basis("sparse", modes=k)
-            return basis.lam, basis.phi
-        basis = self.modal_basis("separable")
+            sparse = self.modal_basis("sparse", modes=k)
+            assert isinstance(sparse, modal_basis.DenseBasis)
+            return sparse.lam, sparse.phi
+        basis = self.modal_basis("auto" if strategy == "dense" else strategy)
+        if isinstance(basis, modal_basis.DenseBasis):
+            return basis.lam[:k], basis.phi[:, :k]
         if k is None and n > modal_basis.DENSE_MAX:
             raise InputError(f"all {n} modes as an explicit matrix need "
                              f"{8 * n * n / 2**30:.1f} GiB; ask for the lowest k modes, or "
@@ -255,11 +257,16 @@ class Model:
         start = time.perf_counter()
         if strategy == "sparse":
             basis: modal_basis.ModalBasis = modal_basis.sparse_basis(
-                self._K, self._M, modes, omega_max, self.constraints.unconstrained)
+                self._K, self._M, modes, omega_max, self.rigid_modes, self._eigen_advice())
+        elif truncated:
+            basis = modal_basis.truncate(self.modal_basis(eigensolver), modes, omega_max)
         else:
-            basis = self.modal_basis(strategy) if truncated else self._complete_basis(strategy)
-            if truncated:
-                basis = modal_basis.truncate(basis, modes, omega_max)
+            try:
+                basis = self._complete_basis(strategy)
+            except UnresolvedSpectrum:
+                if eigensolver != "auto" or modal_basis.separable_reason(self) is not None:
+                    raise
+                basis = self._complete_basis("separable")   # resolves each direction apart
         self._bases[key] = basis
         self.timings["eigen"] = time.perf_counter() - start
         return basis
@@ -267,9 +274,25 @@ class Model:
     def _complete_basis(self, strategy: str) -> modal_basis.ModalBasis:
         if strategy == "separable":
             return modal_basis.separable_basis(self)
-        basis = modal_basis.dense_basis(self._K, self._M)
+        basis = modal_basis.dense_basis(self._K, self._M, self.rigid_modes,
+                                        self._eigen_advice())
         self._eigen = (basis.lam, basis.phi)
         return basis
+
+    @property
+    def rigid_modes(self) -> int | None:
+        """Dimension of ``null K_r`` (motions without energy) from the weights and the
+        constraints, not from eigenvalues (:func:`~splinedeform.solvers.rigid.rigid_count`);
+        ``None`` where no structure is known (intrinsic plate without tension)."""
+        if self._rigid is None:
+            self._rigid = (rigid.rigid_count(self),)
+        return self._rigid[0]
+
+    def _eigen_advice(self) -> str:
+        advice = modal_basis.DEFAULT_ADVICE
+        if modal_basis.separable_reason(self) is None:
+            advice += ", or eigensolver='separable', which resolves each direction apart"
+        return advice
 
     def frequencies(self, k: int = 6) -> Array:
         """Lowest ``k`` undamped angular frequencies ``ω_i = √λ_i``, ascending."""

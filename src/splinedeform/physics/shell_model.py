@@ -187,7 +187,7 @@ class ShellModel:
 
     def frequencies(self, k: int = 6) -> Array:
         """Lowest ``k`` angular frequencies ``ω = √λ`` of ``K_r φ = λ M_r φ`` (rigid ones 0)."""
-        basis = modal_basis.sparse_basis(self._K, self._M, k, None, self.rigid.shape[1] > 0)
+        basis = modal_basis.sparse_basis(self._K, self._M, k, None, self.rigid.shape[1])
         return np.sqrt(basis.lam[:k])
 
     def dynamic(self, load: Load | None, times: ArrayLike, damping: float = 0.0,
@@ -203,10 +203,10 @@ class ShellModel:
         if not np.isfinite(damping) or damping < 0:
             raise InputError(f"shell damping must be finite and >= 0, got {damping!r}")
         if modes is None:
-            basis = modal_basis.dense_basis(self._K, self._M)
+            basis = modal_basis.dense_basis(self._K, self._M, self.rigid.shape[1])
         else:
             basis = modal_basis.sparse_basis(self._K, self._M, int(modes), None,
-                                             self.rigid.shape[1] > 0)
+                                             self.rigid.shape[1])
         jumps, harmonics = [], []
         for term in as_load(load).terms():
             if term.time_dependent_field:

@@ -172,7 +172,10 @@ class ModalResponse:
     Parameters
     ----------
     lam, c : ndarray (N,)
-        Eigenvalues ``λ_i`` (clipped to ``>= 0``, tiny ones snapped to 0) and modal damping.
+        Eigenvalues ``λ_i`` and modal damping. ``λ_i = 0`` exactly marks a rigid-body mode;
+        nothing else is snapped to 0 (a soft mode keeps its small ``λ``): the modal basis
+        decides the rigid modes from the constraints (:mod:`.rigid`). Round-off negatives
+        are clipped to 0.
     q0, v0 : ndarray (N, 3)
         Initial modal displacement and velocity.
     jumps : list of ``(t_j, g_j)``
@@ -183,9 +186,7 @@ class ModalResponse:
 
     def __init__(self, lam: Array, c: Array, q0: Array, v0: Array,
                  jumps: list[tuple[float, Array]], harmonics: list[tuple[float, float, Array]]):
-        lam = np.asarray(lam, dtype=float)
-        tol = 1e-10 * max(float(np.abs(lam).max(initial=0.0)), 1e-300)
-        self.lam = np.where(lam < tol, 0.0, lam)
+        self.lam = np.maximum(np.asarray(lam, dtype=float), 0.0)
         self.c = np.asarray(c, dtype=float)
         self.q0, self.v0 = q0, v0
         merged: dict[float, Array] = {}

@@ -36,6 +36,7 @@ import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
 
 from ..errors import InputError, SingularSystemError
+from .rigid import check_resolved, count_by_gap, direction_rigid
 
 if TYPE_CHECKING:
     from ..model import Model
@@ -238,10 +239,22 @@ class SeparableBasis(ModalBasis):
 
 
 # --------------------------------------------------------------------------- strategies
-def dense_basis(K: sp.spmatrix, M: sp.spmatrix) -> DenseBasis:
-    """All modes by dense ``eigh(K_r, M_r)`` (LAPACK ``sygvd``), ``λ`` clipped at 0."""
+DEFAULT_ADVICE = "Raise the smallest weight, or use fewer cells or a lower degree"
+
+
+def dense_basis(K: sp.spmatrix, M: sp.spmatrix, rigid: int | None = None,
+                advice: str = DEFAULT_ADVICE) -> DenseBasis:
+    """All modes by dense ``eigh(K_r, M_r)`` (LAPACK ``sygvd``).
+
+    The ``rigid`` lowest eigenvalues (the dimension of ``null K_r``, decided from the
+    constraints by :mod:`.rigid`; ``None``: counted at round-off level behind a clear gap)
+    are set to 0; the rest must be resolved (:func:`.rigid.check_resolved`).
+    """
     lam, phi = sla.eigh(K.toarray(), M.toarray(), check_finite=False)
-    return DenseBasis(_zero_small(lam), phi, "dense", True)
+    if rigid is None:
+        rigid = count_by_gap(lam, "dense eigen-solution")
+    lam = check_resolved(lam, rigid, "dense eigen-solution", advice)
+    return DenseBasis(lam, phi, "dense", True)
 
 
 def separable_reason(model: Model) -> str | None:
@@ -281,8 +294,15 @@ def separable_basis(model: Model) -> SeparableBasis:
         raise InputError(f"the separable eigensolver does not apply: {reason}; use "
                          "eigensolver='dense' or 'sparse'")
     A_u, B_u, A_v, B_v = separable_matrices(model)
+    m, c = model.material, model.constraints
     alpha, phi_u = sla.eigh(A_u, B_u, check_finite=False)
     beta, phi_v = sla.eigh(A_v, B_v, check_finite=False)
+    orders_u = [a for w, a in ((m.w10, 1), (m.w20, 2)) if w]
+    orders_v = [a for w, a in ((m.w01, 1), (m.w02, 2)) if w]
+    alpha = check_resolved(alpha, direction_rigid(model.surface.basis_u, c.T_u, orders_u),
+                           "separable eigen-solution in u", DEFAULT_ADVICE)
+    beta = check_resolved(beta, direction_rigid(model.surface.basis_v, c.T_v, orders_v),
+                          "separable eigen-solution in v", DEFAULT_ADVICE)
     return SeparableBasis(alpha, phi_u, beta, phi_v, model.material.mass)
 
 
@@ -309,15 +329,20 @@ def _eigsh(K: sp.spmatrix, M: sp.spmatrix, k: int, shift: float, lu: Any) -> tup
 
 
 def sparse_basis(K: sp.spmatrix, M: sp.spmatrix, k: int | None = None,
-                 omega_max: float | None = None, unconstrained: bool = False) -> DenseBasis:
+                 omega_max: float | None = None, rigid: int | None = 0,
+                 advice: str = DEFAULT_ADVICE) -> DenseBasis:
     """Lowest modes by shift-invert Lanczos (``eigsh`` with a sparse LU of ``K - σM``).
 
     ``k`` modes, or all with ``ω <= omega_max`` (found by doubling the request). One mode more
-    than kept is computed so that the first omitted frequency is known. With edges or points
-    fixed ``σ = 0`` and the LU of ``K`` is kept for the static part; an unconstrained surface
-    (singular ``K``) uses a small negative shift and has no static solve.
+    than kept is computed so that the first omitted frequency is known. Without rigid modes
+    (``rigid = 0``, the dimension of ``null K_r`` from :mod:`.rigid`) ``σ = 0`` and the LU of
+    ``K`` is kept for the static part; with rigid modes (or ``None``, unknown: counted at
+    round-off level behind a gap) ``K`` is singular, a small negative shift is used and
+    there is no static solve. The ``rigid`` lowest eigenvalues are set to 0 and the rest
+    checked against ``λ_max ≈ max K_ii/M_ii`` (:func:`.rigid.check_resolved`).
     """
     n = K.shape[0]
+    unconstrained = rigid != 0
     if unconstrained:
         scale = float(np.mean(K.diagonal() / M.diagonal()))
         shift = -1e-6 * scale
@@ -339,6 +364,10 @@ def sparse_basis(K: sp.spmatrix, M: sp.spmatrix, k: int | None = None,
     else:
         assert k is not None
         lam, phi = _eigsh(K, M, min(k + 1, n - 1), shift, lu)
+    top = float(np.max(K.diagonal() / M.diagonal()))       # a Rayleigh quotient <= λ_max
+    if rigid is None:
+        rigid = count_by_gap(lam, "sparse eigen-solution", top)
+    lam = check_resolved(lam, min(rigid, lam.size), "sparse eigen-solution", advice, top)
     first = lam[k] if k < lam.size else np.inf
     return DenseBasis(lam[:k], phi[:, :k], "sparse", k == n, solve, first)
 
