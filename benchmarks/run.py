@@ -21,7 +21,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from splinedeform import bench
+from splinedeform import bench, bench_goals
 from splinedeform.export import write_text
 
 HERE = Path(__file__).resolve().parent
@@ -37,6 +37,11 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--budget", type=float, help="seconds per numerical run before stopping it")
     p.add_argument("--frames", type=int, help="number of frames")
     p.add_argument("--no-goals", action="store_true", help="skip the goals at scale")
+    p.add_argument("--methods", help="comma-separated numerical methods (default: the study's)")
+    p.add_argument("--families", help="comma-separated problem families (clamped, region)")
+    p.add_argument("--regimes", action="store_true",
+                   help="also the regimes of splinedeform.bench_goals (horizon, load cases, "
+                        "one state) and the goals of issue 10")
     p.add_argument("--note", default=NOTE, help="sentence on the machine for the results file")
     p.add_argument("--render-only", action="store_true",
                    help="rewrite the reports from the last run's bench.json, measuring nothing "
@@ -100,8 +105,28 @@ def main(argv: list[str] | None = None) -> int:
         result = {"rows": [bench.Row(**r) for r in record["rows"]],
                   "goals": [bench.Goal(**g) for g in record["goals"]], "files": files}
     else:
-        result = bench.main(sizes=sizes, quick=args.quick, outdir=out, budget=args.budget,
-                            frames=args.frames, goals=False if args.no_goals else None)
+        split = lambda text: None if text is None else [x.strip() for x in text.split(",")]  # noqa: E731
+        with bench_goals.blas_threads(1) as threads:
+            print(threads, flush=True)
+            result = bench.main(sizes=sizes, quick=args.quick, outdir=out, budget=args.budget,
+                                frames=args.frames, goals=False if args.no_goals else None,
+                                methods=split(args.methods), families=split(args.families))
+    regimes = ""
+    if args.regimes and not args.render_only:
+        record = bench_goals.goals(say=lambda s: print(s, flush=True), quick=args.quick)
+        plate = {}
+        for r in result["rows"]:
+            if r.family != "clamped" or r.solver == "analytic":
+                continue
+            best = plate.get(r.cells)
+            analytic = [a for a in result["rows"] if a.family == "clamped"
+                        and a.cells == r.cells and a.solver == "analytic"][0]
+            if r.status == "ok" and (best is None or r.seconds < best[1]):
+                plate[r.cells] = (analytic.seconds, r.seconds, r.solver)
+        regimes = "\n## Regimes and goals (`splinedeform.bench_goals`)\n\n" + \
+            bench_goals.markdown(record, plate)
+        (out / "regimes.json").write_text(json.dumps(record, indent=1, default=str),
+                                          encoding="utf-8")
     evaluate, evaluated = evaluate_section(args.quick)
     print("\nratios numerical / analytic (time to the same frames at the same accuracy):")
     for line in ratio_lines(result["rows"]):
@@ -118,7 +143,7 @@ def main(argv: list[str] | None = None) -> int:
     stamp = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
     text = (f"# Benchmark results\n\n{args.note}\n\nRun {stamp} with "
             f"`python benchmarks/run.py{' ' + ' '.join(sys.argv[1:]) if argv is None and sys.argv[1:] else ''}`"
-            f"; plots in `{out.relative_to(HERE.parent)}`.\n\n{body}{evaluate}")
+            f"; plots in `{out.relative_to(HERE.parent)}`.\n\n{body}{regimes}{evaluate}")
     write_text(target / "results.md", text)
     write_text(target / "results.csv", bench.csv_text(result["rows"]))
     print(f"written: {target / 'results.md'}, {target / 'results.csv'}")
