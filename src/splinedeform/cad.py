@@ -168,12 +168,18 @@ def _rhino3dm():
     return rhino3dm
 
 
-def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch]) -> Path:
-    """Write ``patches`` as NURBS surfaces to a ``.3dm`` file (atomically); return its path."""
+def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch],
+              names: list[str] | None = None) -> Path:
+    """Write ``patches`` as NURBS surfaces to a ``.3dm`` file (atomically); return its path.
+
+    ``names`` label the objects (openNURBS object names), one per patch.
+    """
     r3 = _rhino3dm()
     path = Path(path)
+    if names is not None and len(names) != len(patches):
+        raise InputError(f"{len(names)} object names for {len(patches)} surfaces")
     model = r3.File3dm()
-    for patch in patches:
+    for index, patch in enumerate(patches):
         (nu, nv), w = patch.degrees, np.asarray(patch.weights)
         cu, cv = w.shape
         srf = r3.NurbsSurface.Create(3, True, nu + 1, nv + 1, cu, cv)
@@ -184,7 +190,10 @@ def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch]) -> Path:
         hom = np.concatenate([patch.points * w[..., None], w[..., None]], axis=-1)
         for i, j in np.ndindex(cu, cv):  # rhino3dm sets control points one at a time
             srf.Points[i, j] = r3.Point4d(*map(float, hom[i, j]))
-        model.Objects.AddSurface(srf)
+        attributes = r3.ObjectAttributes()
+        if names is not None:
+            attributes.Name = names[index]
+        model.Objects.AddSurface(srf, attributes)
     fd, tmp = tempfile.mkstemp(suffix=".3dm", dir=path.parent)
     os.close(fd)
     try:
@@ -195,6 +204,24 @@ def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch]) -> Path:
         if os.path.exists(tmp):
             os.remove(tmp)
     return path
+
+
+def write_frames_3dm(path: str | os.PathLike, surface: Surface, times: NDArray[np.float64],
+                     nets: NDArray[np.float64], label: str = "t") -> Path:
+    """The initial surface and every frame as NURBS surfaces in one ``.3dm`` file.
+
+    Object 0, named ``initial``, is ``surface``; object ``k + 1``, named
+    ``frame k: <label> = <times[k]>``, has the net ``nets[k]`` on the same degrees, knots
+    and weights (see :func:`patch_from_surface`). Written atomically.
+    """
+    nets = np.asarray(nets, dtype=float)
+    times = np.asarray(times, dtype=float).ravel()
+    if nets.ndim != 4 or nets.shape[0] != times.size or nets.shape[1:] != surface.shape + (3,):
+        raise InputError(f"frames must be {times.size} nets of shape {surface.shape + (3,)}, "
+                         f"got {nets.shape}")
+    patches = [patch_from_surface(surface)] + [patch_from_surface(surface, P) for P in nets]
+    names = ["initial"] + [f"frame {k}: {label} = {t:.9g}" for k, t in enumerate(times)]
+    return write_3dm(path, patches, names)
 
 
 def _patch_from_rhino(srf, source: str) -> NurbsPatch:

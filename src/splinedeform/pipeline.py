@@ -6,6 +6,7 @@ pipeline the command line calls: ``run(scenario, outdir, progress) -> RunResult`
 
 from __future__ import annotations
 
+import importlib.util
 import time
 import tomllib
 from contextlib import contextmanager
@@ -103,6 +104,9 @@ def _prepare_outdir(scenario: Scenario, outdir: str | Path | None) -> Path:
     if outdir is None:
         raise InputError("this scenario writes outputs (output.formats = "
                          f"{list(scenario.output.formats)}); give an output folder")
+    if "3dm" in scenario.output.formats and importlib.util.find_spec("rhino3dm") is None:
+        raise scenario.error("output.formats", "3dm needs the 'cad' extra (rhino3dm): "
+                                               "pip install 'splinedeform[cad]'")
     if "mp4" in scenario.output.formats:
         from .viz import mp4_available
 
@@ -306,6 +310,14 @@ def _write_outputs(result: RunResult, folder: Path, stages: _Stages) -> None:
             for path in export.write_control_nets(folder, f"{name}_nets", surface, times, nets,
                                                   formats=wanted):
                 result.outputs.append((f"control nets {path.suffix}", path))
+    if "3dm" in formats:
+        from .cad import write_frames_3dm
+
+        with stages.stage("CAD surfaces"):
+            label = {"dynamic": "time", "static": "load factor",
+                     "modes": "phase"}[scenario.solve.kind]
+            result.outputs.append(("NURBS surfaces .3dm", write_frames_3dm(
+                folder / f"{name}.3dm", surface, times, nets, label)))
     if "images" in formats:
         _write_images(result, folder, stages)
     for ext in ("gif", "mp4"):

@@ -43,7 +43,7 @@ IVP_METHODS = ("rk45", "dop853", "radau", "bdf")
 MASS_MATRICES = ("consistent", "lumped")
 PHYSICS = ("parametric", "intrinsic")
 FORMATS = ("obj", "stl", "ply", "vtu", "json", "npz", "report", "images", "gif", "mp4",
-           "viewer")
+           "viewer", "3dm")
 #: shorthand names accepted in ``output.formats``
 FORMAT_ALIASES = {"pvd": ("vtu",), "nets": ("json", "npz"), "animation": ("gif",),
                   "all": ("obj", "stl", "ply", "vtu", "json", "npz", "report", "images", "gif",
