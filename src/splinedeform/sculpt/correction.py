@@ -1,0 +1,74 @@
+"""Static correction of a truncated sculpting basis (mode acceleration), per grabbed point.
+
+With only the lowest ``k`` modes the omitted ones still answer a held push almost
+statically. Mode acceleration adds their static part: for a unit force at the sample
+point ``a`` (reduced force ``F_a = Tᵀ E_aᵀ``)
+
+    r_a = E_s T (K_r⁻¹ F_a - Φ Λ⁻¹ Φᵀ F_a)          (one scalar per sample point)
+
+and the displacement of the samples becomes ``Φ_s q(t) + Σ_a r_a ⊗ P_a(t)`` with ``P_a(t)``
+the force held at ``a`` at time ``t``. This is the correction of
+``Model.dynamic(..., modes=k)``; it makes the static limit of a held push exact. One sparse
+back-substitution (the factor of ``K_r`` is kept) and one sparse product per grabbed
+point, computed when the point is first grabbed, never per frame.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse.linalg as spla
+from numpy.typing import NDArray
+
+from ..errors import SingularSystemError
+from .modal import SculptBasis
+
+Array = NDArray[np.float64]
+
+
+class StaticCorrection:
+    """Residual flexibility columns ``r_a`` of a :class:`SculptBasis` (cached per sample)."""
+
+    def __init__(self, basis: SculptBasis, phi: Array):
+        model = basis.model
+        self.basis = basis
+        self.phi = phi                                   # reduced modes (n_free, k)
+        self.complete = basis.lam.size == model.n_free
+        self._factor = None if self.complete else spla.splu(model.matrices()[2])
+        u, v = basis.samples_u, basis.samples_v
+        uu, vv = np.meshgrid(u, v, indexing="ij")
+        self._E = model.surface.evaluation_matrix(uu.ravel(), vv.ravel())
+        self._T = model.constraints.T
+        self._cache: dict[int, Array] = {}
+
+    @property
+    def samples(self) -> int:
+        return int(self._E.shape[0])
+
+    def column(self, index: int) -> Array:
+        """``r_a`` for the sample point ``index`` (row-major over the ``(ru, rv)`` grid)."""
+        if index in self._cache:
+            return self._cache[index]
+        if self._factor is None:
+            column = np.zeros(self.samples)
+        else:
+            F = np.asarray(self._T.T @ self._E[index].toarray().ravel())
+            full = self._factor.solve(F)
+            if not np.all(np.isfinite(full)):
+                raise SingularSystemError("the stiffness matrix is singular: no static correction")
+            part = full - self.phi @ ((self.phi.T @ F) / self.basis.lam)
+            column = np.asarray(self._E @ (self._T @ part)).ravel()
+        self._cache[index] = column
+        return column
+
+    def displacement(self, held: dict[int, tuple[float, float, float]]) -> Array:
+        """``Σ_a r_a ⊗ P_a`` for the forces ``held`` at sample points, ``(samples, 3)``."""
+        out = np.zeros((self.samples, 3))
+        for index, force in held.items():
+            out += self.column(index)[:, None] * np.asarray(force, dtype=float)[None, :]
+        return out
+
+
+def static_correction(basis: SculptBasis) -> StaticCorrection:
+    """The correction of ``basis`` (zero when it keeps every mode)."""
+    lam, phi = basis.model.eigen(basis.lam.size)
+    return StaticCorrection(basis, np.asarray(phi))
