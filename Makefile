@@ -8,7 +8,7 @@ STAMP  := $(VENV)/.installed
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[tool,video,cad,test]'
+	$(BIN)/python -m pip install --quiet -e '.[tool,video,cad,sculpt,test]'
 	touch $(STAMP)
 
 demo: $(STAMP)

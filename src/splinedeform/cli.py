@@ -313,6 +313,16 @@ def _register_bench() -> None:
 _register_bench()
 
 
+def _register_sculpt() -> None:
+    """Add ``splinedeform sculpt`` (its server needs the extra 'sculpt')."""
+    from .sculpt.command import register
+
+    register(app)
+
+
+_register_sculpt()
+
+
 def main() -> None:
     """Entry point of the ``splinedeform`` script."""
     app()

@@ -1,0 +1,92 @@
+"""Messages from the sculpting page to the server, validated with pydantic.
+
+Every field is bounded and finite and no extra key is accepted, so a malformed or hostile
+message is refused with a message naming the field before anything is computed. What the
+physics allows beyond that (a boundary preset the surface cannot take, weights leaving a
+deformation without energy) is refused by the scenario validator and the model.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+MAX_PUSHES = 20000
+"""Most force segments one save may hold (a drag changes the force once per frame)."""
+MAX_BODY = 4 * 2**20
+"""Largest request body in bytes (20000 pushes in JSON take about 2 MiB)."""
+
+Weight = Annotated[float, Field(ge=0.0, le=1e8)]
+Edge = Literal["free", "pinned", "clamped", "pole"]
+Component = Annotated[float, Field(ge=-1e12, le=1e12)]
+Time = Annotated[float, Field(ge=0.0, le=1e9)]
+
+
+class _Message(BaseModel):
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, strict=False)
+
+
+class MaterialMessage(_Message):
+    """Material weights and damping: ``[material]`` of a scenario (``mass > 0``)."""
+
+    mass: Annotated[float, Field(gt=0.0, le=1e8)] = 1.0
+    damping: Weight = 0.0
+    rayleigh: Weight = 0.0
+    w10: Weight = 0.0
+    w01: Weight = 0.0
+    w20: Weight = 0.0
+    w11: Weight = 0.0
+    w02: Weight = 0.0
+
+
+class BoundaryMessage(_Message):
+    """Boundary preset per edge: ``[boundary]`` of a scenario."""
+
+    u0: Edge = "free"
+    u1: Edge = "free"
+    v0: Edge = "free"
+    v1: Edge = "free"
+
+
+class ResolveMessage(_Message):
+    """Re-solve the modes with a new material and boundary."""
+
+    material: MaterialMessage
+    boundary: BoundaryMessage
+
+
+class CorrectionMessage(_Message):
+    """The static correction column of one sample point of basis ``version``."""
+
+    version: Annotated[int, Field(ge=0)]
+    index: Annotated[int, Field(ge=0)]
+
+
+class PushMessage(_Message):
+    """A force ``force`` held at sample ``index`` for ``t_on <= t < t_off`` (None: still held)."""
+
+    index: Annotated[int, Field(ge=0)]
+    force: tuple[Component, Component, Component]
+    t_on: Time
+    t_off: Time | None = None
+
+
+class SaveMessage(_Message):
+    """The session as a scenario: the pushes on basis ``version`` up to time ``t_end``."""
+
+    version: Annotated[int, Field(ge=0)]
+    t_end: Annotated[float, Field(gt=0.0, le=1e9)]
+    pushes: Annotated[list[PushMessage], Field(max_length=MAX_PUSHES)]
+
+
+def describe_error(exc: ValidationError) -> str:
+    """One line per problem, ``key.path: what is wrong`` (the input itself is not echoed)."""
+    lines = []
+    for err in exc.errors()[:10]:
+        where = ".".join(str(p) for p in err["loc"]) or "message"
+        lines.append(f"{where}: {err['msg']}")
+    more = exc.error_count() - len(lines)
+    if more > 0:
+        lines.append(f"... and {more} more")
+    return "; ".join(lines)

@@ -1,0 +1,32 @@
+"""The sculpting page: one HTML file with the vendored three.js and the modal data inlined.
+
+The page does the per-frame work itself (see ``data/sculpt_template.html``): it carries the
+modal state ``(q, q', f)`` of every mode from event to event in closed form
+(:mod:`.state` is its Python twin) and sums ``x = x0 + Φ_s q(t)`` (plus the static
+correction of held pushes) over the sample grid in typed arrays. Saved from the browser it
+keeps working offline; only a re-solve, the static correction and "Save" need the server.
+"""
+
+from __future__ import annotations
+
+import html
+import re
+from importlib import resources
+from typing import Any, Mapping
+
+from ..viz import _vendor_text, colormap_table, script_json
+
+
+def sculpt_page(data: Mapping[str, Any]) -> str:
+    """The self-contained page for the modal data ``data`` (see :meth:`.session.Session.payload`)."""
+    template = resources.files("splinedeform").joinpath("data", "sculpt_template.html") \
+        .read_text(encoding="utf-8")
+    three = _vendor_text("three-orbit.min.js")
+    if "</script" in three.lower():
+        raise RuntimeError("the vendored three.js contains '</script' and cannot be inlined")
+    fills = {"__SPLINEDEFORM_TITLE__": html.escape(str(data.get("title", "sculpt"))),
+             "/*__SPLINEDEFORM_THREE__*/": three,
+             "__SPLINEDEFORM_DATA__": script_json({**data, "colormap": colormap_table(64)})}
+    # one pass: text put in by one placeholder is never searched for another
+    pattern = re.compile("|".join(re.escape(key) for key in fills))
+    return pattern.sub(lambda match: fills[match.group(0)], template)

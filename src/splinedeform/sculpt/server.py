@@ -1,0 +1,162 @@
+"""The sculpting server: starlette routes over a :class:`~.session.Session`, run by uvicorn.
+
+Routes (JSON in and out; every error is ``{"error": message}`` with a 4xx status, and the
+page shows it):
+
+- ``GET /``: the page, with the current modal basis inside (it keeps working offline);
+- ``GET /api/basis``: the current modal data (after a re-solve);
+- ``GET /api/status``: progress of a re-solve ``{busy, stage, elapsed, error, version}``;
+- ``POST /api/resolve``: ``{material, boundary}`` → new modes, answered with the new data;
+- ``POST /api/correction``: ``{version, index}`` → the static correction column of a sample;
+- ``POST /api/save``: ``{version, t_end, pushes}`` → the scenario written to the save path.
+
+The server binds to 127.0.0.1 unless told otherwise; it never reads or writes a file named
+by a message (the save path is fixed when it starts).
+"""
+
+from __future__ import annotations
+
+import json
+import socket
+import sys
+from collections.abc import Awaitable, Callable
+from pydantic import BaseModel, ValidationError
+from starlette.applications import Starlette
+from starlette.concurrency import run_in_threadpool
+from starlette.requests import Request
+from starlette.responses import HTMLResponse, JSONResponse, Response
+from starlette.routing import Route
+
+from ..errors import InputError
+from .export import _b64
+from .messages import (MAX_BODY, CorrectionMessage, ResolveMessage, SaveMessage,
+                       describe_error)
+from .page import sculpt_page
+from .session import Busy, Session
+
+
+def _error(message: str, status: int = 400) -> JSONResponse:
+    return JSONResponse({"error": message}, status_code=status)
+
+
+async def _message(request: Request, model: type[BaseModel]) -> BaseModel | JSONResponse:
+    """The body validated as ``model``, or the error response saying what is wrong."""
+    declared = request.headers.get("content-length")
+    if declared is not None and (not declared.isdigit() or int(declared) > MAX_BODY):
+        return _error(f"message too large (at most {MAX_BODY} bytes)", 413)
+    body = b""
+    async for chunk in request.stream():
+        body += chunk
+        if len(body) > MAX_BODY:
+            return _error(f"message too large (at most {MAX_BODY} bytes)", 413)
+    try:
+        data = json.loads(body)
+    except (ValueError, RecursionError):
+        return _error("the message is not JSON")
+    if not isinstance(data, dict):
+        return _error("the message must be a JSON object")
+    try:
+        return model.model_validate(data)
+    except ValidationError as exc:
+        return _error(f"invalid message: {describe_error(exc)}", 422)
+
+
+Handler = Callable[[Request], Awaitable[Response]]
+
+
+def _guarded(handler: Handler) -> Handler:
+    """Input errors become 400 answers, anything else a 500 answer; the server keeps running."""
+    async def guarded(request: Request) -> Response:
+        try:
+            return await handler(request)
+        except Busy as exc:
+            return _error(str(exc), 409)
+        except InputError as exc:
+            return _error(str(exc))
+        except Exception as exc:  # noqa: BLE001  (never let one message stop the server)
+            print(f"sculpt: internal error: {type(exc).__name__}: {exc}", file=sys.stderr)
+            return _error(f"internal error: {type(exc).__name__}: {exc}", 500)
+    return guarded
+
+
+def create_app(session: Session) -> Starlette:
+    """The starlette application serving ``session``."""
+
+    async def page(request: Request) -> Response:
+        html = await run_in_threadpool(sculpt_page, session.payload())
+        return HTMLResponse(html, headers={"Cache-Control": "no-store"})
+
+    async def basis(request: Request) -> Response:
+        return JSONResponse(await run_in_threadpool(session.payload))
+
+    async def status(request: Request) -> Response:
+        return JSONResponse({**session.progress, "version": session.version})
+
+    async def resolve(request: Request) -> Response:
+        message = await _message(request, ResolveMessage)
+        if isinstance(message, JSONResponse):
+            return message
+        await run_in_threadpool(session.resolve, message)
+        return JSONResponse(await run_in_threadpool(session.payload))
+
+    async def correction(request: Request) -> Response:
+        message = await _message(request, CorrectionMessage)
+        if isinstance(message, JSONResponse):
+            return message
+        assert isinstance(message, CorrectionMessage)
+        column = await run_in_threadpool(session.correction_column, message.version,
+                                         message.index)
+        return JSONResponse({"version": message.version, "index": message.index,
+                             "column": _b64(column)})
+
+    async def save(request: Request) -> Response:
+        message = await _message(request, SaveMessage)
+        if isinstance(message, JSONResponse):
+            return message
+        assert isinstance(message, SaveMessage)
+        if not message.pushes:
+            raise InputError("nothing to save yet: push the surface first")
+        path, _ = await run_in_threadpool(session.save, message)
+        print(f"sculpt: saved {len(message.pushes)} force steps to {path}", file=sys.stderr)
+        return JSONResponse({"path": str(path), "loads": len(message.pushes)})
+
+    routes = [Route("/", _guarded(page)), Route("/api/basis", _guarded(basis)),
+              Route("/api/status", _guarded(status)),
+              Route("/api/resolve", _guarded(resolve), methods=["POST"]),
+              Route("/api/correction", _guarded(correction), methods=["POST"]),
+              Route("/api/save", _guarded(save), methods=["POST"])]
+    return Starlette(routes=routes)
+
+
+def bind(host: str, port: int) -> socket.socket:
+    """A listening socket on ``host:port`` (port 0: a free port chosen by the system)."""
+    try:
+        infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
+    except socket.gaierror as exc:
+        raise InputError(f"--host {host!r} is not an address of this machine ({exc})") from None
+    family, _, _, _, address = infos[0]
+    sock = socket.socket(family, socket.SOCK_STREAM)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        sock.bind(address)
+    except OSError as exc:
+        sock.close()
+        raise InputError(f"cannot listen on {host}:{port}: {exc.strerror or exc}") from None
+    sock.listen(64)
+    return sock
+
+
+def serve(session: Session, sock: socket.socket, quiet: bool = False) -> None:
+    """Serve until Ctrl-C (uvicorn handles SIGINT/SIGTERM and shuts down cleanly)."""
+    import uvicorn
+
+    config = uvicorn.Config(create_app(session), log_level="warning" if not quiet else "error",
+                            access_log=False, lifespan="off")
+    uvicorn.Server(config).run(sockets=[sock])
+
+
+def url_of(sock: socket.socket) -> str:
+    host, port = sock.getsockname()[:2]
+    shown = f"[{host}]" if ":" in host else host
+    return f"http://{shown}:{port}/"
+

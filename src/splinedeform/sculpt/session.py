@@ -1,0 +1,205 @@
+"""One sculpting session: a scenario, its current modal basis, re-solves and "Save".
+
+The session keeps the scenario it was started from; a new material or boundary is applied
+as overrides of that scenario (validated by the scenario reader, so a value the physics
+refuses is named like a key of a file) and the model is rebuilt from it. "Save" writes
+the same scenario with the pushes as ``[[load]]`` point forces with step profiles, so
+``splinedeform run`` replays the session.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from ..scenario import build, scenario_to_toml, with_overrides
+from ..scenario.spec import Scenario
+from .correction import StaticCorrection, static_correction
+from .export import _b64, payload
+from .messages import PushMessage, ResolveMessage, SaveMessage
+from .modal import SculptBasis, sculpt_basis
+
+MATERIAL_FIELDS = ("mass", "damping", "rayleigh", "w10", "w01", "w20", "w11", "w02")
+EDGE_NAMES = ("u0", "u1", "v0", "v1")
+MAX_PROBES = 8
+"""Grabbed points written as probes of the saved scenario (the first ones)."""
+
+
+class Busy(RuntimeError):
+    """A re-solve is already running."""
+
+
+class Session:
+    """The state the server keeps: scenario, basis, correction, progress of a re-solve.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Surface, material and boundary to start from (its loads are not used).
+    resolution : int
+        Sample grid ``resolution × resolution`` on the surface.
+    modes : int or None
+        Keep the lowest ``modes`` modes (all when None or more than there are); the
+        omitted ones enter through the static correction.
+    save_path : Path
+        Where "Save" writes the scenario (the page cannot choose another file).
+    """
+
+    def __init__(self, scenario: Scenario, resolution: int = 64, modes: int | None = 200,
+                 save_path: Path | None = None):
+        if scenario.material.physics not in ("parametric", "intrinsic"):
+            raise InputError(f"sculpt needs material.physics 'parametric' or 'intrinsic' "
+                             f"(x, y and z share the modes), got {scenario.material.physics!r}")
+        self.scenario = scenario
+        self.resolution = int(resolution)
+        self.modes = modes
+        self.save_path = Path(save_path or f"{scenario.name}-sculpt.toml")
+        self.version = 0
+        self.progress: dict[str, Any] = {"busy": False, "stage": "idle", "elapsed": 0.0,
+                                         "error": None}
+        self._lock = threading.Lock()
+        self.basis: SculptBasis
+        self.correction: StaticCorrection
+        self._solve(scenario)
+
+    # -- solving ------------------------------------------------------------------------
+    def _stage(self, stage: str, start: float) -> None:
+        self.progress.update(stage=stage, elapsed=time.perf_counter() - start)
+
+    def _solve(self, scenario: Scenario) -> None:
+        from threadpoolctl import threadpool_limits
+
+        # one BLAS thread: the machine's other core draws the page (and oversubscribed
+        # BLAS threads make a dense eigensolve several times slower, not faster)
+        with threadpool_limits(1):
+            self._solve_now(scenario)
+
+    def _solve_now(self, scenario: Scenario) -> None:
+        start = time.perf_counter()
+        self._stage("assembling the matrices", start)
+        model = build(scenario).model
+        k = None if self.modes is None or self.modes >= model.n_free else int(self.modes)
+        self._stage(f"computing {k or model.n_free} modes", start)
+        basis = sculpt_basis(model, self.resolution, k)
+        self._stage("static correction", start)
+        correction = static_correction(basis)
+        self.scenario, self.basis, self.correction = scenario, basis, correction
+        self.version += 1
+        self.timing = time.perf_counter() - start
+        self._stage("done", start)
+
+    def resolve(self, message: ResolveMessage) -> None:
+        """New material and boundary: validate as scenario overrides, rebuild, re-solve.
+
+        Raises :class:`Busy` when a re-solve is running and
+        :class:`~splinedeform.errors.InputError` for values the physics refuses; the
+        current basis stays in place then.
+        """
+        if not self._lock.acquire(blocking=False):
+            raise Busy("a re-solve is already running")
+        try:
+            self.progress.update(busy=True, error=None, stage="validating", elapsed=0.0)
+            overrides: dict[str, Any] = {f"material.{k}": getattr(message.material, k)
+                                         for k in MATERIAL_FIELDS}
+            overrides.update({f"boundary.{e}": getattr(message.boundary, e) for e in EDGE_NAMES})
+            try:
+                self._solve(with_overrides(self.scenario, overrides, origin="sculpt page"))
+            except Exception as exc:
+                self.progress.update(error=str(exc), stage="failed")
+                raise
+        finally:
+            self.progress["busy"] = False
+            self._lock.release()
+
+    # -- what the page receives ------------------------------------------------------------
+    def payload(self) -> dict[str, Any]:
+        """The modal data (see :func:`.export.payload`) plus the control net, the current
+        material and boundary, and what the server offers."""
+        basis, model = self.basis, self.basis.model
+        data = payload(basis)
+        surf = model.surface
+        s = self.scenario
+        data.update(
+            version=self.version, title=s.title or s.name, n_free=int(model.n_free),
+            complete=bool(self.correction.complete),
+            net_shape=list(surf.shape), periodic=[bool(surf.basis_u.periodic),
+                                                  bool(surf.basis_v.periodic)],
+            phi_net=_b64(basis.phi_net), net_rest=_b64(surf.control_points.reshape(-1, 3)),
+            material={k: getattr(s.material, k) for k in MATERIAL_FIELDS},
+            boundary={e: getattr(s.boundary, e) for e in EDGE_NAMES},
+            solve_seconds=round(self.timing, 4), server=True)
+        return data
+
+    def correction_column(self, version: int, index: int) -> np.ndarray:
+        """``r_a`` of sample ``index`` on basis ``version`` (see :mod:`.correction`)."""
+        self._check_version(version)
+        self._check_index(index, "index")
+        return self.correction.column(index)
+
+    def _check_version(self, version: int) -> None:
+        if version != self.version:
+            raise InputError(f"the page shows basis {version} but the server has {self.version} "
+                             "(re-solved meanwhile); reload the page")
+
+    def _check_index(self, index: int, what: str) -> None:
+        count = self.basis.samples_u.size * self.basis.samples_v.size
+        if not 0 <= index < count:
+            raise InputError(f"{what} = {index} is not a sample point (0 .. {count - 1})")
+
+    # -- save --------------------------------------------------------------------------------
+    def to_scenario(self, message: SaveMessage) -> Scenario:
+        """The session as a scenario: pushes as step point loads, probes at grabbed points."""
+        self._check_version(message.version)
+        loads, probes = [], []
+        for n, push in enumerate(message.pushes, start=1):
+            loads.append(self._load_table(push, n))
+            at = loads[-1]["at"]
+            if at not in probes and len(probes) < MAX_PROBES:
+                probes.append(at)
+        overrides: dict[str, Any] = {
+            "load": loads,
+            "title": f"sculpted: {self.scenario.title or self.scenario.name}",
+            "solve": {"kind": "dynamic", "method": "analytic", "t_end": message.t_end,
+                      "frames": 101, "modes": min(6, self.basis.model.n_free)},
+            "output": {"formats": ["report", "images", "viewer"],
+                       "resolution": min(self.resolution, 64)},
+        }
+        if probes:
+            overrides["output"]["probes"] = probes
+        return with_overrides(self.scenario, overrides, origin="sculpt save")
+
+    def _load_table(self, push: PushMessage, n: int) -> dict[str, Any]:
+        self._check_index(push.index, f"pushes[{n}].index")
+        if push.t_off is not None and not push.t_off > push.t_on:
+            raise InputError(f"pushes[{n}]: t_off = {push.t_off} must be after t_on = {push.t_on}")
+        rv = self.basis.samples_v.size
+        u = float(self.basis.samples_u[push.index // rv])
+        v = float(self.basis.samples_v[push.index % rv])
+        table: dict[str, Any] = {"kind": "point", "at": [u, v],
+                                 "force": [float(f) for f in push.force],
+                                 "profile": "step", "t_on": float(push.t_on)}
+        if push.t_off is not None:
+            table["t_off"] = float(push.t_off)
+        return table
+
+    def save(self, message: SaveMessage) -> tuple[Path, str]:
+        """Write the session scenario to :attr:`save_path` (atomically); return it and its text."""
+        from ..export import write_text
+
+        scenario = self.to_scenario(message)
+        model = self.basis.model
+        header = [f"# Saved by splinedeform sculpt: {len(message.pushes)} force steps on "
+                  f"{model.surface.shape[0]}x{model.surface.shape[1]} control points.",
+                  "# splinedeform run replays it with every mode"
+                  + ("." if self.correction.complete else
+                     f" (the page kept {self.basis.lam.size} of {model.n_free} and added the "
+                     "static part of the others)."), ""]
+        text = "\n".join(header) + scenario_to_toml(scenario)
+        path = write_text(self.save_path, text)
+        return path, text
+
