@@ -120,7 +120,10 @@ def create_app(session: Session) -> Starlette:
         print(f"sculpt: saved {len(message.pushes)} force steps to {path}", file=sys.stderr)
         return JSONResponse({"path": str(path), "loads": len(message.pushes)})
 
-    routes = [Route("/", _guarded(page)), Route("/api/basis", _guarded(basis)),
+    async def no_icon(request: Request) -> Response:
+        return Response(status_code=204)
+
+    routes = [Route("/", _guarded(page)), Route("/favicon.ico", no_icon), Route("/api/basis", _guarded(basis)),
               Route("/api/status", _guarded(status)),
               Route("/api/resolve", _guarded(resolve), methods=["POST"]),
               Route("/api/correction", _guarded(correction), methods=["POST"]),
