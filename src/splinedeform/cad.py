@@ -13,7 +13,6 @@ control points ``(w x, w y, w z, w)``. Needs the ``cad`` extra.
 from __future__ import annotations
 
 import os
-import tempfile
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,6 +22,7 @@ from numpy.typing import NDArray
 
 from .basis import BSplineBasis
 from .errors import InputError
+from .export.atomic import atomic_path
 from .knots import KnotVectorBasis, RationalBasis
 from .surface import Basis, Surface
 
@@ -194,15 +194,9 @@ def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch],
         if names is not None:
             attributes.Name = names[index]
         model.Objects.AddSurface(srf, attributes)
-    fd, tmp = tempfile.mkstemp(suffix=".3dm", dir=path.parent)
-    os.close(fd)
-    try:
-        if not model.Write(tmp, 7):
+    with atomic_path(path) as tmp:
+        if not model.Write(str(tmp), 7):
             raise InputError(f"{path}: openNURBS could not write the file")
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
     return path
 
 
