@@ -148,3 +148,36 @@ def test_complex_input_is_refused_not_truncated():
     surf = sd.shapes.plane(cells=2, degree=2)
     with pytest.raises(InputError, match="complex"):
         sd.Surface(surf.control_points + 0j, surf.basis_u, surf.basis_v)
+
+
+# -- values the solvers cannot carry ---------------------------------------------------------
+@pytest.mark.parametrize("material, key", [
+    (dict(w10=1e308, w01=1.0), "material.w10"),
+    (dict(mass=1e-320, w10=1.0, w01=1.0), "material.mass"),
+    (dict(mass=1e-200, w10=1e100, w01=1.0), "material.mass"),  # λ ~ 1e300, mass the more extreme
+    (dict(mass=1e-100, w10=1e200, w01=1.0), "material.w10"),
+])
+def test_material_scales_beyond_double_range_are_refused_naming_the_key(material, key):
+    surf = sd.shapes.plane(cells=3)
+    with pytest.raises(InputError, match=rf"^{key} = .*Rescale the units") as info:
+        sd.Model(surf, sd.Material(**material), boundary="clamped")
+    assert info.value.key == key
+
+
+def test_no_free_coordinate_is_refused_at_the_model():
+    surf = sd.shapes.plane(cells=1)
+    with pytest.raises(InputError, match="no free coordinate: .* 4 x 4 control points"):
+        sd.Model(surf, sd.Material(w10=1.0, w01=1.0), boundary="clamped")
+
+
+def test_an_absurd_angular_frequency_is_refused():
+    with pytest.raises(InputError, match=r"Harmonic.omega must be <= 1e\+12"):
+        Harmonic(omega=1e300)
+
+
+def test_a_huge_tessellation_is_refused_before_allocating():
+    surf = sd.shapes.plane(cells=2, degree=2)
+    with pytest.raises(InputError, match=r"tessellation resolution 1000000 asks for 1e\+12 vertices"):
+        surf.tessellate(10**6)
+    vertices, faces = surf.tessellate((2048, 2))      # the limit is on the product
+    assert vertices.shape == (4096, 3) and faces.shape == (2 * 2047, 3)

@@ -130,9 +130,14 @@ class Piecewise(Profile):
         return [(t, scales[i + 1] - scales[i]) for i, (t, _) in enumerate(self.points)]
 
 
+#: largest angular frequency of a harmonic profile (a period of 6e-12 time units): beyond it
+#: ``ω²`` and the phase ``ω t`` leave the range where the modal response keeps its digits
+OMEGA_MAX = 1e12
+
+
 @dataclass(frozen=True)
 class Harmonic(Profile):
-    """``s(t) = sin(ω t + φ)`` for ``t >= 0`` (0 before)."""
+    """``s(t) = sin(ω t + φ)`` for ``t >= 0`` (0 before), ``0 < ω <= OMEGA_MAX``."""
 
     omega: float
     phase: float = 0.0
@@ -141,6 +146,9 @@ class Harmonic(Profile):
         omega = _finite(self.omega, "Harmonic.omega")
         if omega <= 0:
             raise InputError(f"Harmonic.omega must be > 0, got {omega}")
+        if omega > OMEGA_MAX:
+            raise InputError(f"Harmonic.omega must be <= {OMEGA_MAX:g} (a period of "
+                             f"{2 * np.pi / OMEGA_MAX:.1e}), got {omega:g}; rescale the time unit")
         object.__setattr__(self, "omega", omega)
         object.__setattr__(self, "phase", _finite(self.phase, "Harmonic.phase"))
 

@@ -84,3 +84,39 @@ class Material:
 
     def as_dict(self) -> dict[str, float]:
         return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+#: entries of the assembled matrices, and their ratio (the scale of ``λ = ω²``), must stay
+#: below this (and the mass entries above its inverse), so that the eigensolver's products
+#: and the modal exponentials keep inside the range of doubles (about 1e±308)
+MATRIX_RANGE = 1e280
+
+
+def check_scales(material: Material, K_max: float, M_max: float) -> None:
+    """Refuse weights and mass whose assembled matrices doubles cannot carry.
+
+    ``K_max = max |K_ij|`` and ``M_max = max |M_ij|`` of the reduced stiffness and mass
+    matrices. Required: both finite, ``K_max <= R``, ``M_max >= 1/R`` and
+    ``K_max / M_max <= R`` (an upper bound of scale of ``λ_max``) with
+    ``R = MATRIX_RANGE``. The error is an :class:`InputError` whose ``key`` attribute is
+    the material key to change (``material.mass`` or the largest weight).
+    """
+    weights = {w: getattr(material, w) for w in WEIGHTS if getattr(material, w)}
+    largest = max(weights, key=lambda w: weights[w])
+    problem = None
+    if not (np.isfinite(K_max) and K_max <= MATRIX_RANGE):
+        key, problem = largest, "the stiffness matrix overflows"
+    elif not (np.isfinite(M_max) and M_max >= 1 / MATRIX_RANGE):
+        key, problem = "mass", "the mass matrix underflows"
+    elif K_max / M_max > MATRIX_RANGE:
+        heavy = abs(math.log10(weights[largest])) >= abs(math.log10(material.mass))
+        key, problem = (largest if heavy else "mass"), "the eigenvalues λ = ω² overflow"
+    if problem is None:
+        return
+    error = InputError(
+        f"material.{key} = {getattr(material, key):g}: {problem} (largest stiffness entry "
+        f"{K_max:.3g}, largest mass entry {M_max:.3g}; the solvers need them within "
+        f"1e±{math.log10(MATRIX_RANGE):.0f} and their ratio below {MATRIX_RANGE:.0e}). "
+        f"Rescale the units: e.g. divide every weight and load by the same factor")
+    error.key = f"material.{key}"  # type: ignore[attr-defined]
+    raise error

@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 from .boundary import Constraints, build_constraints
 from .errors import InputError, SingularSystemError
 from .loads import Load, as_load, static_time
-from .material import Material
+from .material import Material, check_scales
 from .physics import PHYSICS, intrinsic
 from .quadrature import gram_matrix
 from .solution import ModalSolution, StaticSolution
@@ -126,6 +126,14 @@ class Model:
         self.constraints: Constraints = build_constraints(
             surface.basis_u, surface.basis_v, boundary,
             None if fixed is None else np.asarray(fixed))
+        if self.constraints.n_free == 0:
+            error = InputError(
+                f"no free coordinate: the boundary {self.constraints.edges} fixes every one of "
+                f"the {surface.shape[0]} x {surface.shape[1]} control points (cells "
+                f"{surface.basis_u.cells} x {surface.basis_v.cells}, degree "
+                f"{surface.basis_u.degree}), so nothing can move; use more cells or free an edge")
+            error.key = "boundary"  # type: ignore[attr-defined]
+            raise error
         top = lambda b: min(2, b.degree)  # noqa: E731
         self.gram_u = [gram_matrix(surface.basis_u, a) for a in range(top(surface.basis_u) + 1)]
         self.gram_v = [gram_matrix(surface.basis_v, a) for a in range(top(surface.basis_v) + 1)]
@@ -138,6 +146,8 @@ class Model:
         self.K_full, self.M_full = K, M
         self._K = (T.T @ K @ T).tocsc()
         self._M = (T.T @ M @ T).tocsc()
+        if self._M.nnz:
+            check_scales(material, _largest(self._K), _largest(self._M))
         self._C = ((material.damping / material.mass) * self._M
                    + material.rayleigh * self._K).tocsc()
         self._eigen: tuple[Array, Array] | None = None
@@ -435,6 +445,11 @@ def _outside(basis: modal_basis.ModalBasis, M: sp.spmatrix, x: Array) -> float:
         return 0.0
     rest = x - basis.expand(basis.project(M @ x)[None])[0]
     return float(np.sqrt(max(np.sum(rest * (M @ rest)), 0.0))) / norm
+
+
+def _largest(A: sp.spmatrix) -> float:
+    """``max |A_ij|`` (0 for an empty matrix; NaN propagates)."""
+    return float(np.abs(A.data).max()) if A.nnz else 0.0
 
 
 def _check_count(k: int, available: int) -> int:

@@ -22,6 +22,11 @@ from .knots import KnotVectorBasis, RationalBasis
 Basis = BSplineBasis | KnotVectorBasis | RationalBasis
 
 
+#: largest number of sample points ``ru * rv`` of one tessellation (2048², about 300 MiB
+#: of vertices and faces)
+MAX_SAMPLES = 2048 * 2048
+
+
 @dataclass(frozen=True)
 class Surface:
     """A B-spline surface on the parameter rectangle ``[0, L_u] × [0, L_v]``.
@@ -154,6 +159,11 @@ class Surface:
         ru, rv = (resolution, resolution) if np.isscalar(resolution) else resolution
         if int(ru) < 2 or int(rv) < 2:
             raise InputError(f"tessellation resolution must be >= 2 per direction, got {resolution}")
+        if int(ru) * int(rv) > MAX_SAMPLES:
+            raise InputError(
+                f"tessellation resolution {resolution} asks for {int(ru) * int(rv):.3g} "
+                f"vertices (about {int(ru) * int(rv) * 72 / 2**30:.3g} GiB with the faces); "
+                f"at most {MAX_SAMPLES} (e.g. 2048 x 2048)")
         return (np.linspace(0.0, self.basis_u.length, int(ru)),
                 np.linspace(0.0, self.basis_v.length, int(rv)))
 

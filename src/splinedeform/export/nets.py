@@ -180,6 +180,27 @@ def _load_npz_nets(path: Path) -> dict[str, Any]:
             "name": str(data["name"]) if "name" in data else path.stem}
 
 
+def real_array(value: Any, where: str) -> NDArray[np.float64]:
+    """``value`` as a float array; strings, objects, booleans and complex numbers refused.
+
+    ``np.asarray(["1.5"], dtype=float)`` would parse strings and ``complex`` would drop an
+    imaginary part, so the stored dtype is checked first (integers are widened).
+    """
+    try:
+        raw = np.asarray(value)
+    except (TypeError, ValueError) as exc:     # ragged nested lists
+        raise InputError(f"{where} must be a numeric array: {exc}") from None
+    if raw.dtype.kind not in "iuf":
+        what = _DTYPE_KINDS.get(raw.dtype.kind, "not numbers")
+        raise InputError(f"{where} must be an array of real numbers, got dtype {raw.dtype} "
+                         f"({what})")
+    return raw.astype(float)
+
+
+_DTYPE_KINDS = {"U": "strings", "S": "bytes", "O": "mixed or nested objects",
+                "b": "booleans", "c": "complex numbers", "V": "records", "M": "dates"}
+
+
 def _basis_from(desc: Mapping[str, Any], size: int, where: str) -> BSplineBasis:
     """The basis a file describes, checked against the net's size ``size`` and its knots."""
     missing = [k for k in _BASIS_KEYS if k not in desc]
@@ -243,10 +264,7 @@ def read_control_net(path: str | os.PathLike[str], frame: int = -1) -> Surface:
     if not source.is_file():
         raise InputError(f"control-net file {source} does not exist")
     data = _load_json_nets(source) if suffix == ".json" else _load_npz_nets(source)
-    try:
-        P = np.asarray(data["control_points"], dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(f"{source}: control_points must be a numeric array") from None
+    P = real_array(data["control_points"], f"{source}: control_points")
     if P.ndim == 3:
         P = P[None]
     if P.ndim != 4 or P.shape[0] == 0 or P.shape[-1] != 3:

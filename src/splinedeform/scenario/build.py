@@ -35,8 +35,8 @@ def _located(scenario: Scenario, path: str) -> Iterator[None]:
         yield
     except ScenarioError:
         raise
-    except InputError as exc:
-        raise scenario.error(path, str(exc)) from None
+    except InputError as exc:   # an error that knows its key (e.g. material.mass) is put there
+        raise scenario.error(getattr(exc, "key", None) or path, str(exc)) from None
     except (ValueError, ArithmeticError) as exc:
         raise scenario.error(path, f"numerical failure ({type(exc).__name__}: {exc}); the "
                                    "values given are probably too extreme") from None
@@ -125,6 +125,8 @@ def _point_grid(scenario: Scenario, path: Path) -> Any:
     """The ``(N_u, N_v, 3)`` grid in a ``.npy`` / ``.npz`` file, or None for a control net."""
     import numpy as np
 
+    from ..export.nets import real_array
+
     try:
         with open(path, "rb") as fh:
             data = np.load(fh, allow_pickle=False)
@@ -141,7 +143,8 @@ def _point_grid(scenario: Scenario, path: Path) -> Any:
     if data.ndim != 3 or data.shape[2] != 3:
         raise scenario.error("surface.path", f"a point grid must have shape (N_u, N_v, 3), "
                                              f"got {data.shape}")
-    return data
+    with _located(scenario, "surface.path"):
+        return real_array(data, f"point grid {path.name}")
 
 
 def build_load(scenario: Scenario) -> Any:

@@ -35,6 +35,7 @@ from pydantic import BaseModel, ConfigDict, Field, Strict
 
 from ..basis import KNOT_KINDS
 from ..boundary import PRESETS
+from ..loads import OMEGA_MAX
 from ..model import METHODS, STEP_METHODS
 from ..shapes import FIT_METHODS
 
@@ -222,7 +223,7 @@ class _Profiled(_Table):
             "`piecewise`: [t, s] pairs, t ≥ 0 increasing; s is the value of the last point with "
             "`t_i ≤ t` (0 before the first)"),
         json_schema_extra={"doc_default": 'required for `piecewise`'})
-    omega: Optional[Positive] = Field(None, description="`harmonic`: `s = sin(ω t + φ)`",
+    omega: Optional[Annotated[float, Strict(), Field(gt=0, le=OMEGA_MAX, allow_inf_nan=False)]] = Field(None, description="`harmonic`: `s = sin(ω t + φ)`",
         json_schema_extra={"doc_default": 'required for `harmonic`'})
     phase: Real = Field(0.0, description="`harmonic`: φ")
 
