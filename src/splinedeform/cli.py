@@ -86,6 +86,11 @@ DEBUG_OPT = typer.Option(False, "--debug", help="Show the full traceback of an e
 OUTSIDE_OPT = typer.Option(False, "--allow-outside-paths",
                            help="Let the scenario read files outside its own folder "
                                 "(surface.path); refused by default.")
+BUDGET_OPT = typer.Option(None, "--budget", help="Raise the limits a run is estimated against "
+                                                 "before it starts, e.g. memory=16GiB,disk=50GiB,"
+                                                 "files=1e5,work=1e13 (inf lifts one). "
+                                                 "[default: memory=4GiB,disk=4GiB,files=5000,"
+                                                 "work=1e12]")
 
 
 def _consoles() -> tuple[Any, Any]:
@@ -143,14 +148,16 @@ def _table(title: str, rows: list[tuple[str, str]]) -> Any:
     return table
 
 
-def _run(scenario: Any, outdir: Path, quiet: bool) -> None:
+def _run(scenario: Any, outdir: Path, quiet: bool, budget: str | None = None) -> None:
     """Run a validated scenario with progress bars and print the summary table."""
     from ._progress import StageProgress
+    from .budget import Budget
     from .pipeline import run, summary_rows
 
+    limits = Budget.parse(budget) if budget is not None else None
     out, err = _consoles()
     with StageProgress(err, enabled=not quiet) as progress:
-        result = run(scenario, outdir, progress=progress)
+        result = run(scenario, outdir, progress=progress, budget=limits)
     if not quiet:
         out.print(_table(f"splinedeform: {scenario.title or scenario.name}",
                          summary_rows(result)))
@@ -167,7 +174,7 @@ def run_command(scenario: Path = SCENARIO_ARG, outdir: Optional[Path] = OUTDIR_O
                 physics: Optional[str] = typer.Option(
                     None, "--physics", help="Override material.physics: parametric (the "
                                             "paper's energy) or intrinsic (on the surface)."),
-                allow_outside_paths: bool = OUTSIDE_OPT,
+                allow_outside_paths: bool = OUTSIDE_OPT, budget: Optional[str] = BUDGET_OPT,
                 quiet: bool = QUIET_OPT, debug: bool = DEBUG_OPT) -> None:
     """Run a scenario file: build, solve, sample frames and write its outputs."""
     from .scenario import load_scenario, with_method, with_overrides
@@ -187,7 +194,7 @@ def run_command(scenario: Path = SCENARIO_ARG, outdir: Optional[Path] = OUTDIR_O
                                     origin="--frames")
         if physics is not None:
             loaded = with_overrides(loaded, {"material.physics": physics}, origin="--physics")
-        _run(loaded, outdir or Path(f"{loaded.name}-output"), quiet)
+        _run(loaded, outdir or Path(f"{loaded.name}-output"), quiet, budget)
 
 
 def demo_scenario() -> Any:
@@ -211,13 +218,15 @@ def demo_command(outdir: Path = typer.Option(Path("demo-output"), "-o", "--outdi
 def validate_command(scenario: Path = SCENARIO_ARG, allow_outside_paths: bool = OUTSIDE_OPT,
                      debug: bool = DEBUG_OPT) -> None:
     """Check a scenario file and print what it would run (with every default filled in)."""
+    from .budget import estimate
     from .scenario import build, describe, load_scenario, scenario_to_toml
 
     with _reported_errors(debug):
         loaded = load_scenario(scenario, allow_outside_paths=allow_outside_paths)
         built = build(loaded)
         out, _ = _consoles()
-        out.print(_table(f"{scenario}: valid", describe(loaded, built)))
+        rows = describe(loaded, built) + estimate(loaded, built.model).rows()
+        out.print(_table(f"{scenario}: valid", rows))
         out.print(scenario_to_toml(loaded), markup=False, highlight=False)
 
 

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterator
 
+from .budget import Budget, check as check_budget
 from .errors import InputError
 from .scenario import Built, Scenario, SolveSpec, _located, build, scenario_to_toml
 
@@ -75,7 +76,7 @@ class _Stages:
 
 
 def run(scenario: Scenario, outdir: str | Path | None = None,
-        progress: ProgressCallback | None = None) -> RunResult:
+        progress: ProgressCallback | None = None, budget: Budget | None = None) -> RunResult:
     """Build, solve, sample the frames and write every requested output to ``outdir``.
 
     Parameters
@@ -86,12 +87,16 @@ def run(scenario: Scenario, outdir: str | Path | None = None,
     progress : callable, optional
         ``progress(stage, done, total)`` for the stages ``build``, ``solve``, ``modes``,
         ``frames`` and one per output.
+    budget : Budget, optional
+        Limits of memory, disk, files and work (default :class:`~splinedeform.budget.Budget`):
+        a run estimated beyond them is refused after building, before solving.
     """
     stages = _Stages(progress)
     formats = scenario.output.formats
     folder = _prepare_outdir(scenario, outdir) if formats else None
     with stages.stage("build"):
         built = build(scenario)
+        check_budget(scenario, built.model, budget)
     result = _solve(scenario, built, stages)
     result.timings = stages.timings
     if folder is not None:
