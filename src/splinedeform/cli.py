@@ -132,15 +132,18 @@ def _print_error(message: str) -> None:
 
 
 def _escape(text: str) -> str:
+    """``text`` shown literally: rich markup escaped, terminal control characters visible."""
     from rich.markup import escape
 
-    return escape(text)
+    from .terminal import printable
+
+    return escape(printable(text))
 
 
 def _table(title: str, rows: list[tuple[str, str]]) -> Any:
     from rich.table import Table
 
-    table = Table(title=title, show_header=False, title_justify="left")
+    table = Table(title=_escape(title), show_header=False, title_justify="left")
     table.add_column("what", style="bold")
     table.add_column("value", overflow="fold")
     for label, value in rows:
@@ -220,6 +223,7 @@ def validate_command(scenario: Path = SCENARIO_ARG, allow_outside_paths: bool = 
     """Check a scenario file and print what it would run (with every default filled in)."""
     from .budget import estimate
     from .scenario import build, describe, load_scenario, scenario_to_toml
+    from .terminal import printable
 
     with _reported_errors(debug):
         loaded = load_scenario(scenario, allow_outside_paths=allow_outside_paths)
@@ -227,7 +231,7 @@ def validate_command(scenario: Path = SCENARIO_ARG, allow_outside_paths: bool = 
         out, _ = _consoles()
         rows = describe(loaded, built) + estimate(loaded, built.model).rows()
         out.print(_table(f"{scenario}: valid", rows))
-        out.print(scenario_to_toml(loaded), markup=False, highlight=False)
+        out.print(printable(scenario_to_toml(loaded)), markup=False, highlight=False)
 
 
 @app.command("schema", cls=_Command)

@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any, Callable, Mapping
 
 from ..errors import ScenarioError
+from ..terminal import printable
 
 
 # =====================================================================================
@@ -246,7 +247,7 @@ class _Problems:
 
     def message(self) -> str:
         """All problems, sorted by line, in one text."""
-        items = [text for _, text in sorted(self.items, key=lambda item: item[0])]
+        items = [printable(text) for _, text in sorted(self.items, key=lambda item: item[0])]
         if len(items) == 1:
             return items[0]
         head = f"{self.source}: {len(items)} problems in the scenario"
