@@ -13,6 +13,7 @@ any reason, matplotlib draws the same picture without a message.
 from __future__ import annotations
 
 import base64
+import hashlib
 import html
 import json
 import os
@@ -475,10 +476,32 @@ def viewer_html(data: Mapping[str, Any]) -> str:
         raise RuntimeError("the vendored three.js contains '</script' and cannot be inlined")
     fills = {"__SPLINEDEFORM_TITLE__": html.escape(str(data["name"])),
              "/*__SPLINEDEFORM_THREE__*/": three,
-             "__SPLINEDEFORM_DATA__": script_json(data)}
+             "__SPLINEDEFORM_DATA__": script_json(data),
+             "__SPLINEDEFORM_CSP__": content_security_policy(template, three)}
     # One pass: text put in by one placeholder is never searched for another.
     pattern = re.compile("|".join(re.escape(key) for key in fills))
     return pattern.sub(lambda match: fills[match.group(0)], template)
+
+
+def content_security_policy(template: str, three: str) -> str:
+    """The page's Content-Security-Policy: nothing but its own inline scripts and style.
+
+    ``default-src 'none'`` forbids every fetch (no network, no images but ``data:``, no
+    frames, no plugins); scripts and the style sheet run only when their text hashes to a
+    listed SHA-256 (three.js and the viewer's own script, as inlined; the JSON data block is
+    not a script). A script smuggled into the page by a name or title would not run.
+    """
+    scripts = [three] + [body for attrs, body in
+                         re.findall(r"<script([^>]*)>(.*?)</script>", template, re.S)
+                         if not attrs.strip() and "__SPLINEDEFORM_" not in body]
+    styles = re.findall(r"<style>(.*?)</style>", template, re.S)
+
+    def hashes(blocks: list[str]) -> str:
+        return " ".join("'sha256-" + base64.b64encode(hashlib.sha256(b.encode("utf-8"))
+                                                      .digest()).decode("ascii") + "'"
+                        for b in blocks)
+    return (f"default-src 'none'; script-src {hashes(scripts)}; style-src {hashes(styles)}; "
+            "img-src data:; base-uri 'none'; form-action 'none'")
 
 
 def script_json(data: Any) -> str:

@@ -54,7 +54,9 @@ def format_value(value: Any) -> str:
         return "[" + ", ".join(format_value(v) for v in value) + "]"
     if isinstance(value, dict):
         return ", ".join(f"{k}={format_value(v)}" for k, v in value.items())
-    return str(value).replace("|", "\\|").replace("\n", " ")
+    # text from a scenario (its title, a net's name) is shown, never interpreted: HTML
+    # escaped, on one line (any whitespace, also U+2028, is one space), pipes escaped
+    return html.escape(" ".join(str(value).split())).replace("|", "\\|")
 
 
 def _is_scalar(value: Any) -> bool:
@@ -62,7 +64,7 @@ def _is_scalar(value: Any) -> bool:
 
 
 def _table(header: Sequence[str], rows: Sequence[Sequence[Any]]) -> list[str]:
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines = ["| " + " | ".join(map(format_value, header)) + " |", "|" + "---|" * len(header)]
     return lines + ["| " + " | ".join(format_value(c) for c in row) + " |" for row in rows]
 
 
