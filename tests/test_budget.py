@@ -132,3 +132,28 @@ def test_the_command_line_raises_the_budget(tmp_path):
     assert allowed.exit_code == 0, allowed.output
     valid = runner.invoke(cli.app, ["validate", str(scenario)])
     assert valid.exit_code == 0 and "estimated files" in valid.output
+
+
+def test_an_adaptive_integrator_over_a_huge_span_is_refused_naming_t_end(tmp_path):
+    text = BASE.replace("t_end = 2.0", "t_end = 1e12").replace("frames = 5",
+                                                                'frames = 5\nmethod = "rk45"')
+    message = refusal(text, tmp_path)
+    assert message.startswith(f"case.toml:{line_of(text, 't_end')}: solve.t_end: ")
+    assert "steps of rk45" in message
+
+
+def test_the_highest_frequency_estimate_is_within_its_stated_factor():
+    # against the dense eigenproblem: 1/2.5 <= estimate / ω_max <= 1 on clamped plates and
+    # membranes (the factor the docstring states)
+    import numpy as np
+
+    import splinedeform as sd
+    from splinedeform.budget import highest_frequency
+
+    for cells, degree, weights in [(8, 3, dict(w10=1, w01=1)), (12, 3, dict(w20=1, w11=1, w02=1)),
+                                   (8, 1, dict(w10=1, w01=1)), (8, 5, dict(w10=1, w01=1))]:
+        model = sd.Model(sd.shapes.plane(cells=cells, degree=degree), sd.Material(**weights),
+                         boundary="clamped")
+        lam, _ = model.eigen()
+        ratio = highest_frequency(model) / np.sqrt(lam.max())
+        assert 1 / 2.5 <= ratio <= 1.0, (cells, degree, ratio)
