@@ -81,7 +81,7 @@ def test_run_writes_the_files_listed_in_the_summary(scenario, tmp_path):
     assert result.exit_code == 0, result.output
     listed = summary_paths(result.stdout)
     assert set(listed) == {"mesh .obj", "mesh .ply", "time series .pvd", "control nets .json",
-                           "report .json", "report .md"}
+                           "report .json", "report .md", "manifest"}
     for path in listed.values():
         assert path.is_file() and path.parent == out
     written = {p.name for p in out.iterdir()}

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import importlib.util
 import time
-import tomllib
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -16,7 +15,8 @@ from typing import Any, Callable, Iterator
 
 from .budget import Budget, check as check_budget
 from .errors import InputError
-from .scenario import Built, Scenario, SolveSpec, _located, build, scenario_to_toml
+from .outputs import make_report, planned_outputs, summary_rows, write_outputs
+from .scenario import Built, Scenario, SolveSpec, _located, build
 
 #: ``progress(stage, done, total)``, called as each stage advances
 ProgressCallback = Callable[[str, int, int], None]
@@ -45,6 +45,10 @@ class RunResult:
     timings: dict[str, float] = field(default_factory=dict)
     outputs: list[tuple[str, Path]] = field(default_factory=list)
     report: dict[str, Any] = field(default_factory=dict)
+    #: files of an earlier run of the same scenario removed from the folder, and files
+    #: left in place with the reason (see :mod:`splinedeform.export.run_folder`)
+    removed: list[Path] = field(default_factory=list)
+    kept: list[tuple[Path, str]] = field(default_factory=list)
 
     @property
     def n_free(self) -> int:
@@ -100,7 +104,7 @@ def run(scenario: Scenario, outdir: str | Path | None = None,
     result = _solve(scenario, built, stages)
     result.timings = stages.timings
     if folder is not None:
-        _write_outputs(result, folder, stages)
+        write_outputs(result, folder, stages)
     result.timings = dict(stages.timings)
     return result
 
@@ -279,154 +283,5 @@ def _domain_centre(surface: Any) -> tuple[float, float]:
     return (0.5 * lu, 0.5 * lv)
 
 
-# -- outputs ---------------------------------------------------------------------------
-def _mesh_net(result: RunResult) -> Any:
-    """The control net written as OBJ/STL/PLY: ``output.time``, else the last frame."""
-    time_ = result.scenario.output.time
-    if time_ is not None:
-        return result.solution.control_points(time_)
-    return result.nets[-1]
-
-
-def _write_outputs(result: RunResult, folder: Path, stages: _Stages) -> None:
-    from . import export
-
-    scenario = result.scenario
-    formats, name, res = scenario.output.formats, scenario.name, scenario.output.resolution
-    surface, rest = result.built.surface, result.rest_net
-    times, nets = result.times, result.nets
-    for ext in ("obj", "stl", "ply"):
-        if ext in formats:
-            with stages.stage(f"mesh .{ext}"):
-                net = _mesh_net(result)
-                vertices, faces = surface.tessellate(res, control_points=net)
-                d = vertices - surface.tessellate(res)[0]
-                import numpy as np
-                data = {"displacement": d, "displacement_magnitude": np.linalg.norm(d, axis=1)}
-                result.outputs.append((f"mesh .{ext}", export.write_mesh(
-                    folder / f"{name}.{ext}", vertices, faces, point_data=data)))
-    if "vtu" in formats:
-        with stages.stage("time series"):
-            result.outputs.append(("time series .pvd", export.write_time_series(
-                folder, name, surface, rest, times, nets, resolution=res)))
-    if "json" in formats or "npz" in formats:
-        with stages.stage("control nets"):
-            wanted = [ext for ext in export.CONTROL_NET_FORMATS if ext in formats]
-            for path in export.write_control_nets(folder, f"{name}_nets", surface, times, nets,
-                                                  formats=wanted):
-                result.outputs.append((f"control nets {path.suffix}", path))
-    if "3dm" in formats:
-        from .cad import write_frames_3dm
-
-        with stages.stage("CAD surfaces"):
-            label = {"dynamic": "time", "static": "load factor",
-                     "modes": "phase"}[scenario.solve.kind]
-            result.outputs.append(("NURBS surfaces .3dm", write_frames_3dm(
-                folder / f"{name}.3dm", surface, times, nets, label)))
-    if "images" in formats:
-        _write_images(result, folder, stages)
-    for ext in ("gif", "mp4"):
-        if ext in formats:
-            _write_animation(result, folder / f"{name}.{ext}", stages)
-    if "viewer" in formats:
-        from .viz import write_viewer
-
-        with stages.stage("viewer"):
-            result.outputs.append(("viewer", write_viewer(folder / "viewer.html", surface, rest,
-                                                          times, nets, resolution=res)))
-    if "report" in formats:
-        with stages.stage("report"):
-            result.report = make_report(result)
-            paths = export.write_report(folder, result.report)
-            result.outputs += [("report .json", paths[0]), ("report .md", paths[1])]
-
-
-def _write_images(result: RunResult, folder: Path, stages: _Stages) -> None:
-    from . import viz
-
-    surface, rest = result.built.surface, result.rest_net
-    kind = result.scenario.solve.kind
-    with stages.stage("images"):
-        label = {"dynamic": "t", "static": "load factor", "modes": "phase"}[kind]
-        last = result.nets[-1] if kind != "modes" else result.nets[len(result.nets) // 4]
-        last_t = result.times[-1] if kind != "modes" else result.times[len(result.times) // 4]
-        result.outputs.append(("picture", viz.render_surfaces(
-            folder / "surfaces.png", surface, rest, [result.nets[0], last],
-            [f"initial ({label} = {result.times[0]:g})", f"{label} = {last_t:.4g}"])))
-        if kind == "dynamic":
-            result.outputs.append(("probe plot", viz.plot_probes(
-                folder / "probes.png", result.times, result.probes)))
-        if result.omegas is not None:
-            result.outputs.append(("mode shapes", viz.plot_modes(
-                folder / "modes.png", surface, result.omegas, result.mode_shapes)))
-
-
-def _write_animation(result: RunResult, path: Path, stages: _Stages) -> None:
-    from .viz import write_animation
-
-    stage = f"animation {path.suffix}"
-    with stages.stage(stage):
-        result.outputs.append((stage, write_animation(
-            path, result.built.surface, result.rest_net, result.times, result.nets,
-            resolution=result.scenario.output.resolution,
-            progress=lambda done, total: stages.tick(stage, done, total + 1))))
-
-
-def make_report(result: RunResult) -> dict[str, Any]:
-    """The content of ``report.json`` / ``report.md``: inputs, solver, timings, energies, probes."""
-    import numpy as np
-
-    s, surface = result.scenario, result.built.surface
-    report: dict[str, Any] = {
-        "inputs": {"source": s.source, **tomllib.loads(scenario_to_toml(s))},
-        "surface": {"shape": s.surface.shape, "net": f"{surface.shape[0]} x {surface.shape[1]}",
-                    "degree": [surface.basis_u.degree, surface.basis_v.degree],
-                    "knots": [surface.basis_u.kind, surface.basis_v.kind],
-                    "domain": [list(d) for d in surface.domain],
-                    "fit_error": surface.fit_error,
-                    "free control points": result.n_free},
-        "solver": {"kind": s.solve.kind,
-                   "method": s.solve.method if s.solve.kind == "dynamic" else "direct",
-                   "t_end": s.solve.t_end if s.solve.kind == "dynamic" else None,
-                   "frames": len(result.times),
-                   "max displacement": result.max_displacement},
-        "timings": {**_solution_timings(result), **result.timings},
-    }
-    if result.omegas is not None:
-        report["modes"] = {"mode": list(range(1, len(result.omegas) + 1)),
-                           "omega": result.omegas,
-                           "frequency (omega / 2 pi)": np.asarray(result.omegas) / (2 * np.pi)}
-    if result.energy is not None:
-        report["energies"] = result.energy
-    frame_label = {"dynamic": "time", "static": "load factor", "modes": "phase"}[s.solve.kind]
-    probes: dict[str, Any] = {frame_label: result.times}
-    for name, d in result.probes.items():
-        probes.update({f"{name} d{c}": d[:, i] for i, c in enumerate("xyz")})
-        probes[f"{name} magnitude"] = np.linalg.norm(d, axis=1)
-    report["probes"] = probes
-    return report
-
-
-def _solution_timings(result: RunResult) -> dict[str, float]:
-    timings = getattr(result.solution, "timings", None) or {}
-    return {f"solver: {k}": float(v) for k, v in timings.items()}
-
-
-def summary_rows(result: RunResult) -> list[tuple[str, str]]:
-    """(label, value) rows of the closing summary: sizes, times per stage, outputs."""
-    s, surface = result.scenario, result.built.surface
-    rows = [("scenario", s.title or s.name),
-            ("control net", f"{surface.shape[0]} x {surface.shape[1]} "
-                            f"({surface.shape[0] * surface.shape[1]} points)"),
-            ("free control points", str(result.n_free)),
-            ("solve", s.solve.kind + (f" ({s.solve.method})" if s.solve.kind == "dynamic"
-                                      else "")),
-            ("modes", "-" if result.omegas is None else
-             f"{len(result.omegas)} (lowest ω = {float(result.omegas[0]):.5g})"),
-            ("frames", str(len(result.times))),
-            ("max displacement", f"{result.max_displacement:.6g}")]
-    rows += [(f"time: {stage}", f"{seconds:.3f} s") for stage, seconds in result.timings.items()]
-    rows += [(label, str(path)) for label, path in result.outputs]
-    return rows
-
-
+__all__ = ["ProgressCallback", "RunResult", "make_report", "planned_outputs", "run",
+           "summary_rows", "write_outputs"]

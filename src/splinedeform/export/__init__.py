@@ -7,7 +7,8 @@ in the target folder, which then replaces the target with :func:`os.replace`.
 * :mod:`.mesh` — triangle meshes (.obj, .stl, .ply, .vtu, .vtk) through meshio;
 * :mod:`.series` — ParaView ``.pvd`` + ``.vtu`` time series;
 * :mod:`.nets` — control nets as JSON / NPZ with their full knot vectors;
-* :mod:`.report` — ``report.json`` and ``report.md``.
+* :mod:`.report` — ``report.json`` and ``report.md``;
+* :mod:`.run_folder` — a run's manifest, stale files of earlier runs, the folder lock.
 """
 
 from .atomic import atomic_path, write_text, write_with
@@ -16,11 +17,14 @@ from .mesh import MESH_FORMATS, write_mesh
 from .nets import (CONTROL_NET_FORMAT, CONTROL_NET_FORMATS, CONTROL_NET_VERSION, CONVENTION,
                    control_net_document, coefficient_index, read_control_net,
                    write_control_nets)
+from .run_folder import (MANIFEST_FORMAT, FolderClaim, claim_folder, file_digest,
+                         manifest_name, read_manifest)
 from .report import (REPORT_TABLE_ROWS, format_value, plain, report_markdown, section_markdown,
                      write_report)
 from .series import frame_file_names, pvd_text, write_time_series
 
-__all__ = ["CONTROL_NET_FORMAT", "CONTROL_NET_FORMATS", "CONTROL_NET_VERSION", "CONVENTION",
+__all__ = ["FolderClaim", "MANIFEST_FORMAT", "claim_folder", "file_digest", "manifest_name",
+           "read_manifest", "CONTROL_NET_FORMAT", "CONTROL_NET_FORMATS", "CONTROL_NET_VERSION", "CONVENTION",
            "coefficient_index", "control_net_document", "MESH_FORMATS", "REPORT_TABLE_ROWS",
            "atomic_path", "check_frames", "check_net", "format_value", "frame_file_names", "plain", "pvd_text",
            "read_control_net", "report_markdown", "section_markdown", "tessellate_frames",
