@@ -85,8 +85,8 @@ def test_newmark_with_a_tiny_step_is_refused_for_work_naming_dt(tmp_path):
 def test_a_raised_budget_lets_the_run_go(tmp_path):
     text = BASE.replace("formats = []", 'formats = ["vtu"]')
     refusal(text, tmp_path, Budget(files=3))
-    result = run(scenario_of(text), tmp_path / "out", budget=Budget(files=6))
-    assert len(list((tmp_path / "out").iterdir())) == 6      # 5 frames and the .pvd
+    result = run(scenario_of(text), tmp_path / "out", budget=Budget(files=7))
+    assert len(list((tmp_path / "out").iterdir())) == 7      # 5 frames, .pvd, manifest
 
 
 def test_estimates_bound_what_a_small_run_writes(tmp_path):
