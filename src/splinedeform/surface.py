@@ -85,6 +85,13 @@ class Surface:
         """Parameter rectangle ``((0, L_u), (0, L_v))``."""
         return (0.0, self.basis_u.length), (0.0, self.basis_v.length)
 
+    @property
+    def weights(self) -> NDArray[np.float64]:
+        """NURBS weights ``w_kl = a_k b_l`` of the net (``a``, ``b`` of rational directions, 1 else)."""
+        a, b = (np.asarray(basis.weights) if isinstance(basis, RationalBasis)
+                else np.ones(basis.size) for basis in (self.basis_u, self.basis_v))
+        return np.outer(a, b)
+
     def with_control_points(self, control_points: ArrayLike, name: str | None = None) -> Surface:
         """The same bases with another control net (``fit_error`` dropped)."""
         return replace(self, control_points=control_points, fit_error=None,

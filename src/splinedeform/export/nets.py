@@ -13,13 +13,16 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..basis import KNOT_KINDS, BSplineBasis
 from ..errors import InputError
-from ..surface import Surface
+from ..knots import KnotVectorBasis, RationalBasis
+from ..surface import Basis, Surface
 from .atomic import _check_stem, _require_folder, write_text, write_with
 from .frames import check_frames
 
 CONTROL_NET_FORMAT = "splinedeform-control-nets"
 CONTROL_NET_VERSION = 2
 CONTROL_NET_FORMATS: tuple[str, ...] = ("json", "npz")
+#: knot kinds stored with their full knot vector only (see :class:`KnotVectorBasis`)
+GENERAL_KINDS: tuple[str, ...] = ("general", "rational")
 #: stated in every file, so that a reader needs neither our source nor our docs
 CONVENTION = (
     "x(u, v) = sum_i sum_j c[i][j] N_i(u) M_j(v) for u in basis.u.domain, v in basis.v.domain; "
@@ -31,7 +34,12 @@ CONVENTION = (
     "control points hold one period: the knots are uniform, extended by degree cells on "
     "each side of the domain, and coefficient_index = n - degree, ..., n - 1, 0, 1, ..., "
     "n - 1 (the last degree control points repeated in front), so that x has period "
-    "length in that direction. In the .npz file the same fields are named "
+    "length in that direction. Kind 'general' (any knot vector) and 'rational' have "
+    "coefficient_index 0, ..., n - 1 too. weights[i][j] > 0 are the NURBS weights of "
+    "control point [i][j] (the same for every frame; all 1 unless a direction is "
+    "'rational'): with w[i][j] = weights[basis.u.coefficient_index[i]]"
+    "[basis.v.coefficient_index[j]], x(u, v) = sum_ij w[i][j] c[i][j] N_i(u) M_j(v) / "
+    "sum_ij w[i][j] N_i(u) M_j(v). In the .npz file the same fields are named "
     "<field>_u and <field>_v.")
 
 
@@ -65,15 +73,16 @@ def control_net_document(surface: Surface, times: ArrayLike, nets: ArrayLike
     Keys: ``format``, ``version``, ``convention`` (the text of :data:`CONVENTION`),
     ``name``, ``shape`` ``[n_u, n_v]``, ``domain`` ``[[0, L_u], [0, L_v]]``, ``basis``
     (``u`` and ``v``: degree, cells, length, kind, periodic, domain, knots,
-    coefficient_index), ``times`` ``(F,)`` and ``control_points`` ``(F, n_u, n_v, 3)``.
-    A field added later (e.g. rational weights ``(F, n_u, n_v)``) is one more key here.
+    coefficient_index), ``times`` ``(F,)``, ``control_points`` ``(F, n_u, n_v, 3)`` and
+    ``weights`` ``(n_u, n_v)`` (NURBS weights, constant in time; all 1 unless rational).
     """
     t, P = check_frames(surface, times, nets)
     basis = {"u": _basis_description(surface.basis_u), "v": _basis_description(surface.basis_v)}
     return {"format": CONTROL_NET_FORMAT, "version": CONTROL_NET_VERSION,
             "convention": CONVENTION, "name": surface.name, "shape": list(surface.shape),
             "domain": [list(d) for d in surface.domain], "basis": basis,
-            "times": t.tolist(), "control_points": P.tolist()}
+            "times": t.tolist(), "control_points": P.tolist(),
+            "weights": surface.weights.tolist()}
 
 
 def _npz_arrays(document: Mapping[str, Any]) -> dict[str, NDArray[Any]]:
@@ -151,7 +160,7 @@ def _load_json_nets(path: Path) -> dict[str, Any]:
         raise InputError(f"{path}: 'basis' must map 'u' and 'v' to "
                          f"{{degree, cells, length, kind}}")
     return {"control_points": doc["control_points"], "u": basis["u"], "v": basis["v"],
-            "name": doc.get("name", path.stem)}
+            "name": doc.get("name", path.stem), "weights": doc.get("weights")}
 
 
 def _load_npz_nets(path: Path) -> dict[str, Any]:
@@ -177,7 +186,8 @@ def _load_npz_nets(path: Path) -> dict[str, Any]:
         return desc
 
     return {"control_points": data["control_points"], "u": direction("u"), "v": direction("v"),
-            "name": str(data["name"]) if "name" in data else path.stem}
+            "name": str(data["name"]) if "name" in data else path.stem,
+            "weights": data.get("weights")}
 
 
 def real_array(value: Any, where: str) -> NDArray[np.float64]:
@@ -201,7 +211,7 @@ _DTYPE_KINDS = {"U": "strings", "S": "bytes", "O": "mixed or nested objects",
                 "b": "booleans", "c": "complex numbers", "V": "records", "M": "dates"}
 
 
-def _basis_from(desc: Mapping[str, Any], size: int, where: str) -> BSplineBasis:
+def _basis_from(desc: Mapping[str, Any], size: int, where: str) -> Basis:
     """The basis a file describes, checked against the net's size ``size`` and its knots."""
     missing = [k for k in _BASIS_KEYS if k not in desc]
     if missing:
@@ -213,8 +223,11 @@ def _basis_from(desc: Mapping[str, Any], size: int, where: str) -> BSplineBasis:
         length = float(desc["length"])
     except (TypeError, ValueError):
         raise InputError(f"{where}: length must be a number, got {desc['length']!r}") from None
+    if kind in GENERAL_KINDS:
+        return _general_basis(desc, size, where)
     if kind not in KNOT_KINDS:
-        raise InputError(f"{where}.kind must be one of {KNOT_KINDS}, got {kind!r}")
+        raise InputError(f"{where}.kind must be one of {KNOT_KINDS + GENERAL_KINDS}, "
+                         f"got {kind!r}")
     # check the size before building anything, so a hostile 'cells' allocates nothing
     expected = int(cells) if kind == "periodic" else int(cells) + int(degree)
     if expected != size:
@@ -225,6 +238,42 @@ def _basis_from(desc: Mapping[str, Any], size: int, where: str) -> BSplineBasis:
     if "knots" in desc:
         _check_knots(desc["knots"], basis, where)
     return basis
+
+
+def _general_basis(desc: Mapping[str, Any], size: int, where: str) -> KnotVectorBasis:
+    """A 'general' or 'rational' direction: the polynomial basis of its stored knots."""
+    if "knots" not in desc:
+        raise InputError(f"{where}: a {desc['kind']} basis needs its knots")
+    knots = real_array(desc["knots"], f"{where}.knots")
+    try:
+        basis = KnotVectorBasis(int(desc["degree"]), knots)
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
+    if basis.size != size:
+        raise InputError(f"{where}: its knots give {basis.size} functions, but control_points "
+                         f"has shape {size} in this direction")
+    return basis
+
+
+def _with_weights(basis_u: Basis, basis_v: Basis, kinds: tuple[Any, Any], weights: Any,
+                  source: Path) -> tuple[Basis, Basis]:
+    """Rational directions take their factor of the stored weights ``w = a bᵀ``."""
+    if "rational" not in kinds:
+        if weights is not None and np.ptp(real_array(weights, f"{source}: weights")) != 0:
+            raise InputError(f"{source}: weights differ but no direction is 'rational'; "
+                             "the weights of a polynomial net are all equal")
+        return basis_u, basis_v
+    from ..cad import weight_factors
+
+    if weights is None:
+        raise InputError(f"{source}: a rational net needs weights, the file has none")
+    w = real_array(weights, f"{source}: weights")
+    if w.shape != (basis_u.size, basis_v.size) or not np.all(np.isfinite(w)) or np.any(w <= 0):
+        raise InputError(f"{source}: a rational net needs weights > 0 of shape "
+                         f"{(basis_u.size, basis_v.size)}, got shape {w.shape}")
+    a, b = weight_factors(w, str(source))
+    return (RationalBasis(basis_u, a) if kinds[0] == "rational" else basis_u,
+            RationalBasis(basis_v, b) if kinds[1] == "rational" else basis_v)
 
 
 def _check_knots(knots: Any, basis: BSplineBasis, where: str) -> None:
@@ -272,6 +321,8 @@ def read_control_net(path: str | os.PathLike[str], frame: int = -1) -> Surface:
                          f"(n_u, n_v, 3), got {P.shape}")
     basis_u = _basis_from(data["u"], P.shape[1], f"{source}: basis.u")
     basis_v = _basis_from(data["v"], P.shape[2], f"{source}: basis.v")
+    basis_u, basis_v = _with_weights(basis_u, basis_v, (data["u"]["kind"], data["v"]["kind"]),
+                                     data.get("weights"), source)
     if isinstance(frame, bool) or not isinstance(frame, (int, np.integer)) \
             or not -P.shape[0] <= frame < P.shape[0]:
         raise InputError(f"frame must be an integer in [{-P.shape[0]}, {P.shape[0] - 1}] "
