@@ -258,9 +258,14 @@ def test_physics_option_selects_the_energy_and_names_a_bad_value(scenario, tmp_p
     result = runner.invoke(cli.app, ["run", str(scenario), "-o", str(tmp_path / "o"),
                                      "--physics", "intrinsic", "-q"])
     assert result.exit_code == 0, result.output
-    result = runner.invoke(cli.app, ["run", str(scenario), "--physics", "shell", "-q"])
+    result = runner.invoke(cli.app, ["run", str(scenario), "--physics", "membrane", "-q"])
     assert result.exit_code == 2
     assert "tiny.toml (--physics): material.physics: expected one of" in result.stderr
+    # the shell takes E, nu, thickness instead of the plate's weights: named where they are
+    result = runner.invoke(cli.app, ["run", str(scenario), "--physics", "shell", "-q"])
+    assert result.exit_code == 2
+    assert "material.E: missing (physics \"shell\" needs it)" in result.stderr
+    assert "material.w10: does not apply to physics \"shell\"" in result.stderr
 
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

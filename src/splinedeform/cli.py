@@ -176,7 +176,8 @@ def run_command(scenario: Path = SCENARIO_ARG, outdir: Optional[Path] = OUTDIR_O
                     None, "--frames", help="Override solve.frames (replaces solve.times)."),
                 physics: Optional[str] = typer.Option(
                     None, "--physics", help="Override material.physics: parametric (the "
-                                            "paper's energy) or intrinsic (on the surface)."),
+                                            "paper's energy), intrinsic (on the surface) or "
+                                            "shell (Kirchhoff–Love; needs E, nu, thickness)."),
                 allow_outside_paths: bool = OUTSIDE_OPT, budget: Optional[str] = BUDGET_OPT,
                 quiet: bool = QUIET_OPT, debug: bool = DEBUG_OPT) -> None:
     """Run a scenario file: build, solve, sample frames and write its outputs."""

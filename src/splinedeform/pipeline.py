@@ -148,6 +148,8 @@ def _solve(scenario: Scenario, built: Built, stages: _Stages) -> RunResult:
             omegas, shapes = model.modes(min(solve.modes, model.n_free))
     with stages.stage("frames"), _located(scenario, "solve"):
         nets = _frames(scenario, built, solution, times, shapes)
+    if shapes is not None and shapes.ndim == 4:     # the shell's modes move x, y, z
+        shapes = np.einsum("kabc,abc->kab", shapes, _net_normals(built.surface))
     result = RunResult(scenario=scenario, built=built, solution=solution, times=times,
                        nets=nets, omegas=omegas, mode_shapes=shapes)
     with np.errstate(over="ignore", invalid="ignore"):
@@ -162,7 +164,8 @@ def _extreme_inputs(scenario: Scenario) -> list[tuple[str, float]]:
 
     values: list[tuple[str, Any]] = [(f"material.{name}", getattr(scenario.material, name))
                                      for name in ("mass", "damping", "rayleigh", "w10", "w01",
-                                                  "w20", "w11", "w02")]
+                                                  "w20", "w11", "w02", "E", "thickness",
+                                                  "density")]
     for i, spec in enumerate(scenario.loads, start=1):
         values.append((f"load[{i}].q", spec.q))
         values.append((f"load[{i}].omega", spec.omega))
@@ -227,12 +230,13 @@ def _frames(scenario: Scenario, built: Built, solution: Any, times: Any, shapes:
     if kind == "static":
         d = solution.control_points() - rest
         return rest + times[:, None, None, None] * d
-    direction = _net_normals(built.surface)
+    # a scalar mode moves along the normals; a shell mode is a displacement net already
+    shape = shapes[0] if shapes.ndim == 4 else shapes[0][..., None] * _net_normals(built.surface)
     size = float(np.ptp(rest.reshape(-1, 3), axis=0).max()) or 1.0
-    peak = float(np.abs(shapes[0]).max()) or 1.0
+    peak = float(np.linalg.norm(shape, axis=-1).max()) or 1.0
     amplitude = 0.1 * size / peak
     wave = np.sin(2.0 * np.pi * times)
-    return rest + amplitude * wave[:, None, None, None] * (shapes[0][..., None] * direction)
+    return rest + amplitude * wave[:, None, None, None] * shape
 
 
 def _net_normals(surface: Any) -> Any:

@@ -36,15 +36,22 @@ Array = NDArray[np.float64]
 
 @dataclass(frozen=True)
 class ShellMaterial:
-    """Young's modulus ``E > 0``, Poisson ratio ``0 <= ν < 0.5``, thickness ``t > 0``, density ``ρ > 0``."""
+    """Young's modulus ``E > 0``, Poisson ratio ``0 <= ν < 0.5``, thickness ``t > 0``, density ``ρ > 0``.
+
+    Damping (both ``>= 0``): ``damping`` ``γ`` is a viscous force per unit surface area and
+    unit velocity, ``rayleigh`` ``β`` is stiffness proportional, ``C = (γ/(ρt)) M + β K``,
+    so mode ``i`` has ``c_i = γ/(ρt) + β ω_i²`` (critically damped at ``c_i = 2 ω_i``).
+    """
 
     E: float
     nu: float
     thickness: float
     density: float = 1.0
+    damping: float = 0.0
+    rayleigh: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("E", "nu", "thickness", "density"):
+        for name in ("E", "nu", "thickness", "density", "damping", "rayleigh"):
             value = getattr(self, name)
             try:
                 value = float(value)
@@ -59,6 +66,9 @@ class ShellMaterial:
                              f"density={self.density:g}")
         if not 0 <= self.nu < 0.5:
             raise InputError(f"shell material Poisson ratio nu must be in [0, 0.5), got {self.nu:g}")
+        if self.damping < 0 or self.rayleigh < 0:
+            raise InputError("shell material damping and rayleigh must be >= 0, got "
+                             f"damping={self.damping:g}, rayleigh={self.rayleigh:g}")
 
 
 def constitutive(g_inv: Array, nu: float) -> Array:

@@ -27,12 +27,13 @@ import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError, SingularSystemError
-from ..loads import Constant, Harmonic, Load, Profile, _profile, _vector3, as_load
+from ..loads import Constant, Harmonic, Load, Profile, _profile, _vector3, as_load, static_time
 from ..solvers import modal_basis
 from ..solvers.analytic import ModalResponse
 from ..surface import Surface
 from . import metric
 from .shell import ShellMaterial, matrices
+from .shell_solution import ShellModalSolution, ShellStaticSolution
 
 Array = NDArray[np.float64]
 EDGES = ("u0", "u1", "v0", "v1")
@@ -82,9 +83,15 @@ def constraint_matrix(surface: Surface, boundary: Mapping[str, str], fixed: Arra
     """``T`` with ``d = T d_free`` over the interleaved ``3n`` displacements."""
     n = surface.shape[0] * surface.shape[1]
     parent = np.arange(3 * n)
-    is_fixed = np.zeros(3 * n, bool) if fixed is None else np.asarray(fixed, bool).ravel().copy()
+    is_fixed = np.zeros(3 * n, bool)
+    if fixed is not None:
+        mask = np.asarray(fixed, bool)
+        if mask.shape == surface.shape:          # whole control points, as for Model
+            mask = np.repeat(mask[..., None], 3, axis=-1)
+        is_fixed = mask.ravel().copy()
     if is_fixed.size != 3 * n:
-        raise InputError(f"fixed must be a boolean mask of shape {surface.shape + (3,)}")
+        raise InputError(f"fixed must be a boolean mask of shape {surface.shape} (control "
+                         f"points) or {surface.shape + (3,)} (components)")
     for edge, kind in boundary.items():
         if edge not in EDGES or kind not in KINDS:
             raise InputError(f"shell boundary: edge must be one of {EDGES} and kind one of "
@@ -120,8 +127,8 @@ class ShellModel:
     material : ShellMaterial
     boundary : mapping edge -> kind, optional
         See the module docstring; missing edges are free.
-    fixed : bool array ``(n_u, n_v, 3)``, optional
-        Individual displacement components that do not move.
+    fixed : bool array ``(n_u, n_v, 3)`` or ``(n_u, n_v)``, optional
+        Individual displacement components (or whole control points) that do not move.
     """
 
     def __init__(self, surface: Surface, material: ShellMaterial,
@@ -134,6 +141,8 @@ class ShellModel:
         self.T = constraint_matrix(surface, dict(boundary or {}), fixed)
         self._K = (self.T.T @ self.K_full @ self.T).tocsc()
         self._M = (self.T.T @ self.M_full @ self.T).tocsc()
+        self._C = (material.damping / (material.density * material.thickness) * self._M
+                   + material.rayleigh * self._K).tocsc()
         self.rigid = self._free_rigid_motions()
         self.timings = {"assembly": time.perf_counter() - start}
 
@@ -142,9 +151,9 @@ class ShellModel:
         """Number of free displacement unknowns (x, y, z coupled)."""
         return self.T.shape[1]
 
-    def matrices(self) -> tuple[sp.csc_matrix, sp.csc_matrix]:
-        """Reduced ``(M_r, K_r)``, each ``(n_free, n_free)``."""
-        return self._M, self._K
+    def matrices(self) -> tuple[sp.csc_matrix, sp.csc_matrix, sp.csc_matrix]:
+        """Reduced ``(M_r, C_r, K_r)``, each ``(n_free, n_free)``, ``C_r = (γ/(ρt)) M_r + β K_r``."""
+        return self._M, self._C, self._K
 
     def _free_rigid_motions(self) -> Array:
         """Reduced rigid motions (translations, rotations ``ω × p``) the boundary leaves free."""
@@ -162,16 +171,21 @@ class ShellModel:
         u, s, _ = np.linalg.svd(candidates, full_matrices=False)
         return u[:, s > 1e-10 * s.max()]
 
-    def load_vector(self, load: Load | None) -> Array:
-        """Reduced generalised force ``Tᵀ F`` over the interleaved unknowns."""
-        return np.asarray(self.T.T @ as_load(load).vector(self.surface, 0.0).ravel())
+    def load_vector(self, load: Load | None, t: float = 0.0) -> Array:
+        """Reduced generalised force ``Tᵀ F(t)`` over the interleaved unknowns."""
+        return np.asarray(self.T.T @ as_load(load).vector(self.surface, t).ravel())
 
-    def static(self, load: Load | None) -> Array:
-        """Equilibrium displacement of the control net, ``(n_u, n_v, 3)``.
+    def static(self, load: Load | None, t: float | None = None) -> ShellStaticSolution:
+        """Equilibrium of the shell under ``load`` (at time ``t`` for a time-varying profile).
 
         ``K_r d = Tᵀ F``; free rigid motions ``r`` are removed by ``rᵀ M_r d = 0``.
         """
-        F = self.load_vector(load)
+        start = time.perf_counter()
+        F = self.load_vector(load, static_time(as_load(load), t))
+        d = self._static_solve(F)
+        return ShellStaticSolution(self, d, F, {"static": time.perf_counter() - start})
+
+    def _static_solve(self, F: Array) -> Array:
         C = self._M @ self.rigid
         k = C.shape[1]
         A = sp.bmat([[self._K, sp.csr_matrix(C)], [sp.csr_matrix(C.T), None]], format="csc")
@@ -182,49 +196,124 @@ class ShellModel:
             raise SingularSystemError("the shell's stiffness is singular for this boundary: "
                                       "some deformation other than a rigid motion costs no "
                                       "energy") from None
-        d = x[: self.n_free]
-        return np.asarray(self.T @ d).reshape(self.surface.shape + (3,))
+        return x[: self.n_free]
+
+    def eigen(self, k: int) -> tuple[Array, Array]:
+        """Lowest ``k`` eigenpairs of ``K_r φ = λ M_r φ`` (``Φᵀ M_r Φ = I``, rigid ``λ = 0``)."""
+        k = _count(k, self.n_free)
+        if k > self.n_free // 2:
+            basis = modal_basis.dense_basis(self._K, self._M, self.rigid.shape[1])
+            return basis.lam[:k], basis.phi[:, :k]
+        basis = modal_basis.sparse_basis(self._K, self._M, k, None, self.rigid.shape[1])
+        return basis.lam, basis.phi
 
     def frequencies(self, k: int = 6) -> Array:
-        """Lowest ``k`` angular frequencies ``ω = √λ`` of ``K_r φ = λ M_r φ`` (rigid ones 0)."""
-        basis = modal_basis.sparse_basis(self._K, self._M, k, None, self.rigid.shape[1])
-        return np.sqrt(basis.lam[:k])
+        """Lowest ``k`` angular frequencies ``ω = √λ`` (rigid ones 0)."""
+        return np.sqrt(self.eigen(k)[0])
 
-    def dynamic(self, load: Load | None, times: ArrayLike, damping: float = 0.0,
-                modes: int | None = None) -> Array:
-        """Control net displacements ``(F, n_u, n_v, 3)`` at ``times``, from rest, in closed form.
+    def modes(self, k: int = 6) -> tuple[Array, Array]:
+        """Lowest ``k`` frequencies and mode shapes as control net displacements ``(k, n_u, n_v, 3)``."""
+        lam, phi = self.eigen(k)
+        shapes = np.asarray(self.T @ phi).T.reshape((phi.shape[1],) + self.surface.shape + (3,))
+        return np.sqrt(lam), shapes
 
-        ``M_r d'' + C_r d' + K_r d = Tᵀ F(t)`` with ``C_r = damping · M_r`` (modal damping
-        ``c_i = damping``), solved mode by mode (:class:`~splinedeform.solvers.analytic.ModalResponse`)
-        for piecewise-constant and harmonic load profiles. All modes by dense ``eigh`` or,
-        with ``modes=k``, the lowest ``k`` by sparse Lanczos (no static correction).
+    def _to_free(self, net: ArrayLike | None, what: str) -> Array:
+        if net is None:
+            return np.zeros(self.n_free)
+        arr = np.asarray(net, dtype=float)
+        if arr.shape != self.surface.shape + (3,):
+            raise InputError(f"{what} must have shape (n_u, n_v, 3) = "
+                             f"{self.surface.shape + (3,)}, got {arr.shape}")
+        if not np.all(np.isfinite(arr)):
+            raise InputError(f"{what} must be finite")
+        flat = arr.ravel()
+        free = spla.spsolve((self.T.T @ self.T).tocsc(), self.T.T @ flat)
+        if np.linalg.norm(self.T @ free - flat) > 1e-9 * max(np.linalg.norm(flat), 1e-300):
+            raise InputError(f"{what} moves displacement components that the boundary "
+                             "conditions fix or tie")
+        return np.asarray(free)
+
+    def dynamic(self, load: Load | None, t_end: float, method: str = "analytic",
+                modes: int | None = None, initial_displacement: ArrayLike | None = None,
+                initial_velocity: ArrayLike | None = None,
+                function_samples: int | None = None) -> ShellModalSolution:
+        """Motion on ``[0, t_end]`` in closed form, mode by mode.
+
+        ``M_r d'' + C_r d' + K_r d = Tᵀ F(t)`` with ``C_r = (γ/(ρt)) M_r + β K_r``, so mode
+        ``i`` has damping ``c_i = γ/(ρt) + β λ_i``; solved by
+        :class:`~splinedeform.solvers.analytic.ModalResponse` for piecewise-constant and
+        harmonic load profiles, from the initial displacement and velocity of the control
+        net (default rest). All modes by dense ``eigh``, or with ``modes=k`` the lowest
+        ``k`` by sparse Lanczos plus the exact static part of the omitted modes (mode
+        acceleration) where the stiffness is not singular. ``function_samples`` is accepted
+        for the scalar models' interface; shell loads have no time-dependent field.
         """
-        damping = float(damping)
-        if not np.isfinite(damping) or damping < 0:
-            raise InputError(f"shell damping must be finite and >= 0, got {damping!r}")
+        start = time.perf_counter()
+        if method != "analytic":
+            raise InputError(f"the shell's dynamic solve is the closed-form modal one "
+                             f"(method 'analytic'), got {method!r}")
+        try:
+            t_end = float(t_end)
+        except (TypeError, ValueError):
+            raise InputError(f"t_end must be a number, got {t_end!r}") from None
+        if not np.isfinite(t_end) or t_end <= 0:
+            raise InputError(f"t_end must be finite and > 0, got {t_end}")
+        d0 = self._to_free(initial_displacement, "initial_displacement")
+        v0 = self._to_free(initial_velocity, "initial_velocity")
+        rigid = self.rigid.shape[1]
         if modes is None:
-            basis = modal_basis.dense_basis(self._K, self._M, self.rigid.shape[1])
+            basis = modal_basis.dense_basis(self._K, self._M, rigid)
         else:
-            basis = modal_basis.sparse_basis(self._K, self._M, int(modes), None,
-                                             self.rigid.shape[1])
+            basis = modal_basis.sparse_basis(self._K, self._M, _count(modes, self.n_free), None,
+                                             rigid)
+        load = as_load(load)
+        jumps, harmonics = self._force_terms(load)
+        project = lambda F: basis.project(F)[:, None]  # noqa: E731
+        mat = self.material
+        c = mat.damping / (mat.density * mat.thickness) + mat.rayleigh * basis.lam
+        response = ModalResponse(basis.lam, c, project(self._M @ d0), project(self._M @ v0),
+                                 [(t_j, project(F)) for t_j, F in jumps],
+                                 [(w, phase, project(F)) for w, phase, F in harmonics])
+        correction, truncation = None, {}
+        if not basis.complete:
+            truncation = {"modes": basis.size, "n_free": self.n_free,
+                          "omega_max_kept": float(np.sqrt(basis.lam.max())),
+                          "omega_first_omitted": float(np.sqrt(basis.first_omitted)),
+                          "static_correction": basis.can_solve_static}
+            if basis.can_solve_static:
+                correction, indicators = modal_basis.mode_acceleration(
+                    basis, self._K, self._M, [(t_j, F[:, None]) for t_j, F in jumps],
+                    [(w, phase, F[:, None]) for w, phase, F in harmonics])
+                truncation.update(indicators)
+        timings = {**self.timings, "modal": time.perf_counter() - start}
+        force = lambda t: self.load_vector(load, t)  # noqa: E731
+        return ShellModalSolution(self, t_end, force, timings, basis, response, truncation,
+                                  correction)
+
+    def _force_terms(self, load: Load) -> tuple[list[tuple[float, Array]],
+                                                list[tuple[float, float, Array]]]:
+        """Reduced force as jumps ``(t_j, ΔF_j)`` and harmonics ``(Ω, φ, F)``."""
         jumps, harmonics = [], []
-        for term in as_load(load).terms():
+        for term in load.terms():
             if term.time_dependent_field:
                 raise InputError("the shell's dynamic solve takes loads whose spatial field "
                                  "does not change with time")
-            g = basis.project(np.asarray(self.T.T @ term.field_vector(self.surface).ravel()))
+            F = np.asarray(self.T.T @ term.field_vector(self.surface).ravel())
             if isinstance(term.profile, Harmonic):
-                harmonics.append((term.profile.omega, term.profile.phase, g[:, None]))
+                harmonics.append((term.profile.omega, term.profile.phase, F))
                 continue
             steps = term.profile.jumps()
             if steps is None:
                 raise InputError(f"load profile {type(term.profile).__name__} is neither "
                                  "piecewise constant nor harmonic")
-            jumps += [(t_j, ds * g[:, None]) for t_j, ds in steps]
-        n = basis.lam.size
-        response = ModalResponse(basis.lam, np.full(n, damping), np.zeros((n, 1)),
-                                 np.zeros((n, 1)), jumps, harmonics)
-        Q, _ = response(np.asarray(times, dtype=float).ravel())
-        d = np.einsum("ij,fj->fi", basis.phi, Q[..., 0])
-        full = np.asarray(self.T @ d.T).T
-        return full.reshape((-1,) + self.surface.shape + (3,))
+            jumps += [(t_j, ds * F) for t_j, ds in steps]
+        return jumps, harmonics
+
+
+def _count(k: int, available: int) -> int:
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
+        raise InputError(f"number of modes must be an integer >= 1, got {k!r}")
+    if k > available:
+        raise InputError(f"asked for {k} modes but the shell has only {available} free "
+                         "unknowns")
+    return int(k)

@@ -148,8 +148,15 @@ def _point_grid(scenario: Scenario, path: Path) -> Any:
 
 
 def build_load(scenario: Scenario) -> Any:
-    """The sum of the ``[[load]]`` tables as a :mod:`splinedeform.loads` object (or None)."""
+    """The sum of the ``[[load]]`` tables as a :mod:`splinedeform.loads` object (or None).
+
+    Under ``physics = "shell"`` a ``uniform`` load is a force per unit surface area
+    (:class:`~splinedeform.AreaForce`, e.g. self-weight).
+    """
     from .. import loads as L
+    from ..physics.shell_model import AreaForce
+
+    uniform = AreaForce if scenario.material.physics == "shell" else L.Uniform
 
     total = None
     for i, spec in enumerate(scenario.loads, start=1):
@@ -159,7 +166,7 @@ def build_load(scenario: Scenario) -> Any:
                        "piecewise": lambda: L.Piecewise(spec.points),
                        "harmonic": lambda: L.Harmonic(spec.omega, spec.phase)}[spec.profile]()
             load = {"point": lambda: L.Point(spec.at[0], spec.at[1], spec.force, profile),
-                    "uniform": lambda: L.Uniform(spec.force, profile),
+                    "uniform": lambda: uniform(force=spec.force, profile=profile),
                     "pressure": lambda: L.Pressure(spec.q, profile)}[spec.kind]()
         total = load if total is None else total + load
     return total
@@ -204,6 +211,9 @@ def build(scenario: Scenario) -> Built:
     surface = build_surface(scenario)
     _check_parameters(scenario, surface)
     fixed = free_region_mask(scenario, surface)
+    if scenario.material.physics == "shell":
+        return Built(surface=surface, model=_shell_model(scenario, surface, fixed),
+                     load=build_load(scenario), fixed=fixed)
     with _located(scenario, "material"):
         material = Material(**scenario.material.weights())
     with _located(scenario, "boundary"):
@@ -211,6 +221,17 @@ def build(scenario: Scenario) -> Built:
                       mass_matrix=scenario.material.mass_matrix,
                       physics=scenario.material.physics)
     return Built(surface=surface, model=model, load=build_load(scenario), fixed=fixed)
+
+
+def _shell_model(scenario: Scenario, surface: Any, fixed: Any) -> Any:
+    """The Kirchhoff–Love shell of ``physics = "shell"``."""
+    from ..physics.shell import ShellMaterial
+    from ..physics.shell_model import ShellModel
+
+    with _located(scenario, "material"):
+        material = ShellMaterial(**scenario.material.shell())
+    with _located(scenario, "boundary"):
+        return ShellModel(surface, material, scenario.boundary.edges(), fixed=fixed)
 
 
 def describe(scenario: Scenario, built: Built | None = None) -> list[tuple[str, str]]:

@@ -42,7 +42,12 @@ from ..shapes import FIT_METHODS
 PROFILES = ("constant", "step", "piecewise", "harmonic")
 IVP_METHODS = ("rk45", "dop853", "radau", "bdf")
 MASS_MATRICES = ("consistent", "lumped")
-PHYSICS = ("parametric", "intrinsic")
+PHYSICS = ("parametric", "intrinsic", "shell")
+#: edge kinds of the Kirchhoff–Love shell only (``physics = "shell"``)
+SHELL_EDGES = ("diaphragm", "symmetry")
+#: ``[material]`` keys of the shell, and those of the thin plate under tension
+SHELL_KEYS = ("E", "nu", "thickness", "density")
+PLATE_KEYS = ("mass", "w10", "w01", "w20", "w11", "w02", "mass_matrix")
 FORMATS = ("obj", "stl", "ply", "vtu", "json", "npz", "report", "images", "gif", "mp4",
            "viewer", "3dm")
 #: shorthand names accepted in ``output.formats``
@@ -61,7 +66,7 @@ Text = Annotated[str, Strict()]
 Pair = tuple[Real, Real]
 Cells = Annotated[int, Strict(), Field(ge=1, le=512)]
 Knots = Literal[KNOT_KINDS]  # type: ignore[valid-type]
-Preset = Literal[PRESETS]  # type: ignore[valid-type]
+Preset = Literal[PRESETS + SHELL_EDGES]  # type: ignore[valid-type]
 
 
 class _Table(BaseModel):
@@ -180,9 +185,22 @@ class Material(_Table):
         "consistent", description="Galerkin mass `μ G0⊗G0`, or its row sums on the diagonal "
                                   "(cheaper, less accurate frequencies)")
     physics: Literal[PHYSICS] = Field(  # type: ignore[valid-type]
-        "parametric", description="the paper's energy per unit parameter area, or the same "
+        "parametric", description="the paper's energy per unit parameter area, the same "
                                   "plate under tension measured on the surface (isotropic "
-                                  "weights, see [physics.md](physics.md))")
+                                  "weights), or a linear Kirchhoff–Love shell (x, y, z "
+                                  "coupled; `E`, `nu`, `thickness`, `density` instead of "
+                                  "`mass` and `w..`), see [physics.md](physics.md)")
+    E: Optional[Positive] = Field(None, description="shell: Young's modulus",
+        json_schema_extra={"doc_default": 'required for `shell`'})
+    nu: Optional[Annotated[float, Strict(), Field(ge=0, lt=0.5, allow_inf_nan=False)]] = Field(
+        None, description="shell: Poisson ratio, `0 ≤ ν < 0.5`",
+        json_schema_extra={"doc_default": 'required for `shell`'})
+    thickness: Optional[Positive] = Field(None, description="shell: thickness t",
+        json_schema_extra={"doc_default": 'required for `shell`'})
+    density: Optional[Positive] = Field(None, description=(
+            "shell: density ρ (mass per unit volume; the mass is `ρ t` per unit surface "
+            "area, and `damping` γ gives `C = (γ/(ρt)) M + β K`)"),
+        json_schema_extra={"doc_default": '1 for `shell`'})
 
 
 class FreeRegion(_Table):
@@ -197,7 +215,9 @@ class FreeRegion(_Table):
 class Boundary(_Table):
     u0: Preset = Field("free", description=(
             "edge `u = 0`: pinned holds it (`d = 0`), clamped also holds its slope (`∂n d = 0`), "
-            "pole makes a collapsed edge (open knots) move as one point"))
+            "pole makes a collapsed edge (open knots) move as one point; shell only: diaphragm "
+            "is rigid in the edge's coordinate plane and free out of it, symmetry puts the edge "
+            "on a coordinate symmetry plane"))
     u1: Preset = Field("free", description="edge `u = L_u` (presets as `u0`)")
     v0: Preset = Field("free", description="edge `v = 0` (presets as `u0`)")
     v1: Preset = Field("free", description="edge `v = L_v` (presets as `u0`)")
@@ -233,14 +253,16 @@ class PointLoad(_Profiled):
     at: Pair = Field(title="[u, v]", description="where a point force acts",
         json_schema_extra={"doc_default": 'required for `point`'})
     force: tuple[Real, Real, Real] = Field(title="[fx, fy, fz]", description=(
-            "the force (point) or force per parameter area (uniform)"),
+            "the force (point) or force per parameter area (uniform; per unit surface area "
+            "under physics `shell`)"),
         json_schema_extra={"doc_default": 'required for `point`, `uniform`'})
 
 
 class UniformLoad(_Profiled):
     kind: Literal["uniform"]
     force: tuple[Real, Real, Real] = Field(title="[fx, fy, fz]", description=(
-            "the force (point) or force per parameter area (uniform)"),
+            "the force (point) or force per parameter area (uniform; per unit surface area "
+            "under physics `shell`)"),
         json_schema_extra={"doc_default": 'required for `point`, `uniform`'})
 
 

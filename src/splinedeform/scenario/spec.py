@@ -10,6 +10,7 @@ from typing import Any
 from ..boundary import EDGES
 from ..errors import ScenarioError
 from .keys import MATERIAL_KEYS
+from .schema import SHELL_KEYS
 from .locate import _Problems
 
 
@@ -29,7 +30,8 @@ class SurfaceSpec:
 
 @dataclass(frozen=True)
 class MaterialSpec:
-    """``[material]``: the :class:`~splinedeform.material.Material` arguments and the mass.
+    """``[material]``: the :class:`~splinedeform.material.Material` arguments and the mass,
+    or (``physics = "shell"``) those of :class:`~splinedeform.ShellMaterial`.
 
     The mass density ``mass`` scales the mass matrix.
     """
@@ -44,9 +46,19 @@ class MaterialSpec:
     w02: float = 0.0
     mass_matrix: str = "consistent"
     physics: str = "parametric"
+    E: float | None = None
+    nu: float | None = None
+    thickness: float | None = None
+    density: float | None = None
 
     def weights(self) -> dict[str, float]:
-        return {k: getattr(self, k) for k in MATERIAL_KEYS if k not in ("mass_matrix", "physics")}
+        """Arguments of :class:`~splinedeform.material.Material`."""
+        return {k: getattr(self, k) for k in MATERIAL_KEYS
+                if k not in ("mass_matrix", "physics", *SHELL_KEYS)}
+
+    def shell(self) -> dict[str, float]:
+        """Arguments of :class:`~splinedeform.ShellMaterial` (``physics = "shell"``)."""
+        return {k: getattr(self, k) for k in (*SHELL_KEYS, "damping", "rayleigh")}
 
 
 @dataclass(frozen=True)

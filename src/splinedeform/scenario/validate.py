@@ -6,11 +6,13 @@ import math
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
+from ..boundary import EDGES
 from .checks import Key, _Invalid
 from .keys import (BOUNDARY_KEYS, FORMAT_ALIASES, FREE_REGION_KEYS, LOAD_KEYS, LOAD_KIND_KEYS,
                    METHOD_SETTINGS, MATERIAL_KEYS, PROFILE_KEYS, SHAPE_PARAMETERS, SOLVE_KEYS,
                    SOLVE_KIND_KEYS, SURFACE_KEYS, TABLES, TOP_KEYS, OUTPUT_KEYS)
 from .locate import _describe, _Problems
+from .schema import PLATE_KEYS, SHELL_EDGES, SHELL_KEYS
 from .spec import (BoundarySpec, LoadSpec, MaterialSpec, OutputSpec, Scenario, SolveSpec,
                    SurfaceSpec)
 
@@ -87,8 +89,9 @@ def _validate(raw: dict[str, Any], source: str, lines: Mapping[str, int],
                 problems.add(key, str(exc))
     surface = _validate_surface(raw, problems, directory, allow_outside_paths)
     material = _validate_material(raw, problems, surface)
-    boundary = _validate_boundary(raw, problems)
-    solve = _validate_solve(raw, problems)
+    physics = material.physics if material is not None else "parametric"
+    boundary = _validate_boundary(raw, problems, physics)
+    solve = _validate_solve(raw, problems, physics)
     loads = _validate_loads(raw, problems, solve)
     output = _validate_output(raw, problems, solve)
     problems.raise_if_any()
@@ -157,7 +160,12 @@ def _validate_material(raw: Mapping[str, Any], problems: _Problems,
                        surface: SurfaceSpec | None) -> MaterialSpec | None:
     table = raw.get("material", {})
     values = _check_table(table, MATERIAL_KEYS, "material", problems, "material")
+    if values.get("physics") == "shell":
+        return _validate_shell_material(table, values, problems, surface)
     spec = MaterialSpec(**values)
+    _not_applicable(table, SHELL_KEYS, (), "material", problems,
+                    f"to physics {spec.physics!r}, only to \"shell\" (the thin plate under "
+                    "tension takes mass and the weights w10 ... w02)")
     weights = ("w10", "w01", "w20", "w11", "w02")
     if isinstance(table, dict) and all(getattr(spec, w) == 0 for w in weights) and not any(
             w in table and w not in values for w in weights):
@@ -172,9 +180,35 @@ def _validate_material(raw: Mapping[str, Any], problems: _Problems,
     return spec
 
 
-def _validate_boundary(raw: Mapping[str, Any], problems: _Problems) -> BoundarySpec | None:
+def _validate_shell_material(table: Any, values: dict[str, Any], problems: _Problems,
+                             surface: SurfaceSpec | None) -> MaterialSpec:
+    """``physics = "shell"``: E, nu, thickness required, the plate's keys refused."""
+    _not_applicable(table, PLATE_KEYS, (), "material", problems,
+                    "to physics \"shell\" (a Kirchhoff–Love shell takes E, nu, thickness and "
+                    "density; the thin-plate weights and mass do not apply)")
+    _require(values, table, ("E", "nu", "thickness"), MATERIAL_KEYS, "material", problems,
+             " (physics \"shell\" needs it)")
+    values.setdefault("density", 1.0)
+    if surface is not None and surface.shape not in ("file", "cad") and surface.degree < 2:
+        problems.add("surface.degree", "the Kirchhoff–Love shell (physics \"shell\") needs "
+                                       "curvatures, so second derivatives: degree must be >= 2")
+    return MaterialSpec(**{k: v for k, v in values.items() if k not in PLATE_KEYS})
+
+
+def _validate_boundary(raw: Mapping[str, Any], problems: _Problems,
+                       physics: str = "parametric") -> BoundarySpec | None:
     table = raw.get("boundary", {})
     values = _check_table(table, BOUNDARY_KEYS, "boundary", problems, "boundary")
+    for edge in EDGES:
+        kind = values.get(edge)
+        if kind in SHELL_EDGES and physics != "shell":
+            problems.add(f"boundary.{edge}", f"{kind!r} is an edge of the Kirchhoff–Love shell "
+                                             f"only (material.physics = \"shell\"), not of "
+                                             f"physics {physics!r}")
+        elif kind == "pole" and physics == "shell":
+            problems.add(f"boundary.{edge}", "'pole' is not an edge of the shell (physics "
+                                             "\"shell\"): use free, pinned, clamped, diaphragm "
+                                             "or symmetry")
     region = values.pop("free_region", None)
     box: dict[str, tuple[float, float] | None] = {"free_u": None, "free_v": None}
     if region is not None:
@@ -251,7 +285,8 @@ def _first_not_increasing(times: Iterable[float]) -> int | None:
     return None
 
 
-def _validate_solve(raw: Mapping[str, Any], problems: _Problems) -> SolveSpec | None:
+def _validate_solve(raw: Mapping[str, Any], problems: _Problems,
+                    physics: str = "parametric") -> SolveSpec | None:
     if "solve" not in raw:
         problems.add("solve", f"missing table [solve]; it needs kind = "
                               f"{SOLVE_KEYS['kind'].allowed}")
@@ -267,6 +302,10 @@ def _validate_solve(raw: Mapping[str, Any], problems: _Problems) -> SolveSpec | 
                     f"to kind {kind!r}" + (f" (it uses {', '.join(used)})" if used else ""))
     if kind == "dynamic":
         _check_dynamic(table, values, problems)
+        if physics == "shell" and values.get("method", "analytic") != "analytic":
+            problems.add("solve.method", f"the shell (physics \"shell\") is solved in closed "
+                                         f"form only: method \"analytic\", got "
+                                         f"{values['method']!r}")
     if kind == "modes" and values.get("modes", 1) < 1:
         problems.add("solve.modes", f"a modes solve needs modes >= 1, got {values['modes']}")
     return SolveSpec(kind=kind, **_with_defaults(SOLVE_KEYS, values,

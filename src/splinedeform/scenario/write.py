@@ -10,6 +10,7 @@ from typing import Any, Iterable
 from ..boundary import EDGES
 from .keys import (STEP_METHODS, IVP_METHODS, LOAD_KIND_KEYS, MATERIAL_KEYS, OUTPUT_KEYS,
                    PROFILE_KEYS, TOP_KEYS)
+from .schema import PLATE_KEYS, SHELL_KEYS
 from .spec import LoadSpec, Scenario, SolveSpec
 
 
@@ -82,7 +83,9 @@ def scenario_to_toml(scenario: Scenario) -> str:
     else:
         items += fitted
     out += _toml_table("[surface]", items)
-    out += _toml_table("[material]", [(k, getattr(s.material, k)) for k in MATERIAL_KEYS])
+    skip = PLATE_KEYS if s.material.physics == "shell" else SHELL_KEYS
+    out += _toml_table("[material]", [(k, getattr(s.material, k)) for k in MATERIAL_KEYS
+                                      if k not in skip])
     boundary: list[tuple[str, Any]] = [(e, getattr(s.boundary, e)) for e in EDGES]
     region = {k: getattr(s.boundary, f"free_{k}") for k in "uv"
               if getattr(s.boundary, f"free_{k}") is not None}
