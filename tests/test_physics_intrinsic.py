@@ -165,4 +165,4 @@ kind = "static"
     model = build(parse_scenario(text.format(physics="intrinsic"))).model
     assert model.physics == "intrinsic"
     with pytest.raises(ScenarioError, match=r"case\.toml:8: material\.physics: expected one of"):
-        parse_scenario(text.format(physics="shell"), source="case.toml")
+        parse_scenario(text.format(physics="membrane"), source="case.toml")
