@@ -137,6 +137,7 @@ class ShellModel:
         if not isinstance(material, ShellMaterial):
             raise InputError("a shell needs a ShellMaterial(E, nu, thickness, density)")
         self.surface, self.material = surface, material
+        self.physics = "shell"
         self.K_full, self.M_full = matrices(surface, material)
         self.T = constraint_matrix(surface, dict(boundary or {}), fixed)
         self._K = (self.T.T @ self.K_full @ self.T).tocsc()
@@ -262,6 +263,10 @@ class ShellModel:
         v0 = self._to_free(initial_velocity, "initial_velocity")
         rigid = self.rigid.shape[1]
         if modes is None:
+            if self.n_free > modal_basis.DENSE_MAX:
+                raise InputError(f"all modes of {self.n_free} coupled unknowns need a dense "
+                                 f"eigenproblem above the limit {modal_basis.DENSE_MAX}: give "
+                                 "modes=k for the lowest modes plus the static correction")
             basis = modal_basis.dense_basis(self._K, self._M, rigid)
         else:
             basis = modal_basis.sparse_basis(self._K, self._M, _count(modes, self.n_free), None,
