@@ -212,6 +212,16 @@ def test_resolve_from_the_page_shows_progress_and_resets(page):
                            timeout=60000)
     assert page.evaluate("sculptState.version") == 2
     assert page.evaluate("sculptState.pushes.length") == 0
+    page.check("#region-on")                 # only the middle of the sheet moves
+    page.fill("#region-u0", "0.3")
+    page.fill("#region-u1", "0.7")
+    page.click("#resolve")
+    page.wait_for_function("sculptState.version === 3 || sculptState.errors.length > 0",
+                           timeout=60000)
+    assert page.evaluate("sculptState.errors") == []
+    assert page.evaluate("document.getElementById('region-on').checked")
+    assert page.evaluate("document.getElementById('region-u1').value") == "0.7"
+    page.uncheck("#region-on")
     page.select_option("#boundary-u0", "free")
     page.select_option("#boundary-u1", "free")
     page.select_option("#boundary-v0", "free")
@@ -219,4 +229,4 @@ def test_resolve_from_the_page_shows_progress_and_resets(page):
     page.click("#resolve")                  # rigid motions: refused, message shown, page alive
     page.wait_for_function("sculptState.errors.length > 0", timeout=60000)
     assert "rigid" in page.evaluate("sculptState.errors.slice(-1)[0]")
-    assert page.evaluate("sculptState.version") == 2
+    assert page.evaluate("sculptState.version") == 3

@@ -8,6 +8,7 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +16,9 @@ import pytest
 
 pytest.importorskip("starlette", reason="the sculpt server needs the extra 'sculpt'")
 pytest.importorskip("httpx", reason="starlette's TestClient needs httpx")
-from starlette.testclient import TestClient  # noqa: E402
+with warnings.catch_warnings():   # starlette >= 1.0 suggests httpx2; httpx still works
+    warnings.simplefilter("ignore")
+    from starlette.testclient import TestClient  # noqa: E402
 
 from splinedeform.scenario import parse_scenario  # noqa: E402
 from splinedeform.sculpt.export import decode  # noqa: E402
@@ -41,8 +44,7 @@ v1 = "pinned"
 kind = "modes"
 """
 RESOLUTION = 7
-# starlette >= 1.0 suggests httpx2 for its TestClient; httpx still works
-pytestmark = pytest.mark.filterwarnings("ignore:Using `httpx`:DeprecationWarning")
+pytestmark = pytest.mark.filterwarnings("ignore:Using `httpx`")
 
 
 @pytest.fixture()
@@ -87,7 +89,30 @@ def test_resolve_changes_the_modes(client, session):
     assert status["busy"] is False and status["stage"] == "done" and status["version"] == 2
 
 
+def test_resolve_with_a_free_region_moves_only_its_points(client, session):
+    """Only control points whose Greville abscissae lie in the box move: fewer free
+    coordinates, and the modes vanish at the samples outside the box's support."""
+    n_before = session.basis.model.n_free
+    body = {**GOOD_RESOLVE, "free_region": {"u": [0.3, 0.7], "v": [0.2, 0.8]}}
+    reply = client.post("/api/resolve", json=body)
+    assert reply.status_code == 200, reply.status_code
+    data = reply.json()
+    assert data["free_region"] == {"u": [0.3, 0.7], "v": [0.2, 0.8]}
+    assert 0 < data["n_free"] < n_before
+    phi = decode(data["phi"]).reshape(RESOLUTION, RESOLUTION, -1)
+    assert np.all(phi[0] == 0.0) and np.all(phi[:, 0] == 0.0)    # edges held: exactly zero
+    # back to the whole net
+    reply = client.post("/api/resolve", json={**GOOD_RESOLVE, "free_region": None})
+    assert reply.json()["free_region"] is None and reply.json()["n_free"] > data["n_free"]
+
+
 HOSTILE = [
+    ("/api/resolve", json.dumps({**GOOD_RESOLVE,
+                                 "free_region": {"u": [0.8, 0.2]}}).encode(), 400),
+    ("/api/resolve", json.dumps({**GOOD_RESOLVE,
+                                 "free_region": {"u": [0.1, None]}}).encode(), 422),
+    ("/api/resolve", json.dumps({**GOOD_RESOLVE,
+                                 "free_region": {"u": [5.0, 6.0]}}).encode(), 400),
     ("/api/resolve", b"not json", 400),
     ("/api/resolve", b"[1, 2]", 400),
     ("/api/resolve", b"[" * 100000 + b"]" * 100000, 400),          # nesting bomb

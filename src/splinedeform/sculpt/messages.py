@@ -49,11 +49,22 @@ class BoundaryMessage(_Message):
     v1: Edge = "free"
 
 
+Parameter = Annotated[float, Field(ge=-1e6, le=1e6)]
+
+
+class FreeRegionMessage(_Message):
+    """``boundary.free_region``: only control points with Greville abscissae in the box move."""
+
+    u: tuple[Parameter, Parameter] | None = None
+    v: tuple[Parameter, Parameter] | None = None
+
+
 class ResolveMessage(_Message):
-    """Re-solve the modes with a new material and boundary."""
+    """Re-solve the modes with a new material, boundary and free region (None: the whole net)."""
 
     material: MaterialMessage
     boundary: BoundaryMessage
+    free_region: FreeRegionMessage | None = None
 
 
 class CorrectionMessage(_Message):

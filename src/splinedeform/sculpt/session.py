@@ -107,6 +107,10 @@ class Session:
             overrides: dict[str, Any] = {f"material.{k}": getattr(message.material, k)
                                          for k in MATERIAL_FIELDS}
             overrides.update({f"boundary.{e}": getattr(message.boundary, e) for e in EDGE_NAMES})
+            region = message.free_region
+            box = None if region is None else {k: list(getattr(region, k)) for k in "uv"
+                                               if getattr(region, k) is not None} or None
+            overrides["boundary.free_region"] = box     # None (or {}): the whole net moves
             try:
                 self._solve(with_overrides(self.scenario, overrides, origin="sculpt page"))
             except Exception as exc:
@@ -132,6 +136,9 @@ class Session:
             phi_net=_b64(basis.phi_net), net_rest=_b64(surf.control_points.reshape(-1, 3)),
             material={k: getattr(s.material, k) for k in MATERIAL_FIELDS},
             boundary={e: getattr(s.boundary, e) for e in EDGE_NAMES},
+            free_region={k: getattr(s.boundary, f"free_{k}") for k in "uv"}
+            if s.boundary.has_free_region else None,
+            domain=[float(surf.basis_u.length), float(surf.basis_v.length)],
             solve_seconds=round(self.timing, 4), server=True)
         return data
 
