@@ -30,6 +30,7 @@ from .quadrature import gram_matrix
 from .solution import ModalSolution, StaticSolution
 from .solvers import modal_basis, rigid
 from .solvers.analytic import ModalResponse
+from .solvers.kronecker_eigen import kronecker_reason
 from .solvers.rigid import UnresolvedSpectrum
 from .surface import Surface
 
@@ -228,12 +229,19 @@ class Model:
         ``(n_free, k)``. Dense ``eigh`` of the reduced system (the reference) up to
         ``DENSE_LIMIT`` free coordinates; larger nets use the separable Kronecker factors
         when they apply, sparse shift-invert Lanczos for the lowest ``k``, or dense ``eigh``
-        up to ``DENSE_MAX`` (see :mod:`splinedeform.solvers.modal_basis`). Cached.
+        up to ``DENSE_MAX`` (see :mod:`splinedeform.solvers.modal_basis`). A few modes
+        (``k <= n/10``, ``n >= 400``) of a net whose modes are not yet known come from
+        sparse Lanczos too unless the separable factors apply: ``O(n k²)`` against the
+        ``O(n³)`` of all modes. Cached.
         """
         n = self.n_free
         if k is not None:
             k = _check_count(k, n)
         strategy = modal_basis.choose(self, "auto", truncated=k is not None and k <= n // 2)
+        few = k is not None and n >= 400 and k <= n // 10
+        if (strategy == "dense" and few and not any(key[1:] == (None, None) for key in self._bases)
+                and modal_basis.separable_reason(self) is not None):
+            strategy = "sparse"
         if strategy == "sparse":
             sparse = self.modal_basis("sparse", modes=k)
             assert isinstance(sparse, modal_basis.DenseBasis)
@@ -284,8 +292,11 @@ class Model:
     def _complete_basis(self, strategy: str) -> modal_basis.ModalBasis:
         if strategy == "separable":
             return modal_basis.separable_basis(self)
-        basis = modal_basis.dense_basis(self._K, self._M, self.rigid_modes,
-                                        self._eigen_advice())
+        if kronecker_reason(self) is None:
+            basis = modal_basis.kronecker_basis(self, self.rigid_modes, self._eigen_advice())
+        else:
+            basis = modal_basis.dense_basis(self._K, self._M, self.rigid_modes,
+                                            self._eigen_advice())
         self._eigen = (basis.lam, basis.phi)
         return basis
 

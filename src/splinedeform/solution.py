@@ -245,16 +245,22 @@ class ModalSolution(Solution):
 
     def _displacements(self, times: Array, velocities: bool) -> tuple[Array, Array | None]:
         n = self.basis.n_free
-        d = np.empty((times.size, n, 3))
-        v = np.empty((times.size, n, 3)) if velocities else None
+        d = np.zeros((times.size, n, 3))
+        v = np.zeros((times.size, n, 3)) if velocities else None
+        active = getattr(self.response, "active", np.arange(3))   # coordinates that move
         i = 0
         for part in self._chunks(times):
-            Q, V = self.response(part)
-            d[i:i + part.size] = self.basis.expand(Q)
+            span = slice(i, i + part.size)
+            if active.size:
+                if hasattr(self.response, "active_part"):
+                    Q, V = self.response.active_part(part)
+                else:
+                    Q, V = self.response(part)
+                d[span, :, active] = self.basis.expand(Q)
+                if v is not None:
+                    v[span, :, active] = self.basis.expand(V)
             if self.correction is not None:
-                d[i:i + part.size] += self.correction(part)
-            if v is not None:
-                v[i:i + part.size] = self.basis.expand(V)
+                d[span] += self.correction(part)
             i += part.size
         return d, v
 

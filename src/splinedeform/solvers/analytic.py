@@ -188,15 +188,28 @@ class ModalResponse:
                  jumps: list[tuple[float, Array]], harmonics: list[tuple[float, float, Array]]):
         self.lam = np.maximum(np.asarray(lam, dtype=float), 0.0)
         self.c = np.asarray(c, dtype=float)
-        self.q0, self.v0 = q0, v0
         merged: dict[float, Array] = {}
         for t_j, g in jumps:
             merged[t_j] = merged.get(t_j, 0.0) + g
-        self.jumps = sorted(merged.items())
-        self.harmonics = harmonics
+        parts = [q0, v0] + [g for g in merged.values()] + [g for _, _, g in harmonics]
+        self.width = q0.shape[1]
+        self.active = np.flatnonzero(np.any([np.any(p != 0, axis=0) for p in parts], axis=0))
+        """Coordinates with a load or an initial condition; the others stay at rest."""
+        a = self.active
+        self.q0, self.v0 = q0[:, a], v0[:, a]
+        self.jumps = sorted((t_j, g[:, a]) for t_j, g in merged.items())
+        self.harmonics = [(omega, phase, g[:, a]) for omega, phase, g in harmonics]
 
     def __call__(self, t: Array) -> tuple[Array, Array]:
         """``Q(t), Q'(t)``, each ``(F, N, 3)`` for times ``t`` of shape ``(F,)``."""
+        Q, V = self.active_part(t)
+        shape = Q.shape[:2] + (self.width,)
+        full_q, full_v = np.zeros(shape), np.zeros(shape)
+        full_q[..., self.active], full_v[..., self.active] = Q, V
+        return full_q, full_v
+
+    def active_part(self, t: Array) -> tuple[Array, Array]:
+        """``Q(t), Q'(t)`` of the :attr:`active` coordinates only, ``(F, N, len(active))``."""
         t = np.asarray(t, dtype=float)[:, None]
         lam, c = self.lam[None, :], self.c[None, :]
         p11, p12, p21, p22 = propagator(lam, c, t)

@@ -36,6 +36,7 @@ import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
 
 from ..errors import InputError, SingularSystemError
+from . import kronecker_eigen
 from .rigid import check_resolved, count_by_gap, direction_rigid
 
 if TYPE_CHECKING:
@@ -255,6 +256,16 @@ def dense_basis(K: sp.spmatrix, M: sp.spmatrix, rigid: int | None = None,
         rigid = count_by_gap(lam, "dense eigen-solution")
     lam = check_resolved(lam, rigid, "dense eigen-solution", advice)
     return DenseBasis(lam, phi, "dense", True)
+
+
+def kronecker_basis(model: Model, rigid: int | None, advice: str = DEFAULT_ADVICE
+                    ) -> DenseBasis:
+    """All modes by the Kronecker reduction to standard form (:mod:`.kronecker_eigen`)."""
+    lam, phi = kronecker_eigen.eigenpairs(model)
+    if rigid is None:
+        rigid = count_by_gap(lam, "dense eigen-solution")
+    return DenseBasis(check_resolved(lam, rigid, "dense eigen-solution", advice), phi,
+                      "dense", True)
 
 
 def separable_reason(model: Model) -> str | None:
