@@ -95,6 +95,26 @@ def ratio_lines(rows: list[bench.Row]) -> list[str]:
     return lines
 
 
+def plate_ratios(rows: list[bench.Row]) -> dict[int, tuple[float, float, str]]:
+    """Per net size of the ``clamped`` family: (analytic s, fastest integrator s, its name);
+    a run stopped at the budget counts with its extrapolated cost when that is the lowest."""
+    plate: dict[int, tuple[float, float, str]] = {}
+    for cells in sorted({r.cells for r in rows if r.family == "clamped"}):
+        here = [r for r in rows if r.family == "clamped" and r.cells == cells]
+        analytic = [r for r in here if r.solver == "analytic"]
+        numerical = [r for r in here if r.solver != "analytic"]
+        if not analytic:
+            continue
+        guess = bench.fastest_estimate(numerical)
+        best = bench.fastest(numerical)
+        if guess is not None:
+            plate[cells] = (analytic[0].seconds, guess.estimate,
+                            f"{guess.solver} (extrapolated from {guess.progress:.0%} of t_end)")
+        elif best is not None:
+            plate[cells] = (analytic[0].seconds, best.seconds, best.solver)
+    return plate
+
+
 def main(argv: list[str] | None = None) -> int:
     args = parse(argv)
     sizes = [int(s) for s in args.sizes.split(",")] if args.sizes else None
@@ -112,21 +132,16 @@ def main(argv: list[str] | None = None) -> int:
                                 frames=args.frames, goals=False if args.no_goals else None,
                                 methods=split(args.methods), families=split(args.families))
     regimes = ""
+    saved = out / "regimes.json"
+    record = None
     if args.regimes and not args.render_only:
         record = bench_goals.goals(say=lambda s: print(s, flush=True), quick=args.quick)
-        plate = {}
-        for r in result["rows"]:
-            if r.family != "clamped" or r.solver == "analytic":
-                continue
-            best = plate.get(r.cells)
-            analytic = [a for a in result["rows"] if a.family == "clamped"
-                        and a.cells == r.cells and a.solver == "analytic"][0]
-            if r.status == "ok" and (best is None or r.seconds < best[1]):
-                plate[r.cells] = (analytic.seconds, r.seconds, r.solver)
-        regimes = "\n## Regimes and goals (`splinedeform.bench_goals`)\n\n" + \
-            bench_goals.markdown(record, plate)
-        (out / "regimes.json").write_text(json.dumps(record, indent=1, default=str),
-                                          encoding="utf-8")
+        saved.write_text(json.dumps(record, indent=1, default=str), encoding="utf-8")
+    elif args.render_only and saved.is_file():
+        record = json.loads(saved.read_text(encoding="utf-8"))
+    if record is not None:
+        regimes = ("\n## Regimes and goals (`splinedeform.bench_goals`)\n\n"
+                   + bench_goals.markdown(record, plate_ratios(result["rows"])))
     evaluate, evaluated = evaluate_section(args.quick)
     print("\nratios numerical / analytic (time to the same frames at the same accuracy):")
     for line in ratio_lines(result["rows"]):

@@ -704,6 +704,21 @@ def fastest(rows: Sequence[Row]) -> Row | None:
     return min(done, key=lambda r: r.seconds) if done else None
 
 
+def fastest_estimate(rows: Sequence[Row]) -> Row | None:
+    """A run stopped at the budget whose extrapolated cost beats every finished run, if any.
+
+    Only runs that simulated at least ``MIN_PROGRESS`` of ``t_end`` are extrapolated, so a
+    method that is probably faster is not hidden behind the budget.
+    """
+    best = fastest(rows)
+    stopped = [r for r in rows if r.status == "over budget" and math.isfinite(r.estimate)
+               and r.progress >= MIN_PROGRESS]
+    quick = min(stopped, key=lambda r: r.estimate) if stopped else None
+    if quick is not None and (best is None or quick.estimate < best.seconds):
+        return quick
+    return None
+
+
 def _cell(row: Row, best: Row | None = None) -> str:
     if row.status == "ok" and best is not None:
         return f"{_fmt(row.seconds, ' s')} (×{_fmt(row.seconds / best.seconds)}; {row.error:.0e})"
@@ -762,11 +777,17 @@ def markdown(rows: list[Row], goals: list[Goal], study: Study, seconds: float,
                 continue
             check = f"{a.error:.0e}" if math.isfinite(a.error) else "—"
             best = fastest(list(here.values()))
+            guess = fastest_estimate(list(here.values()))
+            if guess is not None:
+                lead = f"≈{guess.solver} (extrapolated) | ≈{_fmt(a.seconds / guess.estimate)} |\n"
+            elif best is not None:
+                lead = f"{best.solver} | {_fmt(a.seconds / best.seconds)} |\n"
+            else:
+                lead = "— | — |\n"
             w(f"| {cells}×{cells} | {a.n_free} | {_fmt(a.setup, ' s')} | "
               f"{_fmt(1e3 * a.per_frame, ' ms')} | {_fmt(a.seconds, ' s')} | {check} | "
               + " | ".join(_cell(here[m], best) if m in here else "—" for m in study.methods)
-              + f" | {best.solver if best else '—'} | "
-              + (f"{_fmt(a.seconds / best.seconds)} |\n" if best else "— |\n"))
+              + " | " + lead)
         w("\nSettings found (coarsest reaching the target) and fitted cost slopes "
           "(time ∝ n_free^p, least squares over the three largest nets measured or extrapolated from a run stopped at the budget):\n\n")
         w("| solver | " + " | ".join(f"{c}×{c}" for c in study.sizes) + " | slope p |\n")
