@@ -164,3 +164,20 @@ def test_viewer_rejects_non_html_name(tmp_path):
     with pytest.raises(InputError, match="html"):
         viz.write_viewer(tmp_path / "viewer.txt", surface, surface.control_points, times, nets)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_title_is_the_given_title_and_time_zero_reads_0(browser, tmp_path):
+    surface, times, nets = deforming_plate()
+    title = "plate <rising> & falling"
+    path = viz.write_viewer(tmp_path / "viewer.html", surface, surface.control_points, times,
+                            nets, resolution=8, title=title)
+    context = browser.new_context(viewport={"width": 900, "height": 600})
+    try:
+        pg = context.new_page()
+        pg.goto(path.as_uri())
+        pg.wait_for_function("window.splinedeformViewer !== undefined", timeout=30_000)
+        assert pg.title() == f"splinedeform — {title}"
+        assert pg.inner_text("#title") == title
+        assert pg.inner_text("#time").split() == ["t", "=", "0", "(1/9)"]
+    finally:
+        context.close()

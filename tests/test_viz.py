@@ -94,13 +94,13 @@ def hot_pixels(image: np.ndarray) -> int:
 
 
 def test_render_surfaces_size_and_hot_region(tmp_path, monkeypatch):
-    monkeypatch.setattr(viz, "_pyvista", lambda: None)
+    monkeypatch.setattr(viz.surfaces, "_pyvista", lambda: None)
     s = plane()
     _, nets = motion(s)
     path = viz.render_surfaces(tmp_path / "initial_final.png", s, s.control_points,
                                [nets[0], nets[-1]], ["initial", "final"], resolution=24)
     image = read_png(path)
-    assert image.shape == (400, 2 * 400 + 120, 3)
+    assert image.shape == (400, 2 * 400 + 150, 3)
     assert distinct_colours(image) > 200
     # the rest state has no displacement: no hot pixel; the bumped state has a hot top
     assert hot_pixels(image[:, :400]) == 0
@@ -115,14 +115,14 @@ def test_render_surfaces_falls_back_to_matplotlib_silently(tmp_path, monkeypatch
         def Plotter(*args, **kwargs):
             raise RuntimeError("cannot open display")
 
-    monkeypatch.setattr(viz, "_pyvista", lambda: BrokenPyVista)
+    monkeypatch.setattr(viz.surfaces, "_pyvista", lambda: BrokenPyVista)
     s = plane(3)
     _, nets = motion(s, 2)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         path = viz.render_surfaces(tmp_path / "r.png", s, s.control_points, [nets[-1]], ["t=1"],
                                    resolution=12)
-    assert read_png(path).shape == (400, 520, 3)
+    assert read_png(path).shape == (400, 550, 3)
     assert capsys.readouterr() == ("", "")
     assert [p.name for p in tmp_path.iterdir()] == ["r.png"]
 
@@ -133,7 +133,7 @@ def test_render_surfaces_uses_pyvista_when_it_can_render(tmp_path, monkeypatch):
 
     class FakePlotter:
         def __init__(self, off_screen, shape, window_size, border):
-            assert off_screen and shape == (1, 2) and window_size == (920, 400)
+            assert off_screen and shape == (1, 2) and window_size == (950, 400)
             calls.append("open")
 
         def subplot(self, row, col):
@@ -153,7 +153,7 @@ def test_render_surfaces_uses_pyvista_when_it_can_render(tmp_path, monkeypatch):
             pass
 
         def screenshot(self, filename):
-            iio.imwrite(filename, np.full((400, 920, 3), 200, np.uint8), extension=".png")
+            iio.imwrite(filename, np.full((400, 950, 3), 200, np.uint8), extension=".png")
 
         def close(self):
             calls.append("close")
@@ -167,7 +167,7 @@ def test_render_surfaces_uses_pyvista_when_it_can_render(tmp_path, monkeypatch):
         Plotter = FakePlotter
         PolyData = FakeMesh
 
-    monkeypatch.setattr(viz, "_pyvista", lambda: FakePyVista)
+    monkeypatch.setattr(viz.surfaces, "_pyvista", lambda: FakePyVista)
     s = plane(3)
     _, nets = motion(s, 2)
     path = viz.render_surfaces(tmp_path / "r.png", s, s.control_points, list(nets), ["a", "b"],
@@ -254,7 +254,7 @@ def test_mp4_when_an_encoder_is_available(tmp_path):
 
 
 def test_mp4_without_encoder_names_the_extra(tmp_path, monkeypatch):
-    monkeypatch.setattr(viz, "mp4_available", lambda: False)
+    monkeypatch.setattr(viz.animation, "mp4_available", lambda: False)
     s = plane(3)
     times, nets = motion(s, 2)
     with pytest.raises(InputError, match="video"):

@@ -12,6 +12,8 @@ from contextlib import AbstractContextManager
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
+import numpy as np
+
 from .scenario import scenario_to_toml
 
 if TYPE_CHECKING:
@@ -75,6 +77,20 @@ def write_outputs(result: RunResult, folder: Path, stages: Stages) -> None:
         claim.release()
 
 
+def _welded_mesh(result: RunResult) -> tuple[Any, Any, Any]:
+    """The mesh written as OBJ/STL/PLY: vertices, faces and displacements from rest.
+
+    Tessellated at rest and in the written state; grid points that coincide in both
+    (seams, poles) are welded and the triangles that collapse dropped.
+    """
+    from .export import tessellate_frames, weld
+
+    surface, res = result.built.surface, result.scenario.output.resolution
+    X, faces = tessellate_frames(surface, np.stack([result.rest_net, _mesh_net(result)]), res)
+    keep, faces = weld(X, faces)
+    return X[1, keep], faces, X[1, keep] - X[0, keep]
+
+
 def _write_files(result: RunResult, folder: Path, stages: Stages) -> None:
     from . import export
 
@@ -85,10 +101,7 @@ def _write_files(result: RunResult, folder: Path, stages: Stages) -> None:
     for ext in ("obj", "stl", "ply"):
         if ext in formats:
             with stages.stage(f"mesh .{ext}"):
-                net = _mesh_net(result)
-                vertices, faces = surface.tessellate(res, control_points=net)
-                d = vertices - surface.tessellate(res)[0]
-                import numpy as np
+                vertices, faces, d = _welded_mesh(result)
                 data = {"displacement": d, "displacement_magnitude": np.linalg.norm(d, axis=1)}
                 result.outputs.append((f"mesh .{ext}", export.write_mesh(
                     folder / f"{name}.{ext}", vertices, faces, point_data=data)))
@@ -119,8 +132,9 @@ def _write_files(result: RunResult, folder: Path, stages: Stages) -> None:
         from .viz import write_viewer
 
         with stages.stage("viewer"):
-            result.outputs.append(("viewer", write_viewer(folder / "viewer.html", surface, rest,
-                                                          times, nets, resolution=res)))
+            result.outputs.append(("viewer", write_viewer(
+                folder / "viewer.html", surface, rest, times, nets, resolution=res,
+                title=scenario.title or scenario.name)))
     if "report" in formats:
         with stages.stage("report"):
             result.report = make_report(result)
@@ -128,21 +142,68 @@ def _write_files(result: RunResult, folder: Path, stages: Stages) -> None:
             result.outputs += [("report .json", paths[0]), ("report .md", paths[1])]
 
 
+def peak_frame(result: RunResult) -> int:
+    """Index of the frame with the largest displacement ``max |B_u (P_f - P_rest) B_vᵀ|``
+    on the output grid (the first such frame)."""
+    from .export import tessellate_frames
+
+    surface = result.built.surface
+    D = result.nets - surface.control_points
+    X, _ = tessellate_frames(surface, D, result.scenario.output.resolution)
+    return int(np.argmax(np.linalg.norm(X, axis=-1).max(axis=-1)))
+
+
+#: samples of the probe curves when the solution is known at every time
+DENSE_PROBE_SAMPLES = 600
+
+
+def dense_probes(result: RunResult, samples: int = DENSE_PROBE_SAMPLES
+                 ) -> tuple[Any, dict[str, Any]] | None:
+    """Probe displacements at ``samples`` times over ``[0, t_end]``, for a solution that is
+    exact between frames (the analytic solver); None otherwise.
+
+    Evaluated in chunks of times so that ``chunk × n_u n_v ≤ 4·10⁶`` entries. Each time
+    costs up to ``n_free²`` operations (all modes), so fewer samples are taken for large
+    nets (at most ``3·10⁹`` operations in all), and none when that is not more than the
+    frames.
+    """
+    solution = result.solution
+    if result.scenario.solve.kind != "dynamic" or \
+            not getattr(solution, "exact_between_frames", False):
+        return None
+    samples = min(samples, int(3e9 / max(result.n_free, 1) ** 2))
+    if samples <= len(result.times):
+        return None
+    t = np.union1d(np.linspace(0.0, float(result.scenario.solve.t_end), samples), result.times)
+    n_u, n_v = result.built.surface.shape
+    chunk = max(1, 4_000_000 // (n_u * n_v * 3))
+    out: dict[str, Any] = {}
+    for name, (u, v) in result.probe_points.items():
+        out[name] = np.concatenate([solution.displacement(t[i:i + chunk], u, v)
+                                    for i in range(0, t.size, chunk)])
+    if not all(np.all(np.isfinite(d)) for d in out.values()):
+        return None
+    return t, out
+
+
 def _write_images(result: RunResult, folder: Path, stages: Stages) -> None:
+    """surfaces.png (rest shape and the frame of largest displacement), probes.png, modes.png."""
     from . import viz
 
     surface, rest = result.built.surface, result.rest_net
     kind = result.scenario.solve.kind
     with stages.stage("images"):
         label = {"dynamic": "t", "static": "load factor", "modes": "phase"}[kind]
-        last = result.nets[-1] if kind != "modes" else result.nets[len(result.nets) // 4]
-        last_t = result.times[-1] if kind != "modes" else result.times[len(result.times) // 4]
+        peak = peak_frame(result)
         result.outputs.append(("picture", viz.render_surfaces(
-            folder / "surfaces.png", surface, rest, [result.nets[0], last],
-            [f"initial ({label} = {result.times[0]:g})", f"{label} = {last_t:.4g}"])))
+            folder / "surfaces.png", surface, rest, [result.nets[0], result.nets[peak]],
+            [f"initial ({label} = {result.times[0]:g})",
+             f"largest displacement ({label} = {result.times[peak]:.4g})"])))
         if kind == "dynamic":
+            dense = dense_probes(result)
             result.outputs.append(("probe plot", viz.plot_probes(
-                folder / "probes.png", result.times, result.probes)))
+                folder / "probes.png", result.times, result.probes,
+                *(dense if dense is not None else (None, None)))))
         if result.omegas is not None:
             result.outputs.append(("mode shapes", viz.plot_modes(
                 folder / "modes.png", surface, result.omegas, result.mode_shapes)))
@@ -161,8 +222,6 @@ def _write_animation(result: RunResult, path: Path, stages: Stages) -> None:
 
 def make_report(result: RunResult) -> dict[str, Any]:
     """The content of ``report.json`` / ``report.md``: inputs, solver, timings, energies, probes."""
-    import numpy as np
-
     s, surface = result.scenario, result.built.surface
     report: dict[str, Any] = {
         "inputs": {"source": s.source, **tomllib.loads(scenario_to_toml(s))},

@@ -4,7 +4,8 @@ Every file is written atomically (:mod:`.atomic`): the content goes to a tempora
 in the target folder, which then replaces the target with :func:`os.replace`.
 
 * :mod:`.frames` — validation of frames, ``X = B_u P B_vᵀ`` for many nets at once;
-* :mod:`.mesh` — triangle meshes (.obj, .stl, .ply, .vtu, .vtk) through meshio;
+* :mod:`.mesh` — triangle meshes (.obj with normals, .stl, .ply, .vtu, .vtk);
+* :mod:`.weld` — welded meshes of closed and degenerate surfaces, vertex normals;
 * :mod:`.series` — ParaView ``.pvd`` + ``.vtu`` time series;
 * :mod:`.nets` — control nets as JSON / NPZ with their full knot vectors;
 * :mod:`.report` — ``report.json`` and ``report.md``;
@@ -13,7 +14,7 @@ in the target folder, which then replaces the target with :func:`os.replace`.
 
 from .atomic import atomic_path, write_text, write_with
 from .frames import check_frames, check_net, tessellate_frames
-from .mesh import MESH_FORMATS, write_mesh
+from .mesh import MESH_FORMATS, write_mesh, write_obj
 from .nets import (CONTROL_NET_FORMAT, CONTROL_NET_FORMATS, CONTROL_NET_VERSION, CONVENTION,
                    control_net_document, coefficient_index, read_control_net,
                    write_control_nets)
@@ -21,6 +22,7 @@ from .run_folder import (MANIFEST_FORMAT, FolderClaim, claim_folder, file_digest
                          manifest_name, read_manifest)
 from .report import (REPORT_TABLE_ROWS, format_value, plain, report_markdown, section_markdown,
                      write_report)
+from .weld import WELD_TOLERANCE, vertex_normals, weld
 from .series import frame_file_names, pvd_text, write_time_series
 
 __all__ = ["FolderClaim", "MANIFEST_FORMAT", "claim_folder", "file_digest", "manifest_name",
@@ -29,4 +31,4 @@ __all__ = ["FolderClaim", "MANIFEST_FORMAT", "claim_folder", "file_digest", "man
            "atomic_path", "check_frames", "check_net", "format_value", "frame_file_names", "plain", "pvd_text",
            "read_control_net", "report_markdown", "section_markdown", "tessellate_frames",
            "write_control_nets", "write_mesh", "write_report", "write_text", "write_time_series",
-           "write_with"]
+           "write_with", "write_obj", "weld", "vertex_normals", "WELD_TOLERANCE"]

@@ -1,6 +1,7 @@
-"""Triangle meshes for other programs (.obj, .stl, .ply, .vtu, .vtk) through meshio.
+"""Triangle meshes for other programs (.obj, .stl, .ply, .vtu, .vtk).
 
-meshio is imported lazily (it is part of the ``tool`` extra).
+OBJ is written here (with vertex normals, which meshio's writer does not reference from
+the faces); the others through meshio, imported lazily (it is part of the ``tool`` extra).
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 from .atomic import write_with
+from .weld import vertex_normals
 
 MESH_FORMATS: tuple[str, ...] = (".obj", ".stl", ".ply", ".vtu", ".vtk")
 _MESHIO_OPTIONS: dict[str, dict[str, Any]] = {
@@ -64,6 +66,30 @@ def _ply_point_data(point_data: dict[str, NDArray[np.float64]]) -> dict[str, NDA
     return out
 
 
+def write_obj(path: str | os.PathLike[str], vertices: ArrayLike, faces: ArrayLike,
+              normals: ArrayLike | None = None) -> Path:
+    """Wavefront OBJ with vertex normals: ``v x y z``, ``vn nx ny nz``, ``f a//a b//b c//c``.
+
+    Coordinates are written with 17 significant digits (they read back exactly).
+    ``normals`` defaults to :func:`~splinedeform.export.weld.vertex_normals` (area-weighted
+    face normals); faces keep their orientation, so normals follow ``x_u × x_v``.
+    """
+    V, Fc = _check_mesh(vertices, faces)
+    N = vertex_normals(V, Fc) if normals is None else np.asarray(normals, dtype=float)
+    if N.shape != V.shape or not np.all(np.isfinite(N)):
+        raise InputError(f"normals must be a finite array of shape {V.shape}, got {N.shape}")
+    corners = np.repeat(Fc + 1, 2, axis=1)               # a//a b//b c//c (1-based)
+
+    def save(tmp: Path) -> None:
+        with open(tmp, "w", encoding="ascii") as fh:
+            fh.write("# splinedeform surface mesh: vertices, vertex normals, triangles\n")
+            np.savetxt(fh, V, fmt="v %.17g %.17g %.17g")
+            np.savetxt(fh, N, fmt="vn %.17g %.17g %.17g")
+            np.savetxt(fh, corners, fmt="f %d//%d %d//%d %d//%d")
+
+    return write_with(path, save)
+
+
 def write_mesh(path: str | os.PathLike[str], vertices: ArrayLike, faces: ArrayLike,
                point_data: Mapping[str, ArrayLike] | None = None) -> Path:
     """Write a triangle mesh; the format follows the suffix (.obj, .stl, .ply, .vtu, .vtk).
@@ -76,11 +102,9 @@ def write_mesh(path: str | os.PathLike[str], vertices: ArrayLike, faces: ArrayLi
     faces : array_like of int, shape ``(M, 3)``
     point_data : mapping of name to ``(N,)`` or ``(N, c)`` arrays, optional
         Kept by .vtu/.vtk as is and by .ply as scalar properties (vectors split into
-        ``name_0, name_1, ...``); OBJ and STL cannot hold it and drop it. STL stores
-        float32 coordinates.
+        ``name_0, name_1, ...``); OBJ and STL cannot hold it and drop it. OBJ gets
+        vertex normals (:func:`write_obj`). STL stores float32 coordinates.
     """
-    import meshio
-
     target = Path(path)
     suffix = target.suffix.lower()
     if suffix not in MESH_FORMATS:
@@ -88,7 +112,11 @@ def write_mesh(path: str | os.PathLike[str], vertices: ArrayLike, faces: ArrayLi
                          f"got {target.name!r}")
     V, Fc = _check_mesh(vertices, faces)
     data = _check_point_data(point_data, V.shape[0])
-    if suffix in (".obj", ".stl"):
+    if suffix == ".obj":
+        return write_obj(target, V, Fc)
+    import meshio
+
+    if suffix == ".stl":
         data = {}
     elif suffix == ".ply":
         data = _ply_point_data(data)
@@ -97,4 +125,3 @@ def write_mesh(path: str | os.PathLike[str], vertices: ArrayLike, faces: ArrayLi
     options = _MESHIO_OPTIONS.get(suffix, {})
     return write_with(target, lambda tmp: meshio.write(tmp, mesh, file_format=suffix[1:],
                                                        **options))
-

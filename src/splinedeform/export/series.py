@@ -14,6 +14,7 @@ from ..surface import Surface
 from .atomic import _check_stem, _require_folder, write_text
 from .frames import check_frames, check_net, tessellate_frames
 from .mesh import write_mesh
+from .weld import weld
 
 
 def pvd_text(entries: Sequence[tuple[float, str]]) -> str:
@@ -44,7 +45,8 @@ def write_time_series(directory: str | os.PathLike[str], stem: str, surface: Sur
     * ``displacement_magnitude`` ``= |displacement|``, for colouring.
 
     The points are the same in every frame, so a warp by the field is applied exactly
-    once. The ``.pvd`` is written last and lists every frame with its time. Returns the
+    once. Grid points that coincide at rest and in every frame (a periodic seam, a pole)
+    are one point (:func:`~splinedeform.export.weld.weld`). The ``.pvd`` is written last and lists every frame with its time. Returns the
     ``.pvd`` path.
     """
     folder = _require_folder(directory)
@@ -53,6 +55,8 @@ def write_time_series(directory: str | os.PathLike[str], stem: str, surface: Sur
     rest = check_net(surface, rest_net, "rest net")
     X, faces = tessellate_frames(surface, P, resolution)
     X0, _ = tessellate_frames(surface, rest, resolution)
+    keep, faces = weld(np.concatenate([X0[None], X]), faces)
+    X0, X = X0[keep], X[:, keep]
     names = frame_file_names(stem, t.size)
     for f, name in enumerate(names):
         d = X[f] - X0

@@ -1,0 +1,176 @@
+"""probes.png (displacement histories) and modes.png (mode shapes along the normal)."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import InputError
+from ..surface import Surface, grid_faces
+from .colour import MODE_COLORMAP
+from .figures import PANEL_INCHES, _axes3d, _bounds, _box, _collection, _figure, _save_png
+
+
+def _check_histories(t: NDArray[np.float64], probes: Mapping[str, ArrayLike], what: str
+                     ) -> dict[str, NDArray[np.float64]]:
+    if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)):
+        raise InputError(f"{what} must be a finite 1-D array (F,), got shape {t.shape}")
+    if not isinstance(probes, Mapping) or not probes:
+        raise InputError("probes must be a non-empty mapping of name to (F, 3) displacements")
+    histories = {}
+    for name, values in probes.items():
+        d = np.asarray(values, dtype=float)
+        if d.shape != (t.size, 3) or not np.all(np.isfinite(d)):
+            raise InputError(f"probe {name!r} must be a finite array of shape ({t.size}, 3), "
+                             f"got {d.shape}")
+        histories[str(name)] = d
+    return histories
+
+
+def plot_probes(path: str | os.PathLike[str], times: ArrayLike,
+                probes: Mapping[str, ArrayLike], dense_times: ArrayLike | None = None,
+                dense_probes: Mapping[str, ArrayLike] | None = None) -> Path:
+    """Displacement components ``d_x, d_y, d_z`` and ``|d|`` against time, one panel per probe.
+
+    ``probes`` maps a probe name to its displacement history ``(F, 3)`` at the output
+    frames ``times (F,)``. When the solution is known at every time (the analytic
+    solver), give it sampled densely as ``dense_times (T,)`` and ``dense_probes`` (same
+    names, ``(T, 3)``): the curves are drawn from those and the frames marked as dots on
+    them; otherwise the curves join the frames. The picture is 800 px wide and 250 px
+    high per probe.
+    """
+    t = np.asarray(times, dtype=float)
+    histories = _check_histories(t, probes, "times")
+    curves_t, curves = t, histories
+    if dense_times is not None or dense_probes is not None:
+        curves_t = np.asarray(dense_times, dtype=float)
+        curves = _check_histories(curves_t, dense_probes or {}, "dense_times")
+        if set(curves) != set(histories):
+            raise InputError(f"dense_probes must name the same probes as probes: "
+                             f"{sorted(histories)}, got {sorted(curves)}")
+    fig = _figure(8.0, 2.5 * len(histories))
+    axes = fig.subplots(len(histories), 1, squeeze=False, sharex=True)[:, 0]
+    for ax, (name, d) in zip(axes, histories.items()):
+        c = curves[name]
+        for k, label in enumerate(("$d_x$", "$d_y$", "$d_z$")):
+            line, = ax.plot(curves_t, c[:, k], lw=1.2, label=label)
+            if curves is not histories:
+                ax.plot(t, d[:, k], "o", ms=2.5, color=line.get_color())
+        ax.plot(curves_t, np.linalg.norm(c, axis=1), "k--", lw=1.2, label="$|d|$")
+        ax.set_title(name, fontsize=10)
+        ax.set_ylabel("displacement")
+        ax.grid(alpha=0.3)
+        ax.legend(loc="best", fontsize=8, ncols=2, framealpha=0.8)
+    note = f" (curves: {curves_t.size} samples of the solution; dots: output frames)" \
+        if curves is not histories else ""
+    axes[-1].set_xlabel("time" + note)
+    fig.tight_layout()
+    return _save_png(fig, path)
+
+
+# -- plot_modes ----------------------------------------------------------------------------
+def _unit_normals(surface: Surface, u: NDArray[np.float64], v: NDArray[np.float64]
+                  ) -> NDArray[np.float64]:
+    """``n = x_u × x_v / |x_u × x_v|`` on a grid, never zero.
+
+    Where the surface degenerates (a pole: a parameter line collapses to one point and
+    ``x_u = 0``), ``n`` is taken at parameters nudged ``10⁻⁶ L`` into the domain and
+    averaged over the grid points that share the degenerate point, so a pole has one
+    normal (and a mode drawn along it keeps the pole closed). A point degenerate even
+    there takes the mean normal of the grid.
+    """
+    cross = np.cross(surface.evaluate_grid(u, v, 1, 0), surface.evaluate_grid(u, v, 0, 1))
+    length = np.linalg.norm(cross, axis=-1)
+    scale = float(length.max()) or 1.0
+    bad = length <= 1e-9 * scale
+    if np.any(bad):
+        i, j = np.nonzero(bad)
+        (_, lu), (_, lv) = surface.domain
+        uu = np.clip(u[i], 1e-6 * lu, (1 - 1e-6) * lu)
+        vv = np.clip(v[j], 1e-6 * lv, (1 - 1e-6) * lv)
+        nudged = np.cross(surface.derivative(uu, vv, 1, 0), surface.derivative(uu, vv, 0, 1))
+        nudged /= np.maximum(np.linalg.norm(nudged, axis=-1, keepdims=True), 1e-300)
+        cross[i, j] = _mean_per_point(surface.evaluate(u[i], v[j]), nudged)
+        length = np.linalg.norm(cross, axis=-1)
+        bad = length <= 1e-12
+    n = cross / np.where(bad, 1.0, length)[..., None]
+    if np.any(bad):
+        mean = n[~bad].sum(axis=0) if np.any(~bad) else np.zeros(3)
+        size = np.linalg.norm(mean)
+        n[bad] = mean / size if size > 0 else np.array([0.0, 0.0, 1.0])
+    return n
+
+
+def _mean_per_point(x: NDArray[np.float64], n: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Mean of the vectors ``n`` over the points ``x`` that coincide (to 1e-9 of the size)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    size = float(np.ptp(x, axis=0).max()) if len(x) > 1 else 0.0
+    pairs = cKDTree(x).query_pairs(1e-9 * max(size, 1.0), output_type="ndarray")
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])),
+                       shape=(len(x), len(x)))
+    _, label = connected_components(graph, directed=False)
+    total = np.zeros((label.max() + 1, 3))
+    np.add.at(total, label, n)
+    return total[label]
+
+
+def mode_geometry(surface: Surface, shape: ArrayLike, resolution: int = 40, scale: float = 0.2
+                  ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+    """The surface displaced along its normal by a scalar mode field, for drawing.
+
+    ``φ(u,v) = Σ_kl φ_kl b_k(u) b_l(v)`` and ``y = x + s φ n`` with
+    ``s = scale · diameter / max|φ|``. Returns vertices ``(N, 3)``, ``φ`` at the vertices
+    ``(N,)`` and faces.
+    """
+    phi_net = np.asarray(shape, dtype=float)
+    u, v = surface.sample_parameters(resolution)
+    phi = surface.evaluate_grid(u, v, control_points=phi_net[..., None])[..., 0]
+    x = surface.evaluate_grid(u, v)
+    _, half = _bounds(x)
+    peak = float(np.abs(phi).max())
+    s = scale * 2 * half / peak if peak > 0 else 0.0
+    y = x + s * phi[..., None] * _unit_normals(surface, u, v)
+    return y.reshape(-1, 3), phi.ravel(), grid_faces(u.size, v.size)
+
+
+def plot_modes(path: str | os.PathLike[str], surface: Surface, omegas: ArrayLike,
+               shapes: ArrayLike, resolution: int = 40) -> Path:
+    """modes.png: mode ``i`` drawn as ``x + s φ_i n`` (see :func:`mode_geometry`).
+
+    Coloured by ``φ_i`` on a symmetric diverging scale; the panel title gives ``ω_i``.
+    Up to three panels per row, 400 × 400 px each.
+    """
+    w = np.asarray(omegas, dtype=float)
+    phis = np.asarray(shapes, dtype=float)
+    if not isinstance(surface, Surface):
+        raise InputError(f"surface must be a splinedeform.Surface, got {type(surface).__name__}")
+    if w.ndim != 1 or w.size == 0 or phis.shape != (w.size, *surface.shape):
+        raise InputError(f"omegas must be (k,) and shapes (k, n_u, n_v) = "
+                         f"(k, {surface.shape[0]}, {surface.shape[1]}); got {w.shape} and "
+                         f"{phis.shape}")
+    if not (np.all(np.isfinite(w)) and np.all(np.isfinite(phis))):
+        raise InputError("omegas and mode shapes must be finite")
+    import matplotlib
+
+    cols = min(w.size, 3)
+    rows = -(-w.size // cols)
+    fig = _figure(PANEL_INCHES * cols, PANEL_INCHES * rows)
+    cmap = matplotlib.colormaps[MODE_COLORMAP]
+    for i in range(w.size):
+        y, phi, faces = mode_geometry(surface, phis[i], resolution)
+        peak = float(np.abs(phi).max()) or 1.0
+        rgba = np.asarray(cmap(0.5 + 0.5 * phi[faces].mean(axis=1) / peak))
+        ax = _axes3d(fig, (rows, cols, i + 1))
+        ax.add_collection3d(_collection(y, faces, rgba))
+        _box(ax, y, zoom=1.3)
+        ax.set_axis_off()
+        ax.set_title(f"mode {i + 1}: ω = {w[i]:.5g}", fontsize=11)
+    return _save_png(fig, path)
+
