@@ -156,7 +156,9 @@ def read_cad(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
                          f"{', '.join(CAD_SUFFIXES)}), got suffix {path.suffix or 'none'!r}")
     if kind == "openNURBS":
         return read_3dm(path, face)
-    raise InputError(f"{path}: {kind} files are not read yet; convert the surface to .3dm")
+    from .cad_step import read_step   # STEP and IGES: OpenCASCADE, the 'cad-step' extra
+
+    return read_step(path, face)
 
 
 def _rhino3dm():

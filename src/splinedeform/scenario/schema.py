@@ -143,7 +143,7 @@ class FromFile(_Fitted):
         description=(
             "`.json` / `.npz` control net written by `splinedeform` (`output.formats` "
             "`json`/`npz`), or a point grid `(N_u, N_v, 3)` in `.npy` (or `.npz` with one array "
-            "or an array `points`); for `cad` an openNURBS `.3dm` file; relative to the "
+            "or an array `points`); for `cad` a `.3dm`, STEP or IGES file; relative to the "
             "scenario file, and inside its folder (see below)"),
         json_schema_extra={"doc_default": "required for `file` and `cad`"})
     frame: Integer = Field(-1, description=(
@@ -154,8 +154,9 @@ class FromCad(_Table):
     shape: Literal["cad"]
     path: Text = Field(
         description=(
-            "CAD file holding NURBS surfaces: openNURBS `.3dm` (the `cad` extra); relative to "
-            "the scenario file, and inside its folder (as for `file`)"),
+            "CAD file holding NURBS surfaces: openNURBS `.3dm` (the `cad` extra), STEP "
+            "`.stp`/`.step` or IGES `.igs`/`.iges` (the `cad-step` extra); relative to the "
+            "scenario file, and inside its folder (as for `file`)"),
         json_schema_extra={"doc_default": "required for `cad`"})
     face: Annotated[int, Strict(), Field(ge=0)] = Field(0, description=(
             "which surface of the file, counting plain surfaces and Brep faces in file "
