@@ -1,8 +1,9 @@
 """Mutated scenarios run end to end: a result or a located ScenarioError, nothing else.
 
 Each example starts from a tiny valid scenario (a 2-cell plane, three frames), applies one
-to four mutations drawn from every key of every table (plausible values, extremes such as
-1e308, 1e-320, inf and NaN, wrong types, unknown and missing keys) and runs it through
+to four mutations drawn from every key of every table (mostly values real scenarios use, so
+that many mutants run, besides extremes such as 1e308, 1e-320, inf and NaN, wrong types,
+unknown and missing keys) and runs it through
 :func:`splinedeform.pipeline.run` into a temporary folder with a small budget. The run must
 either finish or raise a :class:`ScenarioError` whose message starts with ``case.toml:``;
 any other exception is a bug.
@@ -92,6 +93,35 @@ VALUES = {
     "output.time": NUMBER,
 }
 PATHS = sorted(VALUES)
+#: values each key takes in real scenarios, so that many mutants get past reading and run
+PLAUSIBLE = {
+    "surface.shape": st.sampled_from(["plane", "saddle", "tile", "half_sphere", "cylinder",
+                                      "torus"]),
+    "surface.cells": st.integers(1, 5), "surface.degree": st.integers(1, 3),
+    "surface.knots": st.sampled_from(["open", "uniform", "periodic"]),
+    "surface.method": st.sampled_from(["interpolate", "l2", "quasi"]),
+    "material.mass": st.floats(0.1, 10.0), "material.damping": st.floats(0.0, 5.0),
+    "material.rayleigh": st.floats(0.0, 0.1), "material.w10": st.floats(0.0, 5.0),
+    "material.w01": st.floats(0.0, 5.0), "material.w20": st.floats(0.0, 1.0),
+    "material.w11": st.floats(0.0, 1.0), "material.w02": st.floats(0.0, 1.0),
+    "material.mass_matrix": st.sampled_from(["consistent", "lumped"]),
+    "material.physics": st.sampled_from(["parametric", "intrinsic"]),
+    "boundary.u0": st.sampled_from(["free", "pinned", "clamped"]),
+    "boundary.u1": st.sampled_from(["free", "pinned", "clamped"]),
+    "boundary.v0": st.sampled_from(["free", "pinned", "clamped"]),
+    "boundary.v1": st.sampled_from(["free", "pinned", "clamped"]),
+    "load.profile": st.sampled_from(["constant", "step"]),
+    "load.t_on": st.floats(0.0, 1.0), "load.force": st.lists(st.floats(-2.0, 2.0), min_size=3,
+                                                             max_size=3),
+    "solve.kind": st.sampled_from(["static", "dynamic", "modes"]),
+    "solve.method": st.sampled_from(["analytic", "newmark", "genalpha", "radau3", "rk45",
+                                     "dop853", "radau", "bdf"]),
+    "solve.t_end": st.floats(0.01, 3.0), "solve.frames": st.integers(1, 6),
+    "solve.modes": st.integers(0, 6),
+    "output.formats": st.lists(st.sampled_from(["report", "json", "npz", "obj", "stl", "ply",
+                                                "vtu", "viewer"]), max_size=3, unique=True),
+    "output.resolution": st.integers(2, 8),
+}
 
 
 @st.composite
@@ -100,8 +130,12 @@ def mutations(draw) -> list[tuple[str, str, object]]:
     edits = []
     for _ in range(draw(st.integers(1, 4))):
         path = draw(st.sampled_from(PATHS))
-        action = draw(st.sampled_from(["set", "set", "set", "wrong", "delete", "unknown"]))
-        value = draw(WRONG) if action == "wrong" else draw(VALUES[path])
+        action = draw(st.sampled_from(["plausible"] * 6 + ["set"] * 3
+                                      + ["wrong", "delete", "unknown"]))
+        if action == "plausible" and path in PLAUSIBLE:
+            value = draw(PLAUSIBLE[path])
+        else:
+            value = draw(WRONG) if action == "wrong" else draw(VALUES[path])
         edits.append((action, path, value))
     return edits
 
