@@ -1,23 +1,32 @@
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
-STAMP  := $(VENV)/.installed
+
+# make demo installs what the demo needs (extra: tool); make test what the suite needs.
+DEMO_EXTRAS := tool
+TEST_EXTRAS := tool,video,cad,test
 
 .PHONY: demo test bench clean
 
-$(STAMP): pyproject.toml
+$(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[tool,video,cad,sculpt,test]'
-	touch $(STAMP)
 
-demo: $(STAMP)
+$(VENV)/.installed-demo: pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e '.[$(DEMO_EXTRAS)]'
+	touch $@
+
+$(VENV)/.installed: pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e '.[$(TEST_EXTRAS)]'
+	touch $@
+
+demo: $(VENV)/.installed-demo
 	$(BIN)/splinedeform demo -o out/demo
 
-test: $(STAMP)
+test: $(VENV)/.installed
 	$(BIN)/python -m pytest -q
 
-bench: $(STAMP)
+bench: $(VENV)/.installed
 	$(BIN)/python benchmarks/run.py
 
 clean:
