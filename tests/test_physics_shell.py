@@ -3,7 +3,7 @@
 Closed forms: Timoshenko's clamped square plate under uniform load (centre deflection
 0.00126532 q a⁴/D) and the simply supported plate's frequencies π²(m² + n²)√(D/ρt).
 Obstacle course (converged Kirchhoff–Love values): Scordelis–Lo roof 0.3006, pinched
-hemisphere with an 18° hole 0.0924.
+hemisphere 0.0924 without hole and 0.0936 with the 18° hole (see docs/physics.md).
 """
 
 from math import pi
@@ -48,25 +48,38 @@ def test_scordelis_lo_roof():
     assert abs(d[1]) < 1e-10       # midspan is a symmetry plane (round-off scale)
 
 
-def pinched_hemisphere(cells):
-    """Quarter of the hemisphere with an 18° hole, symmetry edges, half loads on them."""
+def pinched_hemisphere(cells, top=72.0):
+    """Quarter of the hemisphere (hole from latitude ``top`` up; 90: closed), symmetry
+    edges, loads of 1 on them (half of each load 2 of the full hemisphere)."""
     def f(u, v):
         return 10.0 * np.stack([np.cos(v) * np.cos(u), np.cos(v) * np.sin(u), np.sin(v)], -1)
-    quarter = sd.shapes.from_function(f, cells=cells, domain=((0, pi / 2), (0, 72 * pi / 180)))
+    quarter = sd.shapes.from_function(f, cells=cells, domain=((0, pi / 2), (0, top * pi / 180)))
     model = ShellModel(quarter, ShellMaterial(6.825e7, 0.3, 0.04),
                        {"u0": "symmetry", "u1": "symmetry"})
     load = sd.loads.Point(0.0, 0.0, (1.0, 0, 0)) + sd.loads.Point(pi / 2, 0.0, (0, -1.0, 0))
     return quarter, model.static(load).displacement(0.0, 0.0)[0]
 
 
-def test_pinched_hemisphere_converges_near_the_reference():
+def test_pinched_hemisphere_with_the_18_degree_hole():
     quarter, w16 = pinched_hemisphere(16)
     assert quarter.fit_error < 1e-5
     _, w12 = pinched_hemisphere(12)
-    # converged: 12 → 16 cells changes 0.4 % (measured 0.09305, 0.09341; 0.09350 at 24)
+    # converged: 12 → 16 cells changes 0.4 % (measured 0.09305, 0.09341; 0.09351 at 32 cells
+    # and with degrees 4 and 5, docs/physics.md)
     assert abs(w16 - w12) < 0.005 * w16
-    # the converged value lies 1.2 % above the published 0.0924 (see docs/physics.md)
-    assert w16 == pytest.approx(0.0924, rel=0.015)
+    # 0.0924 is the theory of the hemisphere *without* hole (MacNeal and Harder say so of
+    # their reference); with the hole the Kirchhoff–Love value is 0.0936 (Abaqus' eight-node
+    # Kirchhoff–Love element extrapolated, 0.093597); 1 % is the accuracy a user's net must
+    # reach, met here to 0.2 %
+    assert w16 == pytest.approx(0.0936, rel=0.01)
+
+
+def test_pinched_hemisphere_closed_meets_the_theory_0_0924():
+    # the configuration 0.0924 belongs to (Morley and Morris): no hole, a pole at the top
+    # whose control points coincide. Measured 0.09222 at 16 cells, 0.09240 at 32
+    quarter, w = pinched_hemisphere(16, top=90.0)
+    assert quarter.fit_error < 1e-5
+    assert w == pytest.approx(0.0924, rel=0.01)
 
 
 def test_shell_bad_input():
