@@ -164,3 +164,80 @@ def test_the_rest_panel_is_shaded_grey_not_navy(tmp_path, monkeypatch):
     assert grey.sum() > 5000 and navy.sum() < 50
     # shaded: the grey takes many levels, not one flat colour
     assert len(np.unique(r[grey])) > 20
+
+
+def zbuffer_check(surface, nets, elev=28.0, azim=-60.0, step=2):
+    """Rendered pixels against an independent z-buffer of the same projected triangles.
+
+    Returns (matching share, number of checked pixels covered by two or more layers).
+    The projection is matplotlib's own (``ax.M`` after drawing); which triangle is seen
+    at a pixel is decided here by the nearest interpolated depth, not by draw order.
+    Pixels within a quarter of a triangle of its edges are skipped (antialiasing).
+    """
+    from mpl_toolkits.mplot3d import proj3d
+
+    from splinedeform.viz.colour import shade
+    from splinedeform.viz.figures import _face_colors
+    from splinedeform.viz.surfaces import _displaced_meshes, surfaces_figure
+
+    X, mag, faces = _displaced_meshes(surface, surface.control_points, nets, 14)
+    vmax = float(mag.max())
+    fig = surfaces_figure(X, mag, faces, ["rest", "crater"], vmax)
+    ax = fig.axes[1]
+    ax.view_init(elev=elev, azim=azim)
+    fig.canvas.draw()
+    image = np.asarray(fig.canvas.buffer_rgba())[..., :3].astype(float) / 255
+    height = image.shape[0]
+    V = X[1]
+    xs, ys, zs = proj3d.proj_transform(V[:, 0], V[:, 1], V[:, 2], ax.M)
+    screen = ax.transData.transform(np.column_stack([xs, ys]))
+    tri = screen[faces]                                   # (M, 3, 2) display pixels
+    depth = np.asarray(zs)[faces]                         # (M, 3)
+    normals = np.cross(V[faces[:, 1]] - V[faces[:, 0]], V[faces[:, 2]] - V[faces[:, 0]])
+    colour = shade(_face_colors(mag[1], faces, vmax), normals)[:, :3]
+    box = ax.bbox
+    px, py = np.meshgrid(np.arange(box.x0 + 5, box.x1 - 5, step),
+                         np.arange(box.y0 + 5, box.y1 - 5, step))
+    points = np.column_stack([px.ravel(), py.ravel()]) + 0.5
+    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
+    det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
+    ok, total, layered = 0, 0, 0
+    for chunk in np.array_split(points, max(1, len(points) // 500)):
+        dx = chunk[:, None, 0] - a[None, :, 0]
+        dy = chunk[:, None, 1] - a[None, :, 1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            l1 = (dx * (c[:, 1] - a[:, 1]) - dy * (c[:, 0] - a[:, 0])) / det
+            l2 = (dy * (b[:, 0] - a[:, 0]) - dx * (b[:, 1] - a[:, 1])) / det
+        l0 = 1 - l1 - l2
+        inside = (l0 >= 0) & (l1 >= 0) & (l2 >= 0) & (np.abs(det) > 1e-9)
+        z = l0 * depth[:, 0] + l1 * depth[:, 1] + l2 * depth[:, 2]
+        z = np.where(inside, z, np.inf)
+        seen = np.argmin(z, axis=1)
+        rows = np.arange(len(chunk))
+        covered = np.isfinite(z[rows, seen])
+        margin = np.minimum(np.minimum(l0, l1), l2)[rows, seen]
+        for k in np.nonzero(covered & (margin > 0.25))[0]:
+            x, y = chunk[k]
+            pixel = image[height - 1 - int(y), int(x)]
+            total += 1
+            ok += np.max(np.abs(pixel - colour[seen[k]])) < 0.12
+            layered += np.sum(np.isfinite(z[k])) >= 2 and \
+                np.sort(z[k])[1] - z[k, seen[k]] > 1e-3
+    return ok / max(total, 1), layered, total
+
+
+@pytest.mark.parametrize("elev", [28.0, 12.0])
+def test_a_crater_is_drawn_in_depth_order(elev, monkeypatch):
+    """A deep crater in a plate, seen from 28° (the pictures' view) and from a grazing 12°
+    where the near rim hides part of it: what is drawn at each pixel is the nearest surface
+    (an independent z-buffer of matplotlib's own projection), for ≥ 97% of the pixels
+    checked; among them dozens (28°) to over a hundred (12°) lie where the surface covers
+    itself."""
+    surface = shapes.plane(cells=(8, 8))
+    P = surface.control_points
+    deep = P.copy()
+    deep[..., 2] -= 0.45 * np.sin(np.pi * P[..., 0]) ** 2 * np.sin(np.pi * P[..., 1]) ** 2
+    share, layered, total = zbuffer_check(surface, [P, deep], elev=elev)
+    # measured: 99.4% (28°) and 99.1% (12°); drawn near-to-far it would be 91% and 58%
+    assert total > 300 and layered > 40
+    assert share >= 0.97

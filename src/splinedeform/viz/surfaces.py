@@ -73,12 +73,15 @@ def _render_pyvista(path: Path, X: NDArray[np.float64], mag: NDArray[np.float64]
         plotter.close()
 
 
-def _render_matplotlib(path: Path, X: NDArray[np.float64], mag: NDArray[np.float64],
-                       faces: NDArray[np.int64], titles: Sequence[str], vmax: float) -> Path:
-    """One 3-D axes per panel; each surface is one collection of triangles depth-sorted
-    by matplotlib (painter's order of the projected centroids), shaded by
+def surfaces_figure(X: NDArray[np.float64], mag: NDArray[np.float64],
+                    faces: NDArray[np.int64], titles: Sequence[str], vmax: float) -> Any:
+    """The matplotlib Figure of :func:`render_surfaces` (one 3-D axes per panel).
+
+    Each surface is one collection of triangles, drawn far to near in the order of the
+    depth of their projected centroids (painter's order), shaded by
     :func:`~splinedeform.viz.colour.shade`. A panel without displacement (the rest shape)
-    is drawn in a neutral grey, so its shading shows the shape rather than a flat navy."""
+    is drawn in a neutral grey, so its shading shows the shape rather than a flat navy.
+    """
     n = X.shape[0]
     width = PANEL_INCHES * n + COLORBAR_INCHES
     fig = _figure(width, PANEL_INCHES)
@@ -92,7 +95,12 @@ def _render_matplotlib(path: Path, X: NDArray[np.float64], mag: NDArray[np.float
         _axis_labels(ax)
         ax.set_title(titles[i], fontsize=10)
     _colorbar(fig, [(n * PANEL_INCHES + 0.45) / width, 0.12, 0.18 / width, 0.72], vmax)
-    return _save_png(fig, path)
+    return fig
+
+
+def _render_matplotlib(path: Path, X: NDArray[np.float64], mag: NDArray[np.float64],
+                       faces: NDArray[np.int64], titles: Sequence[str], vmax: float) -> Path:
+    return _save_png(surfaces_figure(X, mag, faces, titles, vmax), path)
 
 
 def render_surfaces(path: str | os.PathLike[str], surface: Surface, rest_net: ArrayLike,
