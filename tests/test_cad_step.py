@@ -122,3 +122,31 @@ def test_a_scenario_reads_a_step_face(tmp_path):
     u, v = np.meshgrid(np.linspace(0, 1, 30), np.linspace(0, 1, 4), indexing="ij")
     x = surface.evaluate(u, v)
     assert np.abs(np.hypot(x[..., 0], x[..., 1]) - 1).max() <= TOLERANCE[".step"]
+
+
+@pytest.mark.parametrize("fmt, suffix", [("step", ".step"), ("iges", ".igs")])
+def test_scenario_exports_every_frame_as_step_or_iges(tmp_path, fmt, suffix):
+    from splinedeform.pipeline import run
+    from splinedeform.scenario import load_scenario
+
+    from splinedeform.cad import refine
+
+    write_step(tmp_path / "roof.step", [refine(quarter_cylinder(), 4)])
+    (tmp_path / "case.toml").write_text(
+        '[surface]\nshape = "cad"\npath = "roof.step"\n[material]\nw10 = 1.0\nw01 = 1.0\n'
+        '[boundary]\nv0 = "clamped"\n[[load]]\nkind = "pressure"\nq = 1.0\n'
+        f'[solve]\nkind = "static"\nframes = 3\n[output]\nformats = ["{fmt}"]\n')
+    result = run(load_scenario(tmp_path / "case.toml"), tmp_path / "out")
+    path = tmp_path / "out" / f"case{suffix}"
+    assert (f"NURBS surfaces {suffix}", path) in result.outputs
+    surface = result.built.surface
+    u = np.linspace(0, surface.basis_u.length, 50)
+    v = np.linspace(0, surface.basis_v.length, 50)
+    nets = [surface.control_points, *result.nets]
+    scale = np.abs(np.asarray(nets)).max()
+    for face, net in enumerate(nets):
+        theirs = _occt_surface(path, face)
+        got = np.array([[[(q := theirs.Value(a, b)).X(), q.Y(), q.Z()] for b in v] for a in u])
+        ours = surface.evaluate_grid(u, v, control_points=net)
+        assert np.abs(got - ours).max() <= TOLERANCE[suffix] * scale
+    assert np.abs(nets[-1] - nets[0]).max() > 1e-3                    # it did move

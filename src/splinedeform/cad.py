@@ -202,13 +202,13 @@ def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch],
     return path
 
 
-def write_frames_3dm(path: str | os.PathLike, surface: Surface, times: NDArray[np.float64],
-                     nets: NDArray[np.float64], label: str = "t") -> Path:
-    """The initial surface and every frame as NURBS surfaces in one ``.3dm`` file.
+def frame_patches(surface: Surface, times: NDArray[np.float64], nets: NDArray[np.float64],
+                  label: str = "t") -> tuple[list[NurbsPatch], list[str]]:
+    """The initial surface and every frame as NURBS patches, with their names.
 
-    Object 0, named ``initial``, is ``surface``; object ``k + 1``, named
+    Patch 0, named ``initial``, is ``surface``; patch ``k + 1``, named
     ``frame k: <label> = <times[k]>``, has the net ``nets[k]`` on the same degrees, knots
-    and weights (see :func:`patch_from_surface`). Written atomically.
+    and weights (see :func:`patch_from_surface`).
     """
     nets = np.asarray(nets, dtype=float)
     times = np.asarray(times, dtype=float).ravel()
@@ -217,7 +217,14 @@ def write_frames_3dm(path: str | os.PathLike, surface: Surface, times: NDArray[n
                          f"got {nets.shape}")
     patches = [patch_from_surface(surface)] + [patch_from_surface(surface, P) for P in nets]
     names = ["initial"] + [f"frame {k}: {label} = {t:.9g}" for k, t in enumerate(times)]
-    return write_3dm(path, patches, names)
+    return patches, names
+
+
+def write_frames_3dm(path: str | os.PathLike, surface: Surface, times: NDArray[np.float64],
+                     nets: NDArray[np.float64], label: str = "t") -> Path:
+    """The initial surface and every frame as named NURBS surfaces in one ``.3dm`` file
+    (object ``k + 1`` is frame ``k``; see :func:`frame_patches`). Written atomically."""
+    return write_3dm(path, *frame_patches(surface, times, nets, label))
 
 
 def _patch_from_rhino(srf, source: str) -> NurbsPatch:

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from .cad import NurbsPatch
+from .cad import NurbsPatch, frame_patches
 from .errors import InputError
 from .export.atomic import atomic_path
 
@@ -122,6 +122,12 @@ def write_step(path: str | os.PathLike, patches: list[NurbsPatch]) -> Path:
         if not ok:
             raise InputError(f"{path}: OpenCASCADE could not write the file")
     return path
+
+
+def write_frames_step(path: str | os.PathLike, surface: Any, times: Any, nets: Any) -> Path:
+    """The initial surface (face 0) and every frame ``k`` (face ``k + 1``) in one STEP or
+    IGES file, same degrees, knots and weights (see :func:`splinedeform.cad.frame_patches`)."""
+    return write_step(path, frame_patches(surface, times, nets)[0])
 
 
 def _faces(path: Path) -> list[Any]:

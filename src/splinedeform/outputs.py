@@ -36,6 +36,10 @@ def _mesh_net(result: RunResult) -> Any:
     return result.nets[-1]
 
 
+#: STEP / IGES output formats and their file suffixes (the 'cad-step' extra)
+STEP_FILES = {"step": ".step", "iges": ".igs"}
+
+
 def planned_outputs(result: RunResult) -> list[str]:
     """Names of every file :func:`write_outputs` writes for this result, in order."""
     from .export import frame_file_names
@@ -47,6 +51,7 @@ def planned_outputs(result: RunResult) -> list[str]:
         names += [*frame_file_names(name, len(result.times)), f"{name}.pvd"]
     names += [f"{name}_nets.{ext}" for ext in ("json", "npz") if ext in formats]
     names += [f"{name}.3dm"] if "3dm" in formats else []
+    names += [f"{name}{STEP_FILES[ext]}" for ext in STEP_FILES if ext in formats]
     if "images" in formats:
         names.append("surfaces.png")
         if s.solve.kind == "dynamic":
@@ -123,6 +128,13 @@ def _write_files(result: RunResult, folder: Path, stages: Stages) -> None:
                      "modes": "phase"}[scenario.solve.kind]
             result.outputs.append(("NURBS surfaces .3dm", write_frames_3dm(
                 folder / f"{name}.3dm", surface, times, nets, label)))
+    for ext, suffix in STEP_FILES.items():
+        if ext in formats:
+            from .cad_step import write_frames_step
+
+            with stages.stage(f"CAD surfaces {suffix}"):
+                result.outputs.append((f"NURBS surfaces {suffix}", write_frames_step(
+                    folder / f"{name}{suffix}", surface, times, nets)))
     if "images" in formats:
         _write_images(result, folder, stages)
     for ext in ("gif", "mp4"):

@@ -116,6 +116,11 @@ def _prepare_outdir(scenario: Scenario, outdir: str | Path | None) -> Path:
     if "3dm" in scenario.output.formats and importlib.util.find_spec("rhino3dm") is None:
         raise scenario.error("output.formats", "3dm needs the 'cad' extra (rhino3dm): "
                                                "pip install 'splinedeform[cad]'")
+    step = [f for f in ("step", "iges") if f in scenario.output.formats]
+    if step and importlib.util.find_spec("OCP") is None:
+        raise scenario.error("output.formats", f"{step[0]} needs the 'cad-step' extra "
+                                               "(OpenCASCADE): pip install "
+                                               "'splinedeform[cad-step]'")
     if "mp4" in scenario.output.formats:
         from .viz import mp4_available
 

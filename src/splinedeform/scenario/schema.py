@@ -49,7 +49,7 @@ SHELL_EDGES = ("diaphragm", "symmetry")
 SHELL_KEYS = ("E", "nu", "thickness", "density")
 PLATE_KEYS = ("mass", "w10", "w01", "w20", "w11", "w02", "mass_matrix")
 FORMATS = ("obj", "stl", "ply", "vtu", "json", "npz", "report", "images", "gif", "mp4",
-           "viewer", "3dm")
+           "viewer", "3dm", "step", "iges")
 #: shorthand names accepted in ``output.formats``
 FORMAT_ALIASES = {"pvd": ("vtu",), "nets": ("json", "npz"), "animation": ("gif",),
                   "all": ("obj", "stl", "ply", "vtu", "json", "npz", "report", "images", "gif",
