@@ -14,7 +14,8 @@ import re
 from importlib import resources
 from typing import Any, Mapping
 
-from ..viz import _vendor_text, colormap_table, script_json
+from ..viz import colormap_table, script_json
+from ..viz.viewer import _vendor_text
 
 
 def sculpt_page(data: Mapping[str, Any]) -> str:
