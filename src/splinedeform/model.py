@@ -28,7 +28,7 @@ from .material import Material, check_scales
 from .physics import PHYSICS, intrinsic
 from .quadrature import gram_matrix
 from .solution import ModalSolution, StaticSolution
-from .solvers import modal_basis, rigid
+from .solvers import modal_basis, mode_count, rigid
 from .solvers.analytic import ModalResponse
 from .solvers.kronecker_eigen import kronecker_reason
 from .solvers.rigid import UnresolvedSpectrum
@@ -366,6 +366,11 @@ class Model:
             ``Function`` loads, default 400); ``modes`` (keep the lowest k modes) or
             ``omega_max`` (keep ``ω <= omega_max``), both with the exact static part of the
             omitted modes (mode acceleration) and a report in ``solution.truncation``;
+            ``tolerance`` (piecewise-constant loads from rest): the lowest modes, doubled
+            from 32 until an a-priori bound of the omitted modes' dynamic response at
+            ``times`` (default 201 on ``[0, t_end]``) is at most ``tolerance`` of the largest
+            static displacement in the M-norm (:mod:`splinedeform.solvers.mode_count`), the
+            bound reached in ``solution.truncation["bound"]``;
             ``eigensolver`` (``"auto"``, ``"dense"``, ``"separable"``, ``"sparse"``, see
             :func:`splinedeform.solvers.modal_basis.choose`). ``newmark``: ``dt``.
             ``radau3/5/7`` (Radau IIA, order 5/9/13) and ``genalpha``: ``dt`` or
@@ -387,22 +392,33 @@ class Model:
         d0, v0 = self.initial_state(initial_displacement, initial_velocity)
         forcing = numeric.ReducedForcing(self, load)
         if method == "analytic":
+            if options.get("tolerance") is not None:
+                options["times"] = times
             return self._analytic(forcing, t_end, d0, v0, **options)
         return numeric.integrate(self, forcing, method, t_end, times, d0, v0, **options)
 
     def _analytic(self, forcing: Any, t_end: float, d0: Array, v0: Array,
                   function_samples: int = 400, modes: int | None = None,
-                  omega_max: float | None = None, eigensolver: str = "auto") -> ModalSolution:
-        """Closed-form modal solution; ``modes``/``omega_max`` truncate with mode acceleration."""
+                  omega_max: float | None = None, eigensolver: str = "auto",
+                  tolerance: float | None = None, times: ArrayLike | None = None
+                  ) -> ModalSolution:
+        """Closed-form modal solution; ``modes``/``omega_max`` truncate with mode acceleration,
+        ``tolerance`` chooses the number of modes (:mod:`~splinedeform.solvers.mode_count`)."""
         modes, omega_max = self._truncation_request(modes, omega_max)
+        # the reduced force terms in space: modal terms of the identity basis
+        spatial = forcing.modal_terms(sp.identity(self.n_free, format="csr"), t_end,
+                                      function_samples)
+        report: dict[str, Any] = {}
+        if tolerance is not None:
+            report = self._automatic_modes(spatial, d0, v0, t_end, tolerance, times,
+                                           modes, omega_max)
+            if report["modes"] < self.n_free:
+                modes, eigensolver = report["modes"], "sparse"
         basis = self.modal_basis(eigensolver, modes, omega_max)
         start = time.perf_counter()
         M = self._M
         lam = basis.lam
         c = self.material.damping / self.material.mass + self.material.rayleigh * lam
-        # the reduced force terms in space: modal terms of the identity basis
-        spatial = forcing.modal_terms(sp.identity(self.n_free, format="csr"), t_end,
-                                      function_samples)
         jumps = [(t_j, basis.project(F)) for t_j, F in spatial[0]]
         harmonics = [(w, phase, basis.project(F)) for w, phase, F in spatial[1]]
         response = ModalResponse(lam, c, basis.project(M @ d0), basis.project(M @ v0),
@@ -410,10 +426,38 @@ class Model:
         correction, truncation = None, {}
         if not basis.complete:
             correction, truncation = self._truncation(basis, spatial, d0, v0)
+        if report:
+            truncation.update(tolerance=report["tolerance"], bound=report["bound"])
         timings = dict(self.timings)
         timings["modal setup"] = time.perf_counter() - start
         return ModalSolution(self, t_end, forcing, timings, basis, response, truncation,
                              correction)
+
+    def _automatic_modes(self, spatial: tuple[list, list], d0: Array, v0: Array, t_end: float,
+                         tolerance: Any, times: ArrayLike | None, modes: int | None,
+                         omega_max: float | None) -> dict[str, Any]:
+        """Lowest modes meeting ``tolerance`` (relative M-norm at ``times``): the report of
+        :func:`~splinedeform.solvers.mode_count.automatic_basis` (``modes = n_free``: all)."""
+        try:
+            tolerance = float(tolerance)
+        except (TypeError, ValueError):
+            raise InputError(f"tolerance must be a number, got {tolerance!r}") from None
+        if not 0 < tolerance < 1:
+            raise InputError(f"tolerance must be in (0, 1), got {tolerance}")
+        if modes is not None or omega_max is not None:
+            raise InputError("give tolerance= or modes=/omega_max=, not both")
+        if spatial[1] or np.any(d0) or np.any(v0) or self.rigid_modes != 0:
+            raise InputError("tolerance= chooses the modes for piecewise-constant loads from "
+                             "rest on a model without rigid modes; give modes=k otherwise")
+        at = np.linspace(0.0, t_end, 201) if times is None else np.asarray(times, dtype=float)
+        m = self.material
+        basis, correction, report = mode_count.automatic_basis(
+            self._K, self._M, spatial[0], m.damping / m.mass, m.rayleigh, at, tolerance)
+        if basis is None:
+            report["modes"] = self.n_free
+        else:
+            self._bases[("sparse", report["modes"], None)] = basis
+        return report
 
     def _truncation_request(self, modes: int | None, omega_max: float | None
                             ) -> tuple[int | None, float | None]:

@@ -1,0 +1,116 @@
+"""How many modes a requested accuracy needs: an a-priori bound on the omitted modes.
+
+With the lowest ``k`` modes and the exact static part of the rest (mode acceleration), a
+piecewise-constant load ``F(t) = Σ_j ΔF_j H(t - t_j)`` from rest leaves the error
+
+.. math:: e(t) = -Σ_j H(t - t_j) Σ_{i > k} φ_i \\frac{g_{ij}}{λ_i} P_{11}(λ_i, τ_j),
+          \\quad τ_j = t - t_j,
+
+(each omitted mode's step response is ``g/λ (1 - P_11)``, the correction ``g/λ``). Since
+``Σ_{i>k} (g_ij/λ_i)² = ‖R_j‖²_M`` with ``R_j = K⁻¹ΔF_j − Φ Λ⁻¹ Φᵀ ΔF_j`` (the static part the
+correction adds, computed exactly),
+
+.. math:: ‖e(t)‖_M ≤ Σ_j ‖R_j‖_M \\, E(t - t_j),
+          \\quad E(τ) = \\sup_{λ ≥ λ_{k+1}} |P_{11}(λ, c(λ), τ)|,
+
+with ``c(λ) = γ/μ + βλ``. ``|P_11|`` is the free response from a unit displacement, so it is
+at most 1 (its energy decays) and, with ``a = c/2``:
+
+* under-damped (``ω_d² = λ − a² > 0``): ``|P_11| ≤ e^{−aτ}(1 + a·min(τ, 1/ω_d))``;
+* critically or over-damped (``κ = √(a² − λ)``, slow rate ``r = a − κ = λ/(a + κ)``):
+  ``P_11 ≤ e^{−rτ} min((a + κ)/(2κ), 1 + aτ)``.
+
+``E`` is the largest of these on a grid of :data:`GRID` values of ``λ`` over
+:data:`DECADES` decades from ``λ_{k+1}`` (the bounds vary smoothly in ``log λ``). The number
+of modes is doubled until ``max_t Σ_j ‖R_j‖_M E(t − t_j) ≤ tol · max_t ‖K⁻¹F(t)‖_M`` at the
+requested times: what it costs is set by the load's jumps and the damping, not by the net.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+Array = NDArray[np.float64]
+GRID = 3000
+DECADES = 12.0
+
+
+def decay_bound(lam: Array, c: Array, tau: Array) -> Array:
+    """Upper bound of ``|P_11(λ, c, τ)|`` (see the module docstring), broadcast."""
+    lam, c, tau = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (lam, c, tau)))
+    a = 0.5 * c
+    d = a * a - lam
+    out = np.ones(lam.shape)
+    under = d < 0
+    wd = np.sqrt(np.where(under, -d, 1.0))
+    b_under = np.exp(-a * tau) * (1.0 + a * np.minimum(tau, 1.0 / wd))
+    kappa = np.sqrt(np.where(under, 0.0, d))
+    rate = lam / np.maximum(a + kappa, 1e-300)
+    ratio = np.where(kappa > 0, (a + kappa) / (2.0 * np.where(kappa > 0, kappa, 1.0)), np.inf)
+    b_over = np.exp(-rate * tau) * np.minimum(ratio, 1.0 + a * tau)
+    out = np.minimum(out, np.where(under, b_under, b_over))
+    return np.where(tau > 0, out, 1.0)
+
+
+def omitted_envelope(lam_first: float, gamma: float, beta: float, tau: Array) -> Array:
+    """``E(τ) = sup_{λ ≥ λ_first} |P_11|`` for modal damping ``c = γ + βλ``, on a log grid."""
+    tau = np.asarray(tau, dtype=float)
+    if not np.isfinite(lam_first):
+        return np.zeros_like(tau)
+    grid = lam_first * np.logspace(0.0, DECADES, GRID)
+    return decay_bound(grid[:, None], gamma + beta * grid[:, None], tau[None, :]).max(axis=0)
+
+
+def error_bound(norms: Array, jump_times: Array, lam_first: float, gamma: float, beta: float,
+                times: Array) -> Array:
+    """``Σ_j ‖R_j‖_M E(t − t_j) H(t − t_j)`` at ``times`` (``norms[j] = ‖R_j‖_M``)."""
+    times = np.asarray(times, dtype=float)
+    out = np.zeros(times.shape)
+    for t_j, r in zip(jump_times, norms):
+        tau = times - t_j
+        on = tau > 0
+        if r > 0 and np.any(on):
+            out[on] += r * omitted_envelope(lam_first, gamma, beta, tau[on])
+    return out
+
+
+def automatic_basis(K: Any, M: Any, jumps: list[tuple[float, Array]], gamma: float,
+                    beta: float, times: Array, tolerance: float, start: int = 32,
+                    advice: str = "") -> tuple[Any, Any, dict[str, Any]]:
+    """The lowest ``k`` modes, ``k`` doubled from ``start`` until the bound meets ``tolerance``.
+
+    Returns the basis, its static correction and a report (``modes``, ``bound``: the relative
+    bound reached, ``tolerance``). With ``k >= n/2`` all modes are cheaper: ``(None, None,
+    report)`` tells the caller to use the complete basis.
+    """
+    from . import modal_basis
+
+    n = K.shape[0]
+    merged: dict[float, Array] = {}
+    for t_j, F in jumps:
+        merged[t_j] = merged.get(t_j, 0.0) + F
+    jump_times = np.array(sorted(merged), dtype=float)
+    k = min(start, n // 2)
+    report: dict[str, Any] = {"tolerance": tolerance}
+    while k < n // 2:
+        basis = modal_basis.sparse_basis(K, M, k, None, 0, advice or modal_basis.DEFAULT_ADVICE)
+        correction, indicators = modal_basis.mode_acceleration(
+            basis, K, M, [(t, merged[float(t)]) for t in jump_times], [])
+        statics = np.cumsum([basis.static(merged[float(t)]) for t in jump_times], axis=0)
+        scale = max((_m_norm(M, s) for s in statics), default=0.0)
+        norms = np.array([_m_norm(M, part) for part in correction.jump_parts])
+        bound = error_bound(norms, jump_times, basis.first_omitted, gamma, beta, times)
+        relative = float(bound.max(initial=0.0)) / max(scale, 1e-300)
+        report.update(modes=k, bound=relative, **indicators)
+        if relative <= tolerance:
+            return basis, correction, report
+        k *= 2
+    report.update(modes=n, bound=0.0)
+    return None, None, report
+
+
+def _m_norm(M: Any, x: Array) -> float:
+    return float(np.sqrt(max(np.sum(x * (M @ x)), 0.0)))
