@@ -125,11 +125,29 @@ def global_index(G: Grid, n_v: int) -> NDArray[np.int64]:
     return idx.reshape(idx.shape[0], idx.shape[1], -1)
 
 
+def _merge_runs(index: NDArray[np.int64], blocks: Array, axis: int
+                ) -> tuple[NDArray[np.int64], Array]:
+    """Sum the blocks of consecutive grid points along ``axis`` that share their unknowns.
+
+    The Gauss points of one knot span have the same local → global index, so their blocks
+    add before the sparse assembly (fewer COO entries: one block per span, not per point).
+    """
+    idx, blk = np.moveaxis(index, axis, 0), np.moveaxis(blocks, axis, 0)
+    change = np.any(idx[1:] != idx[:-1], axis=tuple(range(1, idx.ndim)))
+    starts = np.r_[0, np.nonzero(change)[0] + 1]
+    return (np.moveaxis(idx[starts], 0, axis),
+            np.moveaxis(np.add.reduceat(blk, starts, axis=0), 0, axis))
+
+
 def assemble(index: NDArray[np.int64], blocks: Array, size: int) -> sp.csr_matrix:
     """Sum per-point dense blocks ``blocks[..., k, l]`` into a symmetric sparse ``size²`` matrix.
 
-    ``index[..., k]`` is the global unknown of local ``k``; duplicates add (COO → CSR).
+    ``index[a, b, k]`` is the global unknown of local ``k`` at grid point ``(a, b)``;
+    blocks of points sharing their unknowns are summed first, then duplicates add
+    (COO → CSR).
     """
+    for axis in (0, 1):
+        index, blocks = _merge_runs(index, blocks, axis)
     rows = np.broadcast_to(index[..., :, None], blocks.shape).ravel()
     cols = np.broadcast_to(index[..., None, :], blocks.shape).ravel()
     A = sp.coo_matrix((blocks.ravel(), (rows, cols)), shape=(size, size)).tocsr()

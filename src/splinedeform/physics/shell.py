@@ -122,11 +122,13 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
     H = constitutive(G.g_inv, nu)
     Bm, Bb = strain_operators(G, N)
     shape = Bm.shape[:2] + (3, -1)
-    Bm, Bb = Bm.reshape(shape), Bb.reshape(shape)
-    membrane = (E * t / (1 - nu ** 2) * dA)[..., None, None] * H
-    bending = (E * t ** 3 / (12 * (1 - nu ** 2)) * dA)[..., None, None] * H
-    K = (np.einsum("abik,abij,abjl->abkl", Bm, membrane, Bm, optimize=True)
-         + np.einsum("abik,abij,abjl->abkl", Bb, bending, Bb, optimize=True))
-    mass = (material.density * t * dA)[..., None, None] * N[0, 0][..., :, None] * N[0, 0][..., None, :]
-    M = np.einsum("abkl,cd->abkcld", mass, np.eye(3)).reshape(K.shape)
-    return metric.assemble(dofs, K, size), metric.assemble(dofs, M, size)
+    B = np.concatenate([Bm.reshape(shape), Bb.reshape(shape)], axis=2)   # (Qu, Qv, 6, 3k)
+    D = np.zeros(B.shape[:2] + (6, 6))
+    D[..., :3, :3] = (E * t / (1 - nu ** 2) * dA)[..., None, None] * H
+    D[..., 3:, 3:] = (E * t ** 3 / (12 * (1 - nu ** 2)) * dA)[..., None, None] * H
+    K = np.swapaxes(B, -1, -2) @ (D @ B)                 # Bmᵀ Dm Bm + Bbᵀ Db Bb per point
+    # mass ρt ∫ N_k N_l dA for each coordinate alike: the scalar matrix ⊗ I₃ (interleaved)
+    N0 = N[0, 0]
+    mass = (material.density * t * dA)[..., None, None] * N0[..., :, None] * N0[..., None, :]
+    M = sp.kron(metric.assemble(index, mass, size // 3), sp.identity(3), format="csr")
+    return metric.assemble(dofs, K, size), M
