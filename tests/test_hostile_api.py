@@ -181,3 +181,8 @@ def test_a_huge_tessellation_is_refused_before_allocating():
         surf.tessellate(10**6)
     vertices, faces = surf.tessellate((2048, 2))      # the limit is on the product
     assert vertices.shape == (4096, 3) and faces.shape == (2 * 2047, 3)
+
+
+def test_a_point_grid_of_strings_is_refused_not_parsed():
+    with pytest.raises(InputError, match="real numbers, got dtype <U3"):
+        sd.shapes.from_points(np.full((4, 4, 3), "1.5"), cells=1, degree=2)

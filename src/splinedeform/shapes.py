@@ -408,10 +408,14 @@ def from_points(grid: ArrayLike, cells: int | tuple[int, int] = DEFAULT_CELLS, d
         raise InputError("point grid is complex; a surface is real (take .real explicitly if "
                          "the imaginary part is meant to go)")
     try:
-        X = np.asarray(grid, dtype=float)
-    except (TypeError, ValueError) as exc:
+        raw = np.asarray(grid)
+    except (TypeError, ValueError) as exc:          # ragged nesting
         raise InputError(f"a point grid must be an array of real numbers of shape "
                          f"(N_u, N_v, 3): {exc}") from None
+    if raw.dtype.kind not in "iuf":                 # numpy would parse strings like "1.5"
+        raise InputError(f"a point grid must be an array of real numbers, got dtype "
+                         f"{raw.dtype}")
+    X = raw.astype(float)
     if X.ndim != 3 or X.shape[2] != 3 or X.shape[0] < 2 or X.shape[1] < 2:
         raise InputError(f"a point grid must have shape (N_u, N_v, 3) with N_u, N_v >= 2, "
                          f"got {X.shape}")
