@@ -75,19 +75,25 @@ def server(tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def page(server):
-    url, _ = server
+def browser():
     with sync_api.sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-        page = browser.new_page(viewport={"width": 900, "height": 600})
-        problems: list[str] = []
-        page.on("pageerror", lambda exc: problems.append(str(exc)))
-        page.goto(url)
-        page.wait_for_function("window.sculptState !== undefined && sculptState.time > 0.2",
-                               timeout=60000)
-        page.problems = problems
-        yield page
-        browser.close()
+        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        yield b
+        b.close()
+
+
+@pytest.fixture(scope="module")
+def page(server, browser):
+    url, _ = server
+    page = browser.new_page(viewport={"width": 900, "height": 600})
+    problems: list[str] = []
+    page.on("pageerror", lambda exc: problems.append(str(exc)))
+    page.goto(url)
+    page.wait_for_function("window.sculptState !== undefined && sculptState.time > 0.2",
+                           timeout=60000)
+    page.problems = problems
+    yield page
+    page.close()
 
 
 def _state(page, expression: str):
@@ -230,3 +236,37 @@ def test_resolve_from_the_page_shows_progress_and_resets(page):
     page.wait_for_function("sculptState.errors.length > 0", timeout=60000)
     assert "rigid" in page.evaluate("sculptState.errors.slice(-1)[0]")
     assert page.evaluate("sculptState.version") == 3
+
+
+def test_a_saved_page_works_offline(server, browser, tmp_path):
+    """The page as served, saved to a file: the same grab moves the surface with no server
+    (no static correction then); Save says why it cannot work instead of failing silently."""
+    import urllib.request
+
+    url, _ = server
+    html = urllib.request.urlopen(url, timeout=60).read()
+    saved = tmp_path / "sculpt.html"
+    saved.write_bytes(html)
+    page = browser.new_page(viewport={"width": 900, "height": 600})
+    requests: list[str] = []
+    page.on("request", lambda r: requests.append(r.url))
+    page.goto(saved.as_uri())
+    page.wait_for_function("window.sculptState !== undefined && sculptState.time > 0.2",
+                           timeout=60000)
+    assert page.evaluate("sculptState.online") is False
+    centre = (R // 2) * R + R // 2
+    at = page.evaluate(f"sculptState.screen({centre})")
+    page.mouse.move(at["x"], at["y"])
+    page.mouse.down()
+    index = page.evaluate("sculptState.grabbed.index")
+    for step in range(1, 9):
+        page.mouse.move(at["x"], at["y"] + 8 * step)
+        page.wait_for_timeout(40)
+    page.wait_for_timeout(600)
+    assert page.evaluate(f"sculptState.displacement({index})")[2] < -1e-3
+    page.mouse.up()
+    page.evaluate("sculptState.save().catch(() => null)")
+    page.wait_for_function("sculptState.errors.length > 0", timeout=30000)
+    assert "offline" in page.evaluate("sculptState.errors[0]")
+    page.close()
+    assert all(r.startswith("file:") for r in requests), requests    # nothing left the file

@@ -15,6 +15,8 @@ point, computed when the point is first grabbed, never per frame.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
@@ -29,28 +31,34 @@ class StaticCorrection:
     """Residual flexibility columns ``r_a`` of a :class:`SculptBasis` (cached per sample)."""
 
     def __init__(self, basis: SculptBasis, phi: Array):
-        model = basis.model
         self.basis = basis
         self.phi = phi                                   # reduced modes (n_free, k)
-        self.complete = basis.lam.size == model.n_free
-        self._factor = None if self.complete else spla.splu(model.matrices()[2])
-        u, v = basis.samples_u, basis.samples_v
-        uu, vv = np.meshgrid(u, v, indexing="ij")
-        self._E = model.surface.evaluation_matrix(uu.ravel(), vv.ravel())
-        self._T = model.constraints.T
+        self.complete = basis.lam.size == basis.model.n_free
+        self._T = basis.model.constraints.T
+        self._samples = basis.samples_u.size * basis.samples_v.size
+        self._factor: Any = None                         # factor of K_r and the sample
+        self._E: Any = None                              # evaluation: at the first grab
         self._cache: dict[int, Array] = {}
 
     @property
     def samples(self) -> int:
-        return int(self._E.shape[0])
+        return int(self._samples)
+
+    def _prepare(self) -> None:
+        model = self.basis.model
+        self._factor = spla.splu(model.matrices()[2])
+        uu, vv = np.meshgrid(self.basis.samples_u, self.basis.samples_v, indexing="ij")
+        self._E = model.surface.evaluation_matrix(uu.ravel(), vv.ravel())
 
     def column(self, index: int) -> Array:
         """``r_a`` for the sample point ``index`` (row-major over the ``(ru, rv)`` grid)."""
         if index in self._cache:
             return self._cache[index]
-        if self._factor is None:
+        if self.complete:
             column = np.zeros(self.samples)
         else:
+            if self._factor is None:
+                self._prepare()
             F = np.asarray(self._T.T @ self._E[index].toarray().ravel())
             full = self._factor.solve(F)
             if not np.all(np.isfinite(full)):
