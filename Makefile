@@ -4,7 +4,7 @@ BIN    := $(VENV)/bin
 
 # make demo installs what the demo needs (extra: tool); make test what the suite needs.
 DEMO_EXTRAS := tool
-TEST_EXTRAS := tool,video,cad,test
+TEST_EXTRAS := tool,video,cad,sculpt,test
 
 .PHONY: demo test bench clean
 
