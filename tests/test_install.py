@@ -29,7 +29,7 @@ def installed_extras(target: str) -> list[str]:
 
 def test_make_demo_installs_the_tool_extra_and_make_test_what_the_suite_needs():
     assert installed_extras("demo") == ["tool"]
-    assert installed_extras("test") == ["tool,video,cad,test"]
+    assert installed_extras("test") == ["tool,video,cad,sculpt,test"]
 
 
 def test_readme_says_what_make_installs():
