@@ -2,7 +2,8 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 
-# make demo installs what the demo needs (extra: tool); make test what the suite needs.
+# make demo installs what the demo needs (extra: tool); make test what the suite needs: every
+# extra but render3d (VTK; matplotlib is the fallback) and cad-step (about 400 MB).
 DEMO_EXTRAS := tool
 TEST_EXTRAS := tool,video,cad,sculpt,test
 

@@ -32,6 +32,28 @@ def test_make_demo_installs_the_tool_extra_and_make_test_what_the_suite_needs():
     assert installed_extras("test") == ["tool,video,cad,sculpt,test"]
 
 
+#: extras make test leaves out, and why (their tests skip with the reason)
+NOT_INSTALLED_BY_MAKE_TEST = {"render3d": "VTK, large; matplotlib is the fallback",
+                              "cad-step": "OpenCASCADE, about 400 MB", "all": "everything"}
+
+
+def _module(requirement: str) -> str:
+    return re.split(r"[<>=\[ ]", requirement)[0].replace("-", "_").lower()
+
+
+def test_make_test_installs_every_extra_whose_tests_would_otherwise_skip():
+    (extras,) = installed_extras("test")
+    installed = set(extras.split(","))
+    assert installed | set(NOT_INSTALLED_BY_MAKE_TEST) == set(EXTRAS)
+    extra_of = {_module(req): extra for extra, reqs in EXTRAS.items() if extra != "all"
+                for req in reqs}
+    for test in (ROOT / "tests").rglob("*.py"):
+        for module in re.findall(r"importorskip\(\s*\"([\w.]+)\"", test.read_text("utf-8")):
+            extra = extra_of.get(module.split(".")[0].lower())
+            assert extra is None or extra in installed or extra in NOT_INSTALLED_BY_MAKE_TEST, \
+                f"{test.name} skips without {module} (extra {extra!r}), which make test leaves out"
+
+
 def test_readme_says_what_make_installs():
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     for target in ("demo", "test"):
