@@ -197,8 +197,13 @@ def test_version_prints_the_version():
     assert result.exit_code == 0 and result.stdout == f"splinedeform {__version__}\n"
 
 
-@pytest.mark.parametrize("command", [[], ["run"], ["demo"], ["validate"], ["schema"], ["info"],
-                                     ["bench"]])
+def _command_names() -> list[list[str]]:
+    import typer.main
+
+    return [[]] + [[name] for name in typer.main.get_command(cli.app).commands]
+
+
+@pytest.mark.parametrize("command", _command_names(), ids=lambda c: " ".join(c) or "splinedeform")
 def test_help_shows_flags_bare(command):
     result = runner.invoke(cli.app, [*command, "--help"])
     assert result.exit_code == 0, result.output

@@ -60,7 +60,14 @@ class _Group(_BareFlags, TyperGroup):
     """The command group, its help showing flags bare."""
 
 
-app = typer.Typer(name="splinedeform", cls=_Group, no_args_is_help=True, add_completion=False,
+class _App(typer.Typer):
+    """The command line; every command's help shows flags bare."""
+
+    def command(self, *args: Any, cls: Any = None, **kwargs: Any) -> Any:
+        return super().command(*args, cls=cls or _Command, **kwargs)
+
+
+app = _App(name="splinedeform", cls=_Group, no_args_is_help=True, add_completion=False,
                   pretty_exceptions_enable=False,
                   help="Physical deformation of B-spline surfaces, solved analytically.")
 
@@ -166,7 +173,7 @@ def _run(scenario: Any, outdir: Path, quiet: bool, budget: str | None = None) ->
                          summary_rows(result)))
 
 
-@app.command("run", cls=_Command)
+@app.command("run")
 def run_command(scenario: Path = SCENARIO_ARG, outdir: Optional[Path] = OUTDIR_OPT,
                 method: Optional[str] = typer.Option(
                     None, "--method", help="Override solve.method: analytic, newmark, radau3, "
@@ -209,7 +216,7 @@ def demo_scenario() -> Any:
     return parse_scenario(text, source="demo.toml")
 
 
-@app.command("demo", cls=_Command)
+@app.command("demo")
 def demo_command(outdir: Path = typer.Option(Path("demo-output"), "-o", "--outdir",
                                              help="Output folder (created if missing)."),
                  quiet: bool = QUIET_OPT, debug: bool = DEBUG_OPT) -> None:
@@ -218,7 +225,7 @@ def demo_command(outdir: Path = typer.Option(Path("demo-output"), "-o", "--outdi
         _run(demo_scenario(), outdir, quiet)
 
 
-@app.command("validate", cls=_Command)
+@app.command("validate")
 def validate_command(scenario: Path = SCENARIO_ARG, allow_outside_paths: bool = OUTSIDE_OPT,
                      debug: bool = DEBUG_OPT) -> None:
     """Check a scenario file and print what it would run (with every default filled in)."""
@@ -235,7 +242,7 @@ def validate_command(scenario: Path = SCENARIO_ARG, allow_outside_paths: bool = 
         out.print(printable(scenario_to_toml(loaded)), markup=False, highlight=False)
 
 
-@app.command("schema", cls=_Command)
+@app.command("schema")
 def schema_command() -> None:
     """Print the JSON Schema of scenario files (for editors: see docs/scenario.md)."""
     import json
@@ -272,7 +279,7 @@ def _optional_rows() -> list[tuple[str, str]]:
     return rows
 
 
-@app.command("info", cls=_Command)
+@app.command("info")
 def info_command() -> None:
     """Version, optional extras that import, and where the examples live."""
     from rich.console import Console
@@ -301,7 +308,7 @@ def _register_bench() -> None:
     if not available:
         return
 
-    @app.command("bench", cls=_Command)
+    @app.command("bench")
     def bench_command(sizes: Optional[str] = typer.Option(
                           None, "--sizes", help="Comma-separated net sizes, e.g. 8,16,32."),
                       quick: bool = typer.Option(False, "--quick", help="A short run."),
