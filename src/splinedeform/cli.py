@@ -37,6 +37,8 @@ OPTIONAL = {
     "imageio_ffmpeg": ("imageio-ffmpeg", "MP4 animation (extra: video)"),
     "pyvista": ("pyvista", "offscreen 3-D rendering (extra: render3d)"),
     "playwright": ("playwright", "viewer test in a headless browser"),
+    "starlette": ("starlette", "sculpt server (extra: sculpt)"),
+    "uvicorn": ("uvicorn", "sculpt server (extra: sculpt)"),
 }
 
 

@@ -63,6 +63,7 @@ class Session:
         self.progress: dict[str, Any] = {"busy": False, "stage": "idle", "elapsed": 0.0,
                                          "error": None}
         self._lock = threading.Lock()
+        self._state_lock = threading.Lock()
         self.basis: SculptBasis
         self.correction: StaticCorrection
         self._solve(scenario)
@@ -88,8 +89,9 @@ class Session:
         basis = sculpt_basis(model, self.resolution, k)
         self._stage("static correction", start)
         correction = static_correction(basis)
-        self.scenario, self.basis, self.correction = scenario, basis, correction
-        self.version += 1
+        with self._state_lock:          # readers see one basis with its version, never a mix
+            self.scenario, self.basis, self.correction = scenario, basis, correction
+            self.version += 1
         self.timing = time.perf_counter() - start
         self._stage("done", start)
 
@@ -144,9 +146,11 @@ class Session:
 
     def correction_column(self, version: int, index: int) -> np.ndarray:
         """``r_a`` of sample ``index`` on basis ``version`` (see :mod:`.correction`)."""
-        self._check_version(version)
-        self._check_index(index, "index")
-        return self.correction.column(index)
+        with self._state_lock:
+            self._check_version(version)
+            self._check_index(index, "index")
+            correction = self.correction
+        return correction.column(index)
 
     def _check_version(self, version: int) -> None:
         if version != self.version:
