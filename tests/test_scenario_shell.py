@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from splinedeform.errors import ScenarioError
-from splinedeform.pipeline import run
+from splinedeform.pipeline import run, summary_rows
 from splinedeform.scenario import parse_scenario, scenario_to_toml
 
 PLATE = """
@@ -59,6 +59,8 @@ def test_modes_of_the_pinned_plate_and_the_written_scenario_reads_back(tmp_path)
                                rtol=2e-3)
     # mode shapes reported as their normal component (a scalar field per mode)
     assert result.mode_shapes.shape == (3, 11, 11)
+    # the summary counts the coupled unknowns, not control points: 9 × 9 inner points × 3
+    assert dict(summary_rows(result))["free unknowns (x, y, z coupled)"] == "243"
     assert np.abs(result.nets[1] - result.rest_net).max() > 0
 
 

@@ -242,7 +242,7 @@ def make_report(result: RunResult) -> dict[str, Any]:
                     "knots": [surface.basis_u.kind, surface.basis_v.kind],
                     "domain": [list(d) for d in surface.domain],
                     "fit_error": surface.fit_error,
-                    "free control points": result.n_free},
+                    _unknowns(result.built.model): result.n_free},
         "solver": {"kind": s.solve.kind,
                    "method": s.solve.method if s.solve.kind == "dynamic" else "direct",
                    "t_end": s.solve.t_end if s.solve.kind == "dynamic" else None,
@@ -276,7 +276,7 @@ def summary_rows(result: RunResult) -> list[tuple[str, str]]:
     rows = [("scenario", s.title or s.name),
             ("control net", f"{surface.shape[0]} x {surface.shape[1]} "
                             f"({surface.shape[0] * surface.shape[1]} points)"),
-            ("free control points", str(result.n_free)),
+            (_unknowns(result.built.model), str(result.n_free)),
             ("solve", s.solve.kind + (f" ({s.solve.method})" if s.solve.kind == "dynamic"
                                       else "")),
             ("modes", "-" if result.omegas is None else
@@ -294,3 +294,6 @@ def summary_rows(result: RunResult) -> list[tuple[str, str]]:
     return rows
 
 
+def _unknowns(model: Any) -> str:
+    """What the model's free coordinates are called (the shell's are coupled unknowns)."""
+    return str(getattr(model, "unknowns_label", "free control points"))

@@ -152,6 +152,9 @@ class ShellModel:
         """Number of free displacement unknowns (x, y, z coupled)."""
         return self.T.shape[1]
 
+    #: how summaries name :attr:`n_free` (a scalar model counts free control points)
+    unknowns_label = "free unknowns (x, y, z coupled)"
+
     def matrices(self) -> tuple[sp.csc_matrix, sp.csc_matrix, sp.csc_matrix]:
         """Reduced ``(M_r, C_r, K_r)``, each ``(n_free, n_free)``, ``C_r = (γ/(ρt)) M_r + β K_r``."""
         return self._M, self._C, self._K

@@ -241,7 +241,8 @@ def describe(scenario: Scenario, built: Built | None = None) -> list[tuple[str, 
     if built is not None:
         n_u, n_v = built.surface.shape
         rows += [("control net", f"{n_u} x {n_v} ({n_u * n_v} points)"),
-                 ("free control points", str(built.model.n_free))]
+                 (getattr(built.model, "unknowns_label", "free control points"),
+                  str(built.model.n_free))]
     rows += [("loads", ", ".join(f"{ld.kind} ({ld.profile})" for ld in s.loads) or "none"),
              ("solve", s.solve.kind + (f" with {s.solve.method} to t = {s.solve.t_end:g}"
                                        if s.solve.kind == "dynamic" else "")),
