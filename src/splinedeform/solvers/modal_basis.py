@@ -20,13 +20,12 @@ arrays without the caller knowing how ``Φ`` is stored:
 
 Every basis also solves the static problem ``K_r d = F`` exactly (:meth:`ModalBasis.static`)
 so that a truncated basis can add the mode-acceleration correction
-``K⁻¹F − Φ Λ⁻¹ Φᵀ F`` (see :class:`StaticCorrection`).
+``K⁻¹F − Φ Λ⁻¹ Φᵀ F`` (:mod:`.mode_acceleration`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -37,6 +36,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError, SingularSystemError
 from . import kronecker_eigen
+from .mode_acceleration import StaticCorrection, mode_acceleration  # noqa: F401 (public here too)
 from .rigid import check_resolved, count_by_gap, direction_rigid
 
 if TYPE_CHECKING:
@@ -433,69 +433,6 @@ def truncate(basis: ModalBasis, k: int | None, omega_max: float | None
         return basis.restricted(np.sort(order[:k]))
     assert isinstance(basis, DenseBasis)
     return basis.truncated(k, basis.modal_static)
-
-
-# --------------------------------------------------------------------------- mode acceleration
-@dataclass
-class StaticCorrection:
-    """Mode acceleration: the omitted modes respond quasi-statically.
-
-    For the piecewise-constant load ``F(t) = Σ_j ΔF_j H(t - t_j)`` and harmonic terms
-    ``F_h sin(Ωt + φ)`` the truncated solution ``Φ Q(t)`` gets
-    ``Σ_j H(t - t_j) R_j + Σ_h sin(Ωt + φ) R_h`` with ``R = K⁻¹F - Φ Λ⁻¹ Φᵀ F``, exact in the
-    static limit. ``H(0) = 0``, as in the modal step response.
-    """
-
-    jump_times: Array
-    jump_parts: Array          # (J, n_free, 3)
-    harmonics: list[tuple[float, float, Array]]
-
-    def __call__(self, t: Array) -> Array:
-        """Correction at times ``t`` (F,) → ``(F, n_free, 3)``."""
-        t = np.asarray(t, dtype=float)
-        on = (t[:, None] > self.jump_times[None, :]).astype(float)
-        J, n, c = self.jump_parts.shape
-        out = (on @ self.jump_parts.reshape(J, n * c)).reshape(t.size, n, c)
-        for omega, phase, part in self.harmonics:
-            out += np.where(t >= 0, np.sin(omega * t + phase), 0.0)[:, None, None] * part
-        return out
-
-
-def mode_acceleration(basis: ModalBasis, K: sp.spmatrix, M: sp.spmatrix,
-                      jumps: list[tuple[float, Array]],
-                      harmonics: list[tuple[float, float, Array]]
-                      ) -> tuple[StaticCorrection, dict[str, float]]:
-    """The static correction of a truncated basis and its error indicators.
-
-    Returns the correction and
-
-    * ``omitted_static = max_j ‖R_j‖_M / ‖K⁻¹F_j‖_M``: for a piecewise-constant load each
-      omitted mode's exact response is ``g_i/λ_i (1 - P_11(τ))`` against ``g_i/λ_i`` here,
-      so the error in the M-norm is at most ``max|P_11| · Σ_j ‖R_j‖_M`` with
-      ``|P_11| <= 1/√(1-ζ²)`` (``<= 1`` for over-damped modes); this is its relative size;
-    * ``static_residual = max_j ‖K K⁻¹F_j - F_j‖ / ‖F_j‖``: the static limit is exact to it.
-    """
-    merged: dict[float, Array] = {}
-    for t_j, F in jumps:
-        merged[t_j] = merged.get(t_j, 0.0) + F
-    times = np.array(sorted(merged), dtype=float)
-    loads = [merged[float(t_j)] for t_j in times] + [F for _, _, F in harmonics]
-    parts, omitted, residual = [], [0.0], [0.0]
-    for F in loads:
-        full = basis.static(F)
-        part = full - basis.modal_static(F)
-        parts.append(part)
-        omitted.append(_m_norm(M, part) / max(_m_norm(M, full), 1e-300))
-        residual.append(float(np.linalg.norm(K @ full - F) / max(np.linalg.norm(F), 1e-300)))
-    jump_parts = np.array(parts[:times.size]) if times.size else np.zeros((0, basis.n_free, 3))
-    harmonic_parts = [(omega, phase, part) for (omega, phase, _), part
-                      in zip(harmonics, parts[times.size:])]
-    return (StaticCorrection(times, jump_parts, harmonic_parts),
-            {"omitted_static": float(max(omitted)), "static_residual": float(max(residual))})
-
-
-def _m_norm(M: sp.spmatrix, x: Array) -> float:
-    return float(np.sqrt(max(np.sum(x * (M @ x)), 0.0)))
 
 
 def eigen_residual(K: sp.spmatrix, M: sp.spmatrix, basis: ModalBasis, sample: int = 64) -> float:
