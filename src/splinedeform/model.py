@@ -27,9 +27,10 @@ from .loads import Load, as_load, static_time
 from .material import Material, check_scales
 from .physics import PHYSICS, intrinsic
 from .quadrature import gram_matrix
+from . import modal_solve
+from .modal_solve import check_count as _check_count
 from .solution import ModalSolution, StaticSolution
-from .solvers import modal_basis, mode_count, rigid
-from .solvers.analytic import ModalResponse
+from .solvers import modal_basis, rigid
 from .solvers.kronecker_eigen import kronecker_reason
 from .solvers.rigid import UnresolvedSpectrum
 from .surface import Surface
@@ -398,119 +399,11 @@ class Model:
         return numeric.integrate(self, forcing, method, t_end, times, d0, v0, **options)
 
     def _analytic(self, forcing: Any, t_end: float, d0: Array, v0: Array,
-                  function_samples: int = 400, modes: int | None = None,
-                  omega_max: float | None = None, eigensolver: str = "auto",
-                  tolerance: float | None = None, times: ArrayLike | None = None
-                  ) -> ModalSolution:
-        """Closed-form modal solution; ``modes``/``omega_max`` truncate with mode acceleration,
-        ``tolerance`` chooses the number of modes (:mod:`~splinedeform.solvers.mode_count`)."""
-        modes, omega_max = self._truncation_request(modes, omega_max)
-        # the reduced force terms in space: modal terms of the identity basis
-        spatial = forcing.modal_terms(sp.identity(self.n_free, format="csr"), t_end,
-                                      function_samples)
-        report: dict[str, Any] = {}
-        if tolerance is not None:
-            report = self._automatic_modes(spatial, d0, v0, t_end, tolerance, times,
-                                           modes, omega_max)
-            if report["modes"] < self.n_free:
-                modes, eigensolver = report["modes"], "sparse"
-        basis = self.modal_basis(eigensolver, modes, omega_max)
-        start = time.perf_counter()
-        M = self._M
-        lam = basis.lam
-        c = self.material.damping / self.material.mass + self.material.rayleigh * lam
-        jumps = [(t_j, basis.project(F)) for t_j, F in spatial[0]]
-        harmonics = [(w, phase, basis.project(F)) for w, phase, F in spatial[1]]
-        response = ModalResponse(lam, c, basis.project(M @ d0), basis.project(M @ v0),
-                                 jumps, harmonics)
-        correction, truncation = None, {}
-        if not basis.complete:
-            correction, truncation = self._truncation(basis, spatial, d0, v0)
-        if report:
-            truncation.update(tolerance=report["tolerance"], bound=report["bound"])
-        timings = dict(self.timings)
-        timings["modal setup"] = time.perf_counter() - start
-        return ModalSolution(self, t_end, forcing, timings, basis, response, truncation,
-                             correction)
-
-    def _automatic_modes(self, spatial: tuple[list, list], d0: Array, v0: Array, t_end: float,
-                         tolerance: Any, times: ArrayLike | None, modes: int | None,
-                         omega_max: float | None) -> dict[str, Any]:
-        """Lowest modes meeting ``tolerance`` (relative M-norm at ``times``): the report of
-        :func:`~splinedeform.solvers.mode_count.automatic_basis` (``modes = n_free``: all)."""
-        try:
-            tolerance = float(tolerance)
-        except (TypeError, ValueError):
-            raise InputError(f"tolerance must be a number, got {tolerance!r}") from None
-        if not 0 < tolerance < 1:
-            raise InputError(f"tolerance must be in (0, 1), got {tolerance}")
-        if modes is not None or omega_max is not None:
-            raise InputError("give tolerance= or modes=/omega_max=, not both")
-        if spatial[1] or np.any(d0) or np.any(v0) or self.rigid_modes != 0:
-            raise InputError("tolerance= chooses the modes for piecewise-constant loads from "
-                             "rest on a model without rigid modes; give modes=k otherwise")
-        at = np.linspace(0.0, t_end, 201) if times is None else np.asarray(times, dtype=float)
-        m = self.material
-        basis, correction, report = mode_count.automatic_basis(
-            self._K, self._M, spatial[0], m.damping / m.mass, m.rayleigh, at, tolerance)
-        if basis is None:
-            report["modes"] = self.n_free
-        else:
-            self._bases[("sparse", report["modes"], None)] = basis
-        return report
-
-    def _truncation_request(self, modes: int | None, omega_max: float | None
-                            ) -> tuple[int | None, float | None]:
-        if modes is not None and omega_max is not None:
-            raise InputError("give either modes=k or omega_max=, not both")
-        if modes is not None:
-            modes = _check_count(modes, self.n_free)
-        if omega_max is not None:
-            try:
-                omega_max = float(omega_max)
-            except (TypeError, ValueError):
-                raise InputError(f"omega_max must be a number, got {omega_max!r}") from None
-            if not np.isfinite(omega_max) or omega_max <= 0:
-                raise InputError(f"omega_max must be finite and > 0, got {omega_max}")
-        return modes, omega_max
-
-    def _truncation(self, basis: modal_basis.ModalBasis, spatial: tuple[list, list],
-                    d0: Array, v0: Array) -> tuple[Any, dict[str, Any]]:
-        """Mode-acceleration correction and the truncation report of a truncated basis."""
-        report: dict[str, Any] = {
-            "modes": basis.size, "n_free": self.n_free,
-            "omega_max_kept": float(np.sqrt(basis.lam.max())),
-            "omega_first_omitted": float(np.sqrt(basis.first_omitted)),
-            "initial_residual": max(_outside(basis, self._M, d0), _outside(basis, self._M, v0)),
-        }
-        if not basis.can_solve_static:
-            report.update(static_correction=False, omitted_static=float("nan"),
-                          static_residual=float("nan"))
-            return None, report
-        correction, indicators = modal_basis.mode_acceleration(basis, self._K, self._M,
-                                                               *spatial)
-        report.update(static_correction=True, **indicators)
-        return correction, report
-
-
-def _outside(basis: modal_basis.ModalBasis, M: sp.spmatrix, x: Array) -> float:
-    """Relative M-norm of the part of ``x`` outside the span of a basis."""
-    norm = float(np.sqrt(np.sum(x * (M @ x))))
-    if norm == 0.0:
-        return 0.0
-    rest = x - basis.expand(basis.project(M @ x)[None])[0]
-    return float(np.sqrt(max(np.sum(rest * (M @ rest)), 0.0))) / norm
+                  **options: Any) -> ModalSolution:
+        """Closed-form modal solution (:func:`splinedeform.modal_solve.analytic`)."""
+        return modal_solve.analytic(self, forcing, t_end, d0, v0, **options)
 
 
 def _largest(A: sp.spmatrix) -> float:
     """``max |A_ij|`` (0 for an empty matrix; NaN propagates)."""
     return float(np.abs(A.data).max()) if A.nnz else 0.0
-
-
-def _check_count(k: int, available: int) -> int:
-    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
-        raise InputError(f"number of modes must be an integer >= 1, got {k!r}")
-    if k > available:
-        raise InputError(f"asked for {k} modes but the model has only {available} free "
-                         "coordinates")
-    return int(k)

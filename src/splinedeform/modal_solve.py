@@ -1,0 +1,141 @@
+"""The analytic path of :meth:`splinedeform.Model.dynamic`: modes, modal forces, response.
+
+``d(t) = Φ Q(t)`` with the closed-form modal coordinates of
+:class:`~splinedeform.solvers.analytic.ModalResponse`; a truncated basis (``modes``,
+``omega_max`` or ``tolerance``) adds the exact static part of the omitted modes
+(:mod:`~splinedeform.solvers.mode_acceleration`) and reports the truncation.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import ArrayLike, NDArray
+
+from .errors import InputError
+from .solution import ModalSolution
+from .solvers import modal_basis, mode_count
+from .solvers.analytic import ModalResponse
+
+if TYPE_CHECKING:
+    from .model import Model
+
+Array = NDArray[np.float64]
+
+
+def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
+             function_samples: int = 400, modes: int | None = None,
+             omega_max: float | None = None, eigensolver: str = "auto",
+             tolerance: float | None = None, times: ArrayLike | None = None
+             ) -> ModalSolution:
+    """Closed-form modal solution; ``modes``/``omega_max`` truncate with mode acceleration,
+    ``tolerance`` chooses the number of modes (:mod:`~splinedeform.solvers.mode_count`)."""
+    modes, omega_max = truncation_request(model, modes, omega_max)
+    # the reduced force terms in space: modal terms of the identity basis
+    spatial = forcing.modal_terms(sp.identity(model.n_free, format="csr"), t_end,
+                                  function_samples)
+    report: dict[str, Any] = {}
+    if tolerance is not None:
+        report = _automatic_modes(model, spatial, d0, v0, t_end, tolerance, times,
+                                  modes, omega_max)
+        if report["modes"] < model.n_free:
+            modes, eigensolver = report["modes"], "sparse"
+    basis = model.modal_basis(eigensolver, modes, omega_max)
+    start = time.perf_counter()
+    M = model._M
+    lam = basis.lam
+    c = model.material.damping / model.material.mass + model.material.rayleigh * lam
+    jumps = [(t_j, basis.project(F)) for t_j, F in spatial[0]]
+    harmonics = [(w, phase, basis.project(F)) for w, phase, F in spatial[1]]
+    response = ModalResponse(lam, c, basis.project(M @ d0), basis.project(M @ v0),
+                             jumps, harmonics)
+    correction, truncation = None, {}
+    if not basis.complete:
+        correction, truncation = _truncation(model, basis, spatial, d0, v0)
+    if report:
+        truncation.update(tolerance=report["tolerance"], bound=report["bound"])
+    timings = dict(model.timings)
+    timings["modal setup"] = time.perf_counter() - start
+    return ModalSolution(model, t_end, forcing, timings, basis, response, truncation,
+                         correction)
+
+def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Array,
+                     t_end: float, tolerance: Any, times: ArrayLike | None,
+                     modes: int | None, omega_max: float | None) -> dict[str, Any]:
+    """Lowest modes meeting ``tolerance`` (relative M-norm at ``times``): the report of
+    :func:`~splinedeform.solvers.mode_count.automatic_basis` (``modes = n_free``: all)."""
+    try:
+        tolerance = float(tolerance)
+    except (TypeError, ValueError):
+        raise InputError(f"tolerance must be a number, got {tolerance!r}") from None
+    if not 0 < tolerance < 1:
+        raise InputError(f"tolerance must be in (0, 1), got {tolerance}")
+    if modes is not None or omega_max is not None:
+        raise InputError("give tolerance= or modes=/omega_max=, not both")
+    if spatial[1] or np.any(d0) or np.any(v0) or model.rigid_modes != 0:
+        raise InputError("tolerance= chooses the modes for piecewise-constant loads from "
+                         "rest on a model without rigid modes; give modes=k otherwise")
+    at = np.linspace(0.0, t_end, 201) if times is None else np.asarray(times, dtype=float)
+    m = model.material
+    basis, correction, report = mode_count.automatic_basis(
+        model._K, model._M, spatial[0], m.damping / m.mass, m.rayleigh, at, tolerance)
+    if basis is None:
+        report["modes"] = model.n_free
+    else:
+        model._bases[("sparse", report["modes"], None)] = basis
+    return report
+
+def truncation_request(model: Model, modes: int | None, omega_max: float | None
+                       ) -> tuple[int | None, float | None]:
+    """Checked ``modes`` (an integer in ``[1, n_free]``) and ``omega_max`` (finite, > 0)."""
+    if modes is not None and omega_max is not None:
+        raise InputError("give either modes=k or omega_max=, not both")
+    if modes is not None:
+        modes = check_count(modes, model.n_free)
+    if omega_max is not None:
+        try:
+            omega_max = float(omega_max)
+        except (TypeError, ValueError):
+            raise InputError(f"omega_max must be a number, got {omega_max!r}") from None
+        if not np.isfinite(omega_max) or omega_max <= 0:
+            raise InputError(f"omega_max must be finite and > 0, got {omega_max}")
+    return modes, omega_max
+
+def _truncation(model: Model, basis: modal_basis.ModalBasis, spatial: tuple[list, list],
+                d0: Array, v0: Array) -> tuple[Any, dict[str, Any]]:
+    """Mode-acceleration correction and the truncation report of a truncated basis."""
+    report: dict[str, Any] = {
+        "modes": basis.size, "n_free": model.n_free,
+        "omega_max_kept": float(np.sqrt(basis.lam.max())),
+        "omega_first_omitted": float(np.sqrt(basis.first_omitted)),
+        "initial_residual": max(_outside(basis, model._M, d0), _outside(basis, model._M, v0)),
+    }
+    if not basis.can_solve_static:
+        report.update(static_correction=False, omitted_static=float("nan"),
+                      static_residual=float("nan"))
+        return None, report
+    correction, indicators = modal_basis.mode_acceleration(basis, model._K, model._M,
+                                                           *spatial)
+    report.update(static_correction=True, **indicators)
+    return correction, report
+
+
+def _outside(basis: modal_basis.ModalBasis, M: sp.spmatrix, x: Array) -> float:
+    """Relative M-norm of the part of ``x`` outside the span of a basis."""
+    norm = float(np.sqrt(np.sum(x * (M @ x))))
+    if norm == 0.0:
+        return 0.0
+    rest = x - basis.expand(basis.project(M @ x)[None])[0]
+    return float(np.sqrt(max(np.sum(rest * (M @ rest)), 0.0))) / norm
+
+
+def check_count(k: int, available: int) -> int:
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
+        raise InputError(f"number of modes must be an integer >= 1, got {k!r}")
+    if k > available:
+        raise InputError(f"asked for {k} modes but the model has only {available} free "
+                         "coordinates")
+    return int(k)
