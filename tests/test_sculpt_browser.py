@@ -149,6 +149,49 @@ def test_drag_down_moves_the_point_down_and_release_rings_down(page):
     assert not page.problems
 
 
+def test_held_push_on_the_page_equals_python_with_static_correction(page, server):
+    """While a push is held (page paused), the drawn displacement of every sample equals
+    the Python twin of the page's pushes plus the static correction of the 19 omitted
+    modes (Model.dynamic's mode acceleration), to 1e-5 of the largest value (float32 Φ_s
+    and correction columns)."""
+    from splinedeform.scenario import build, load_scenario
+    from splinedeform.sculpt import Push, sculpt_basis
+    from splinedeform.sculpt.correction import static_correction
+    from splinedeform.sculpt.state import modal_history
+
+    _, folder = server
+    page.evaluate("sculptState.reset()")
+    at = page.evaluate(f"sculptState.screen({(R // 2) * R + 5})")
+    page.mouse.move(at["x"], at["y"])
+    page.mouse.down()
+    for step in range(1, 7):
+        page.mouse.move(at["x"], at["y"] + 8 * step)
+        page.wait_for_timeout(40)
+    page.wait_for_timeout(300)
+    page.evaluate("sculptState.setPaused(true)")
+    index = page.evaluate("sculptState.grabbed.index")
+    page.wait_for_function(f"sculptState.corrections.includes({index})", timeout=30000)
+    page.wait_for_timeout(500)                      # the spring force settles at frozen time
+    snap = page.evaluate("sculptState.snapshot()")
+    page.mouse.up()
+    page.evaluate("sculptState.setPaused(false)")
+    model = build(load_scenario(folder / "sheet.toml")).model
+    basis = sculpt_basis(model, R, MODES)
+    pushes = snap["pushes"]
+    assert pushes and pushes[-1]["t_off"] is None
+    twin = modal_history(basis, [Push(float(basis.samples_u[p["index"] // R]),
+                                      float(basis.samples_v[p["index"] % R]),
+                                      tuple(p["force"]), p["t_on"],
+                                      np.inf if p["t_off"] is None else p["t_off"])
+                                 for p in pushes], [snap["time"]])[0]
+    held = {pushes[-1]["index"]: tuple(pushes[-1]["force"])}
+    expect = basis.phi_samples @ twin + static_correction(basis).displacement(held)
+    got = np.asarray(snap["displacement"]).reshape(-1, 3)
+    scale = np.max(np.abs(expect))
+    assert scale > 1e-3
+    assert np.max(np.abs(got - expect)) <= 1e-5 * scale
+
+
 def test_page_closed_form_equals_the_python_twin(page, server):
     """sculptState.simulate runs the page's own propagation (JavaScript, float64 state,
     float32 mode shapes) for given pushes; the Python twin with the same basis agrees to
