@@ -134,3 +134,26 @@ def test_unresolved_dense_spectrum_is_refused_with_its_condition_number():
     assert isinstance(UnresolvedSpectrum("x"), SingularSystemError)
     # auto falls back to the separable factors, which resolve it
     assert model.modal_basis().kind == "separable"
+
+
+def test_static_solve_of_the_positive_definite_membrane():
+    """The membrane is positive definite (no rigid modes): static must not call it singular.
+
+    At w01 = 1e-8 the condition number is ~1e12: the sparse LU's residual is ~4e-7 of F, its
+    error ~1e-7 (measured against the 1-D solution); one refinement step estimates that
+    error and the solve is accepted within 1e-6 (STATIC_TRUST). At w01 = 1e-10 the estimate
+    exceeds it and the solve is refused as ill-conditioned, naming the estimate.
+    """
+    load = sd.Uniform((0.0, 0.0, 1.0))
+    model = membrane(1e-8)
+    exact = membrane_static(model, load)
+    d = model.static(load).d_free[:, 2].reshape(exact.shape)
+    assert np.abs(d - exact).max() <= 1e-6 * np.abs(exact).max()
+    with pytest.raises(SingularSystemError, match="not singular but too ill-conditioned"):
+        membrane(1e-10).static(load)
+    # a structurally singular system is named as such before any factorisation
+    free = sd.Model(sd.shapes.plane(cells=(6, 6)), sd.Material(w10=1.0), boundary={"u0": "pinned"})
+    assert free.rigid_modes == 0
+    loose = sd.Model(sd.shapes.plane(cells=(6, 6)), sd.Material(w01=1.0), boundary={"u0": "pinned"})
+    with pytest.raises(SingularSystemError, match="without energy"):
+        loose.static(load)
