@@ -102,3 +102,17 @@ def test_rational_model_converges_to_the_polynomial_approximation():
     rates = np.log2(gaps[:-1] / gaps[1:])
     assert np.all(rates[-1] >= 1.5), (gaps, rates)
     assert gaps[-1].max() <= 2e-3, gaps
+
+
+def test_bending_on_a_c0_knot_vector_is_refused():
+    # two quarter arcs joined by a double knot: C0 in u at 0.5
+    ring = np.array([[1.0, 0, 0], [1, 1, 0], [0, 1, 0], [-1, 1, 0], [-1, 0, 0]])
+    points = np.stack([ring, ring + [0, 0, 1.0], ring + [0, 0, 2.0]], axis=1)
+    patch = NurbsPatch((2, 2), np.array([0, 0, 0, 0.5, 0.5, 1, 1, 1.0]),
+                       np.array([0, 0, 0, 1, 1, 1.0]), points,
+                       np.outer([1, S, 1, S, 1], [1, 1, 1]))
+    surf = surface_from_patch(patch)
+    assert surf.basis_u.continuity == 0 and surf.basis_v.continuity == 2
+    with pytest.raises(InputError, match="w20 needs a C1 basis in u"):
+        sd.Model(surf, sd.Material(w10=1, w01=1, w20=1), boundary={"u0": "clamped"})
+    sd.Model(surf, sd.Material(w10=1, w01=1, w02=1), boundary={"u0": "clamped"})   # v is C2

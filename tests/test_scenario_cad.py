@@ -158,3 +158,20 @@ def test_3dm_export_of_every_frame_evaluates_equal_in_rhino3dm(tmp_path, surface
         assert np.abs(back.knots_u - (given.knots_u - 4.0)).max() <= 1e-15
         assert np.abs(back.knots_v - given.knots_v).max() <= 1e-15
         assert np.abs(back.weights - given.weights).max() <= 1e-15
+
+
+def test_poles_of_a_cad_sphere_move_as_one_point(tmp_path):
+    model = r3.File3dm()
+    model.Objects.AddBrep(r3.Brep.CreateFromSphere(r3.Sphere(r3.Point3d(0, 0, 0), 1.0)))
+    model.Write(str(tmp_path / "ball.3dm"), 7)
+    with pytest.warns(UserWarning, match="Brep face"):
+        from splinedeform.cad import read_3dm
+        surf = surface_from_patch(read_3dm(tmp_path / "ball.3dm"))
+    m = sd.Model(surf, sd.Material(w10=1.0, w01=1.0), boundary={"v0": "pole", "v1": "pole"})
+    # a free membrane: the rigid translation (one per coordinate, λ = 0 up to round-off,
+    # so ω ~ 1e-8), then positive frequencies
+    omega = m.frequencies(2)
+    assert omega[0] <= 1e-6 * omega[1] and omega[1] > 0.1
+    d = m.dynamic(sd.Point(1.0, 0.0, (0, 0, 1.0)), t_end=0.5).control_points(0.5)
+    for row in (d[:, 0], d[:, -1]):          # every pole's control points stay together
+        assert np.abs(row - row[0]).max() <= 1e-12 * np.abs(d).max()

@@ -188,16 +188,28 @@ def _check_mask(fixed: NDArray[np.bool_], basis_u: BSplineBasis, basis_v: BSplin
 
 
 def _pole_rows(edge: str, basis_u: BSplineBasis, basis_v: BSplineBasis) -> NDArray[np.int64]:
-    """Flat indices of the control points on a degenerate edge (open knots only)."""
+    """Flat indices of the control points on a degenerate edge (clamped knots only)."""
     basis = basis_u if edge[0] == "u" else basis_v
-    if basis.kind != "open":
-        raise InputError(f"a pole edge ({edge}) needs open knots in {edge[0]} (its control "
-                         f"points must lie on the edge), got {basis.kind!r}")
+    if not _clamped(basis, int(edge[1])):
+        raise InputError(f"a pole edge ({edge}) needs open knots in {edge[0]}, or a knot vector "
+                         f"clamped at that end (its control points must lie on the edge), got "
+                         f"{basis.kind!r}")
     n_u, n_v = basis_u.size, basis_v.size
     line = 0 if edge[1] == "0" else (n_u if edge[0] == "u" else n_v) - 1
     if edge[0] == "u":
         return line * n_v + np.arange(n_v)
     return np.arange(n_u) * n_v + line
+
+
+def _clamped(basis: BSplineBasis, end: int) -> bool:
+    """Whether the spline interpolates its end coefficient at ``end`` (0 or 1): open knots,
+    or a general knot vector whose end knot is repeated ``n + 1`` times."""
+    if basis.kind == "open":
+        return True
+    if basis.kind not in ("general", "rational"):
+        return False
+    t, n = basis.knots, basis.degree
+    return bool(t[0] == t[n]) if end == 0 else bool(t[-1] == t[-n - 1])
 
 
 def _with_poles(basis_u: BSplineBasis, basis_v: BSplineBasis, edges: dict[str, str],

@@ -100,6 +100,14 @@ class KnotVectorBasis:
         """Number of non-empty knot spans."""
         return self.breaks.size - 1
 
+    @property
+    def continuity(self) -> int:
+        """Order ``k`` with every spline ``C^k`` on the domain: ``n - μ_max`` for the largest
+        interior knot multiplicity ``μ_max`` (``n`` without interior knots)."""
+        t, n = self.knots, self.degree
+        inner = t[(t > self.breaks[0]) & (t < self.breaks[-1])]
+        return n - (int(np.unique(inner, return_counts=True)[1].max()) if inner.size else 0)
+
     def shifted(self, origin: float) -> KnotVectorBasis:
         """The same basis over the knots ``t_i - origin`` (domain moved by ``-origin``)."""
         return KnotVectorBasis(self.degree, self.knots - origin)
@@ -213,6 +221,7 @@ class RationalBasis:
     length = property(lambda self: self.basis.length)
     cells = property(lambda self: self.basis.cells)
     knots = property(lambda self: self.basis.knots)
+    continuity = property(lambda self: self.basis.continuity)
     kind = "rational"
 
     def greville(self) -> NDArray[np.float64]:

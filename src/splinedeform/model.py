@@ -122,6 +122,12 @@ class Model:
             if weight and basis.degree < 2:
                 raise InputError(f"bending weight w{'20' if name == 'u' else '02'} needs degree "
                                  f">= 2 in {name} (second derivatives), got {basis.degree}")
+            if weight and getattr(basis, "continuity", basis.degree - 1) < 1:
+                raise InputError(
+                    f"bending weight w{'20' if name == 'u' else '02'} needs a C1 basis in "
+                    f"{name}, but its knot vector repeats an interior knot {basis.degree} "
+                    "times (the surface may kink there, where bending energy is undefined); "
+                    "use tension weights only, or a knot vector without such knots")
         self.surface = surface
         self.material = material
         self.mass_matrix = mass_matrix
