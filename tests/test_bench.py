@@ -197,3 +197,22 @@ def test_goal_regimes_run_and_report_their_settings():
         assert r["radau7"]["status"] == "ok" and r["radau7"]["error"] <= 1e-4
         assert math.isclose(r["ratio"], r["radau7"]["seconds"] / r["analytic_s"], rel_tol=1e-12)
     assert {h["name"] for h in result["horizons"]} == {"light", "plate"}
+
+
+def test_a_run_stopped_at_the_budget_reports_where_its_stepping_was(monkeypatch):
+    """Before stepping, the integrators probe the load up to 97 % of t_end (which coordinates
+    move); the progress of a stopped run must be that of the stepping, not of the probes.
+    A fake clock ticking once per reading stops the run after a few dozen load calls, far
+    from the end: the old bookkeeping reported 97 % here and extrapolated ~budget/0.97."""
+    import itertools
+
+    t_end = bench.reference_t_end("clamped")
+    times = np.linspace(0.0, t_end, 200)
+    case = bench.Case("clamped", 4, bench.build_model("clamped", 4), bench.study_load(t_end),
+                      t_end, times)
+    ticks = itertools.count()
+    monkeypatch.setattr(bench.time, "perf_counter", lambda: float(next(ticks)))
+    stopped = bench.attempt(case, "radau7", 0, budget=80)
+    assert stopped.stopped
+    assert 0 < stopped.progress < 0.2
+    assert stopped.estimate > 5 * stopped.seconds      # extrapolated well beyond the budget

@@ -216,7 +216,14 @@ class OverBudget(Exception):
 
 
 class _TimedForcing(numeric.ReducedForcing):
-    """The reduced load, raising :class:`OverBudget` after a deadline; remembers the time reached."""
+    """The reduced load, raising :class:`OverBudget` after a deadline; remembers the time reached.
+
+    ``reached`` is the time of the *latest* call, not the largest: before stepping, the
+    integrators probe the load at times spread over ``[0, t_end]`` (up to 97 % of it) to find
+    the coordinates that move, so the largest time asked says nothing of the progress. The
+    stepping itself asks for the load in increasing time, so the latest call is where it was
+    stopped.
+    """
 
     def __init__(self, model: Model, load: loads.Load, deadline: float):
         super().__init__(model, load)
@@ -226,7 +233,7 @@ class _TimedForcing(numeric.ReducedForcing):
     def __call__(self, t: float) -> Array:
         if time.perf_counter() > self.deadline:
             raise OverBudget
-        self.reached = max(self.reached, float(t))
+        self.reached = float(t)
         return super().__call__(t)
 
 
