@@ -185,6 +185,8 @@ def test_read_control_net_round_trips_every_layout(written, suffix):
     surface, nets, folder = written
     back = export.read_control_net(folder / f"nets{suffix}", 1)
     assert back.basis_u == surface.basis_u and back.basis_v == surface.basis_v
+    # no arithmetic between writing and reading: NPZ stores the doubles and JSON writes
+    # their shortest round-tripping repr, so the read-back is exact
     np.testing.assert_array_equal(back.control_points, nets[1])
 
 
@@ -228,6 +230,7 @@ def test_files_of_version_1_without_knots_are_still_read(tmp_path):
            "times": [0.0], "control_points": [surface.control_points.tolist()]}
     (tmp_path / "old.json").write_text(json.dumps(doc))
     back = export.read_control_net(tmp_path / "old.json")
+    # JSON floats written by repr read back exactly: no arithmetic in between
     np.testing.assert_array_equal(back.control_points, surface.control_points)
     doc["version"] = 99
     (tmp_path / "new.json").write_text(json.dumps(doc))
