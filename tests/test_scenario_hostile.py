@@ -13,29 +13,7 @@ from typer.testing import CliRunner
 from splinedeform import BSplineBasis, ScenarioError, Surface
 from splinedeform.scenario import _located, load_scenario, parse_scenario, scenario_to_toml
 
-DYNAMIC = """\
-[surface]
-shape = "plane"
-cells = 3
-
-[material]
-w10 = 1.0
-w01 = 1.0
-
-[boundary]
-u0 = "clamped"
-u1 = "clamped"
-
-[[load]]
-kind = "uniform"
-force = [0.0, 0.0, -1.0]
-profile = "step"
-
-[solve]
-kind = "dynamic"
-t_end = 2.0
-frames = 5
-"""
+from tiny_scenario import DYNAMIC
 
 
 def line_of(text: str, start: str) -> int:

@@ -10,32 +10,7 @@ from splinedeform import ScenarioError
 from splinedeform.pipeline import run
 from splinedeform.scenario import build, load_scenario, parse_scenario
 
-BASE = """\
-[surface]
-shape = "plane"
-cells = 3
-
-[material]
-w10 = 1.0
-w01 = 1.0
-
-[boundary]
-u0 = "clamped"
-u1 = "clamped"
-
-[[load]]
-kind = "uniform"
-force = [0.0, 0.0, -1.0]
-profile = "step"
-
-[solve]
-kind = "dynamic"
-t_end = 2.0
-frames = 5
-
-[output]
-formats = []
-"""
+from tiny_scenario import BASE
 
 
 def line_of(text: str, start: str) -> int:
