@@ -322,6 +322,27 @@ def test_key_lines_follow_tables_arrays_inline_tables_and_strings():
     assert lines["boundary.surface.degree"] == 19
 
 
+def test_quoted_keys_are_located_by_the_key_they_name():
+    # A basic quoted key's escapes name the same key as its bare spelling; a literal
+    # quoted key keeps its backslashes. Lines are exact integers: no tolerance.
+    text = "\n".join([
+        "[material]",                # 1
+        '"m\\u0061ss" = 2.0',       # 2  "m\u0061ss" is the key mass
+        "'w\\10' = 1.0",            # 3  literal: the key is w\10
+    ])
+    lines = key_lines(text)
+    assert lines["material.mass"] == 2
+    assert lines["material.w\\10"] == 3
+
+
+def test_an_unknown_escaped_key_is_reported_at_its_own_line():
+    text = PLANE.replace("mass = 2.0", '"m\\u0061s" = 2.0')
+    message = error_of(text)
+    line = next(i for i, row in enumerate(text.splitlines(), 1) if row.startswith('"m'))
+    assert line > 1
+    assert located(message, "case.toml", line, "material.mas")
+
+
 # -- error messages name the file, the key path and its line ------------------------------
 def located(message: str, source: str, line: int, path: str) -> bool:
     return f"{source}:{line}: {path}:" in message

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import tomllib
 from typing import Any, Callable, Mapping
 
 from ..errors import ScenarioError
@@ -12,6 +13,20 @@ from ..terminal import printable
 # Where keys are written: tomllib gives values, not positions
 # =====================================================================================
 _BARE = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-")
+
+
+def _decoded(quote: str, raw: str) -> str:
+    """The key a quoted TOML key names: a basic ``"..."`` key's escapes decoded by tomllib.
+
+    A literal ``'...'`` key has no escapes. An undecodable raw text is returned as it is
+    (tomllib has already refused such a file before any key is located).
+    """
+    if quote == "'" or "\\" not in raw:
+        return raw
+    try:
+        return tomllib.loads(f'k = "{raw}"')["k"]
+    except tomllib.TOMLDecodeError:
+        return raw
 
 
 class _KeyScanner:
@@ -83,7 +98,7 @@ class _KeyScanner:
         while True:
             self.skip_blank(newlines=False)
             if self.peek() in ('"', "'"):
-                parts.append(self.string())
+                parts.append(_decoded(self.peek(), self.string()))
             else:
                 start = self.pos
                 while not self.at_end() and self.peek() in _BARE:
