@@ -11,6 +11,7 @@ import scipy.sparse as sp
 
 import splinedeform as sd
 from splinedeform.errors import InputError
+from splinedeform import spectrum
 from splinedeform.solvers import modal_basis as mb
 
 MATERIAL = sd.Material(mass=1.7, damping=0.3, rayleigh=1e-3, w10=2.0, w01=1.0, w20=0.5,
@@ -45,7 +46,7 @@ def model_for(case, material=MATERIAL, cells=(7, 9)):
 @pytest.mark.parametrize("case", CASES)
 def test_separable_factors_reproduce_the_assembled_matrices(case):
     model = model_for(case)
-    A_u, B_u, A_v, B_v = mb.separable_matrices(model)
+    A_u, B_u, A_v, B_v = mb.separable_matrices(model.kronecker_factors())
     M, _, K = model.matrices()
     K_sep = np.kron(A_u, B_v) + np.kron(B_u, A_v)
     assert np.abs(K_sep - K.toarray()).max() <= 1e-12 * np.abs(K).max()
@@ -79,9 +80,9 @@ def test_separable_and_dense_paths_agree(case):
 
 def test_auto_chooses_separable_above_the_dense_limit(monkeypatch):
     model = model_for("open clamped")
-    assert mb.choose(model) == "dense"                 # small nets: the dense reference
+    assert spectrum.choose(model) == "dense"                 # small nets: the dense reference
     monkeypatch.setattr(mb, "DENSE_LIMIT", 10)
-    assert mb.choose(model) == "separable"
+    assert spectrum.choose(model) == "separable"
     reference = model.modal_basis("dense")
     lam, phi = model.eigen(5)
     assert np.allclose(lam, reference.lam[:5], rtol=1e-10, atol=0)
@@ -104,12 +105,12 @@ def test_separable_path_is_refused_with_the_reason(change, words, monkeypatch):
         fixed = (g[:, None] - 0.5) ** 2 + (g[None, :] - 0.5) ** 2 > 0.3**2
     model = sd.Model(surf, change.get("material", MATERIAL), boundary="clamped", fixed=fixed,
                      mass_matrix=change.get("mass_matrix", "consistent"))
-    assert words in mb.separable_reason(model)
+    assert words in spectrum.separable_reason(model)
     with pytest.raises(InputError, match=words):
         model.dynamic(LOAD, 1.0, eigensolver="separable")
     monkeypatch.setattr(mb, "DENSE_LIMIT", 10)
-    assert mb.choose(model) == "dense"
-    assert mb.choose(model, truncated=True) == "sparse"
+    assert spectrum.choose(model) == "dense"
+    assert spectrum.choose(model, truncated=True) == "sparse"
 
 
 def general_model(**kwargs):

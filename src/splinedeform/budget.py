@@ -135,8 +135,6 @@ def show(resource: str, amount: float) -> str:
 
 def estimate(scenario: Any, model: Any) -> Estimate:
     """Resources of running ``scenario`` with its built ``model`` (see the module docstring)."""
-    from .solvers import modal_basis
-
     solve, output = scenario.solve, scenario.output
     formats = set(output.formats)
     F = len(solve.frame_times()) if solve.kind == "dynamic" else solve.frames
@@ -158,7 +156,7 @@ def estimate(scenario: Any, model: Any) -> Estimate:
         stages.append(Term(F * IMAGE_BYTES, f"{F} animation images of 640 x 480",
                            (frames_key, fmt)))
     dense = solve.kind != "static" and (solve.method == "analytic" or solve.modes > 0) \
-        and _strategy(model, modal_basis) == "dense"
+        and _strategy(model) == "dense"
     if dense:
         stages.append(Term(32.0 * n * n, f"dense eigenproblem of {n} free coordinates",
                            ("surface.cells", "boundary")))
@@ -231,9 +229,11 @@ def highest_frequency(model: Any) -> float:
     return float(np.sqrt(ratio.max()))
 
 
-def _strategy(model: Any, modal_basis: Any) -> str:
+def _strategy(model: Any) -> str:
+    from .spectrum import choose
+
     try:
-        return str(modal_basis.choose(model, "auto", truncated=False))
+        return str(choose(model, "auto", truncated=False))
     except InputError:       # too large for dense: the solver says so itself
         return "none"
 

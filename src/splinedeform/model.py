@@ -29,10 +29,10 @@ from .physics import PHYSICS, intrinsic
 from .quadrature import gram_matrix
 from . import modal_solve
 from .modal_solve import check_count as _check_count
-from .solution import ModalSolution, StaticSolution
-from .solvers import modal_basis, rigid
-from .solvers.kronecker_eigen import kronecker_reason
-from .solvers.rigid import UnresolvedSpectrum
+from .solution import ModalSolution, SampledSolution, StaticSolution
+from . import spectrum
+from .solvers import modal_basis, numeric
+from .solvers.system import KroneckerFactors, Reduction
 from .surface import Surface
 
 Array = NDArray[np.float64]
@@ -180,6 +180,13 @@ class Model:
         full = self.constraints.T @ d_free
         return np.asarray(full).reshape(self.surface.shape + np.shape(d_free)[1:])
 
+    @property
+    def reduction(self) -> Reduction:
+        """The constraint map and load offset the solvers reduce loads with."""
+        rest = self._reduce_force(np.zeros((self.constraints.T.shape[0], 3))) \
+            if self.rest == "none" else None
+        return Reduction(self.constraints.T, self.surface, rest)
+
     def load_vector(self, load: Load, t: float = 0.0) -> Array:
         """Reduced generalised force ``Tᵀ (F(t) [- K p0 when rest='none'])``, shape ``(n_free, 3)``."""
         F = as_load(load).vector(self.surface, t)
@@ -258,29 +265,9 @@ class Model:
         up to ``DENSE_MAX`` (see :mod:`splinedeform.solvers.modal_basis`). A few modes
         (``k <= n/10``, ``n >= 400``) of a net whose modes are not yet known come from
         sparse Lanczos too unless the separable factors apply: ``O(n k²)`` against the
-        ``O(n³)`` of all modes. Cached.
+        ``O(n³)`` of all modes. Cached (:mod:`splinedeform.spectrum`).
         """
-        n = self.n_free
-        if k is not None:
-            k = _check_count(k, n)
-        strategy = modal_basis.choose(self, "auto", truncated=k is not None and k <= n // 2)
-        few = k is not None and n >= 400 and k <= n // 10
-        if (strategy == "dense" and few and not any(key[1:] == (None, None) for key in self._bases)
-                and modal_basis.separable_reason(self) is not None):
-            strategy = "sparse"
-        if strategy == "sparse":
-            sparse = self.modal_basis("sparse", modes=k)
-            assert isinstance(sparse, modal_basis.DenseBasis)
-            return sparse.lam, sparse.phi
-        basis = self.modal_basis("auto" if strategy == "dense" else strategy)
-        if isinstance(basis, modal_basis.DenseBasis):
-            return basis.lam[:k], basis.phi[:, :k]
-        if k is None and n > modal_basis.DENSE_MAX:
-            raise InputError(f"all {n} modes as an explicit matrix need "
-                             f"{8 * n * n / 2**30:.1f} GiB; ask for the lowest k modes, or "
-                             "use dynamic(), which keeps the Kronecker factors")
-        order = np.argsort(basis.lam, kind="stable")[:k]
-        return basis.lam[order], basis.columns(order)
+        return spectrum.eigen(self, None if k is None else _check_count(k, self.n_free))
 
     def modal_basis(self, eigensolver: str = "auto", modes: int | None = None,
                     omega_max: float | None = None) -> modal_basis.ModalBasis:
@@ -293,38 +280,11 @@ class Model:
         modes, omega_max : optional
             Keep only the lowest ``modes`` modes, or those with ``ω <= omega_max``.
         """
-        truncated = modes is not None or omega_max is not None
-        strategy = modal_basis.choose(self, eigensolver, truncated)
-        key = (strategy, modes, omega_max)
-        if key in self._bases:
-            return self._bases[key]
-        start = time.perf_counter()
-        if strategy == "sparse":
-            basis: modal_basis.ModalBasis = modal_basis.sparse_basis(
-                self._K, self._M, modes, omega_max, self.rigid_modes, self._eigen_advice())
-        elif truncated:
-            basis = modal_basis.truncate(self.modal_basis(eigensolver), modes, omega_max)
-        else:
-            try:
-                basis = self._complete_basis(strategy)
-            except UnresolvedSpectrum:
-                if eigensolver != "auto" or modal_basis.separable_reason(self) is not None:
-                    raise
-                basis = self._complete_basis("separable")   # resolves each direction apart
-        self._bases[key] = basis
-        self.timings["eigen"] = time.perf_counter() - start
-        return basis
+        return spectrum.modal_basis_of(self, eigensolver, modes, omega_max)
 
-    def _complete_basis(self, strategy: str) -> modal_basis.ModalBasis:
-        if strategy == "separable":
-            return modal_basis.separable_basis(self)
-        if kronecker_reason(self) is None:
-            basis = modal_basis.kronecker_basis(self, self.rigid_modes, self._eigen_advice())
-        else:
-            basis = modal_basis.dense_basis(self._K, self._M, self.rigid_modes,
-                                            self._eigen_advice())
-        self._eigen = (basis.lam, basis.phi)
-        return basis
+    def kronecker_factors(self) -> KroneckerFactors:
+        """The reduced 1-D Gram factors of ``M_r`` and ``K_r`` (:mod:`splinedeform.spectrum`)."""
+        return spectrum.kronecker_factors(self)
 
     @property
     def rigid_modes(self) -> int | None:
@@ -332,14 +292,8 @@ class Model:
         constraints, not from eigenvalues (:func:`~splinedeform.solvers.rigid.rigid_count`);
         ``None`` where no structure is known (intrinsic plate without tension)."""
         if self._rigid is None:
-            self._rigid = (rigid.rigid_count(self),)
+            self._rigid = (spectrum.rigid_count(self),)
         return self._rigid[0]
-
-    def _eigen_advice(self) -> str:
-        advice = modal_basis.DEFAULT_ADVICE
-        if modal_basis.separable_reason(self) is None:
-            advice += ", or eigensolver='separable', which resolves each direction apart"
-        return advice
 
     def frequencies(self, k: int = 6) -> Array:
         """Lowest ``k`` undamped angular frequencies ``ω_i = √λ_i``, ascending."""
@@ -404,8 +358,6 @@ class Model:
             Radau default one, gen-α default ``dt = t_end/2000``), gen-α ``rho_inf``.
             ``solve_ivp`` methods: ``rtol``, ``atol``, ``max_step``.
         """
-        from .solvers import numeric
-
         if method not in METHODS:
             raise InputError(f"unknown method {method!r}; choose one of {METHODS}")
         try:
@@ -421,7 +373,19 @@ class Model:
             if options.get("tolerance") is not None:
                 options["times"] = times
             return self._analytic(forcing, t_end, d0, v0, **options)
-        return numeric.integrate(self, forcing, method, t_end, times, d0, v0, **options)
+        start = time.perf_counter()
+        M, C, K = self.matrices()
+        out_times, d, v, stats = numeric.run(M, C, K, forcing, forcing.breakpoints, method,
+                                             t_end, times, d0, v0, **options)
+        return self.sampled_solution(method, t_end, forcing, out_times, d, v, stats,
+                                     time.perf_counter() - start)
+
+    def sampled_solution(self, method: str, t_end: float, forcing: Any, times: Array,
+                         d: Array, v: Array, stats: dict, seconds: float) -> SampledSolution:
+        """States of a numerical method at ``times`` read out as a solution of this model."""
+        timings = dict(self.timings)
+        timings["integration"] = seconds
+        return SampledSolution(self, method, t_end, forcing, timings, times, d, v, stats)
 
     def _analytic(self, forcing: Any, t_end: float, d0: Array, v0: Array,
                   **options: Any) -> ModalSolution:

@@ -15,7 +15,7 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 if TYPE_CHECKING:
-    from .modal_basis import ModalBasis
+    from .bases import ModalBasis
 
 Array = NDArray[np.float64]
 

@@ -9,14 +9,16 @@
 * ``radau3``/``radau5``/``radau7`` and ``genalpha`` take the matrices directly
   (:func:`.radau.radau`, :func:`.genalpha.genalpha`).
 
-Both restart at the load's breakpoints (steps and switches), so discontinuities do not cost
-accuracy, and return a :class:`~splinedeform.solution.SampledSolution` at the output times.
+All restart at the load's breakpoints (steps and switches), so discontinuities do not cost
+accuracy. :func:`run` takes the reduced matrices, the forcing and the output times and
+returns the states at those times; the model wraps them in a
+:class:`~splinedeform.solution.SampledSolution`.
 """
 
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING, Any
+from typing import Any, Callable
 
 import numpy as np
 import scipy.linalg as sla
@@ -26,80 +28,15 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import solve_ivp
 
 from ..errors import InputError
-from ..loads import Harmonic, Load
-from ..solution import SampledSolution
+from .forcing import ReducedForcing  # noqa: F401 (public here too)
 from .genalpha import genalpha
 from .radau import radau
 from .stepping import active_columns
-
-if TYPE_CHECKING:
-    from ..model import Model
 
 Array = NDArray[np.float64]
 IVP_METHODS = {"rk45": "RK45", "dop853": "DOP853", "radau": "Radau", "bdf": "BDF"}
 RADAU_METHODS = {"radau3": 3, "radau5": 5, "radau7": 7}
 ONE_STEP_METHODS = (*RADAU_METHODS, "genalpha")
-
-
-class ReducedForcing:
-    """The reduced load ``F_r(t) = Σ_terms s(t) Tᵀ F_term(t)`` of a model.
-
-    Spatial vectors of loads whose field does not change in time are computed once.
-    Callable: ``forcing(t) -> (n_free, 3)``.
-    """
-
-    def __init__(self, model: Model, load: Load):
-        self.model = model
-        self.terms = load.terms()
-        self._fixed = [None if term.time_dependent_field
-                       else np.asarray(model.constraints.T.T @ term.field_vector(model.surface))
-                       for term in self.terms]
-        self._rest = (model._reduce_force(np.zeros((model.constraints.T.shape[0], 3)))
-                      if model.rest == "none" else None)
-        self.breakpoints = load.breakpoints()
-
-    def _field(self, i: int, t: float) -> Array:
-        fixed = self._fixed[i]
-        if fixed is not None:
-            return fixed
-        full = self.terms[i].field_vector(self.model.surface, t)
-        return np.asarray(self.model.constraints.T.T @ full)
-
-    def __call__(self, t: float) -> Array:
-        out = np.zeros((self.model.n_free, 3)) if self._rest is None else self._rest.copy()
-        for i, term in enumerate(self.terms):
-            scale = float(term.profile(t))
-            if scale:
-                out += scale * self._field(i, t)
-        return out
-
-    def modal_terms(self, phi: Array, t_end: float, samples: int
-                    ) -> tuple[list[tuple[float, Array]], list[tuple[float, float, Array]]]:
-        """Modal jumps ``(t_j, Φᵀ ΔF_j)`` and harmonic terms ``(Ω, φ, Φᵀ F)``.
-
-        Time-dependent fields are sampled at ``samples`` interval midpoints on ``[0, t_end]``
-        (piecewise constant in time, first-order accurate in the interval width).
-        """
-        jumps: list[tuple[float, Array]] = []
-        harmonics: list[tuple[float, float, Array]] = []
-        if self._rest is not None:
-            jumps.append((0.0, phi.T @ self._rest))
-        edges = np.linspace(0.0, t_end, int(samples) + 1)
-        for i, term in enumerate(self.terms):
-            jumps_of_profile = term.profile.jumps()
-            if self._fixed[i] is not None and jumps_of_profile is not None:
-                g = phi.T @ self._fixed[i]
-                jumps += [(t_j, ds * g) for t_j, ds in jumps_of_profile]
-            elif self._fixed[i] is not None and isinstance(term.profile, Harmonic):
-                harmonics.append((term.profile.omega, term.profile.phase, phi.T @ self._fixed[i]))
-            else:
-                mids = 0.5 * (edges[:-1] + edges[1:])
-                values = [phi.T @ (float(term.profile(tm)) * self._field(i, tm)) for tm in mids]
-                previous = np.zeros_like(values[0])
-                for t_j, value in zip(edges[:-1], values):
-                    jumps.append((float(t_j), value - previous))
-                    previous = value
-        return jumps, harmonics
 
 
 def _output_times(times: ArrayLike | None, t_end: float) -> Array:
@@ -122,33 +59,52 @@ def _left_limit(a: float, b: float) -> float:
     return b - 1e-12 * (b - a)
 
 
-def integrate(model: Model, forcing: ReducedForcing, method: str, t_end: float,
-              times: ArrayLike | None, d0: Array, v0: Array, **options: Any) -> SampledSolution:
-    """Run a numerical method and return its solution at the output times."""
+def run(M: sp.spmatrix, C: sp.spmatrix, K: sp.spmatrix, forcing: Callable[[float], Array],
+        breakpoints: list[float], method: str, t_end: float, times: ArrayLike | None,
+        d0: Array, v0: Array, **options: Any) -> tuple[Array, Array, Array, dict]:
+    """Integrate ``M d'' + C d' + K d = F(t)`` with ``method`` to the output ``times``.
+
+    Returns ``(times, d, v, stats)`` with ``d``, ``v`` of shape ``(F, n, 3)`` at the checked
+    output times (default 201 evenly spaced on ``[0, t_end]``).
+    """
     out_times = _output_times(times, t_end)
-    start = time.perf_counter()
     if method == "newmark":
-        d, v, stats = newmark(model, forcing, t_end, out_times, d0, v0, **options)
+        d, v, stats = newmark(M, C, K, forcing, breakpoints, t_end, out_times, d0, v0,
+                              **options)
     elif method in ONE_STEP_METHODS:
-        M, C, K = model.matrices()
         try:
             if method == "genalpha":
-                d, v, stats = genalpha(M, C, K, forcing, forcing.breakpoints, t_end, out_times,
+                d, v, stats = genalpha(M, C, K, forcing, breakpoints, t_end, out_times,
                                        d0, v0, **options)
             else:
-                d, v, stats = radau(M, C, K, forcing, forcing.breakpoints, t_end, out_times,
+                d, v, stats = radau(M, C, K, forcing, breakpoints, t_end, out_times,
                                     d0, v0, stages=RADAU_METHODS[method], **options)
         except (TypeError, ValueError) as exc:
             raise InputError(f"method {method!r}: {exc}") from None
     else:
-        d, v, stats = ivp(model, forcing, IVP_METHODS[method], t_end, out_times, d0, v0, **options)
-    timings = dict(model.timings)
-    timings["integration"] = time.perf_counter() - start
-    return SampledSolution(model, method, t_end, forcing, timings, out_times, d, v, stats)
+        d, v, stats = ivp(M, C, K, forcing, breakpoints, IVP_METHODS[method], t_end,
+                          out_times, d0, v0, **options)
+    return out_times, d, v, stats
 
 
-def newmark(model: Model, forcing: ReducedForcing, t_end: float, out_times: Array,
-            d0: Array, v0: Array, dt: float | None = None) -> tuple[Array, Array, dict]:
+def integrate(system: Any, forcing: ReducedForcing, method: str, t_end: float,
+              times: ArrayLike | None, d0: Array, v0: Array, **options: Any) -> Any:
+    """:func:`run` on ``system.matrices()``, wrapped by ``system.sampled_solution``.
+
+    For callers that hold a model (``system``): the model reads out the states as a
+    :class:`~splinedeform.solution.SampledSolution` with the integration's time.
+    """
+    start = time.perf_counter()
+    M, C, K = system.matrices()
+    out_times, d, v, stats = run(M, C, K, forcing, forcing.breakpoints, method, t_end, times,
+                                 d0, v0, **options)
+    return system.sampled_solution(method, t_end, forcing, out_times, d, v, stats,
+                                   time.perf_counter() - start)
+
+
+def newmark(M: sp.spmatrix, C: sp.spmatrix, K: sp.spmatrix, forcing: Callable[[float], Array],
+            breakpoints: list[float], t_end: float, out_times: Array, d0: Array, v0: Array,
+            dt: float | None = None) -> tuple[Array, Array, dict]:
     """Average-acceleration Newmark with steps of at most ``dt`` hitting every output time.
 
     Update: ``K_eff d₊ = F₊ + M (4/Δt² d + 4/Δt v + a) + C (2/Δt d + v)``, then
@@ -159,10 +115,9 @@ def newmark(model: Model, forcing: ReducedForcing, t_end: float, out_times: Arra
     dt = float(dt)
     if not np.isfinite(dt) or dt <= 0:
         raise InputError(f"Newmark step dt must be finite and > 0, got {dt}")
-    M, C, K = model.matrices()
     mass_lu = spla.splu(M)
     factors: dict[float, Any] = {}
-    stops = np.union1d(out_times, [t for seg in _segments(forcing.breakpoints, t_end) for t in seg])
+    stops = np.union1d(out_times, [t for seg in _segments(breakpoints, t_end) for t in seg])
     stops = stops[np.concatenate([[True], np.diff(stops) > 1e-9 * t_end])]   # merge near-equal
     d, v = d0.copy(), v0.copy()
     acc = lambda t, d, v: mass_lu.solve(forcing(t) - C @ v - K @ d)  # noqa: E731
@@ -195,7 +150,8 @@ def newmark(model: Model, forcing: ReducedForcing, t_end: float, out_times: Arra
     return d_out, v_out, {"steps": steps, "factorisations": len(factors)}
 
 
-def ivp(model: Model, forcing: ReducedForcing, method: str, t_end: float, out_times: Array,
+def ivp(M: sp.spmatrix, C: sp.spmatrix, K: sp.spmatrix, forcing: Callable[[float], Array],
+        breakpoints: list[float], method: str, t_end: float, out_times: Array,
         d0: Array, v0: Array, rtol: float = 1e-8, atol: float = 1e-12,
         max_step: float = np.inf) -> tuple[Array, Array, dict]:
     """``solve_ivp`` on ``y = (d_c, v_c)`` for the moving coordinates ``c``, restarted at
@@ -203,10 +159,9 @@ def ivp(model: Model, forcing: ReducedForcing, method: str, t_end: float, out_ti
     for name, value in (("rtol", rtol), ("atol", atol)):
         if not np.isfinite(value) or value <= 0:
             raise InputError(f"{name} must be finite and > 0, got {value}")
-    M, C, K = model.matrices()
-    n = model.n_free
+    n = M.shape[0]
     mass_lu = spla.splu(M)
-    cols = active_columns(forcing, forcing.breakpoints, t_end, d0, v0)
+    cols = active_columns(forcing, breakpoints, t_end, d0, v0)
     m = len(cols)
 
     def rhs(t: float, y: Array) -> Array:
@@ -222,7 +177,7 @@ def ivp(model: Model, forcing: ReducedForcing, method: str, t_end: float, out_ti
     d_out, v_out = np.zeros((out_times.size, n, 3)), np.zeros((out_times.size, n, 3))
     stats = {"nfev": 0, "njev": 0, "nlu": 0, "columns": m}
     filled = 0
-    for ta, tb in _segments(forcing.breakpoints, t_end):
+    for ta, tb in _segments(breakpoints, t_end):
         last = tb == t_end
         inside = out_times[(out_times >= ta) & ((out_times <= tb) if last else (out_times < tb))]
         if not m:

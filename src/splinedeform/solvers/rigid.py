@@ -104,24 +104,25 @@ def parametric_terms(material: Any) -> list[tuple[int, int]]:
     return [ab for w, ab in pairs if w]
 
 
-def rigid_count(model: Any) -> int | None:
-    """Dimension of ``null K_r`` from the weights and the constraints (``None``: unknown).
+def rigid_count(terms: list[tuple[int, int]] | None, basis_u: Any, basis_v: Any,
+                constraints: Any) -> int | None:
+    """Dimension of ``null K_r`` from the stiffness terms and the constraints.
 
-    See the module docstring. ``None`` only for the intrinsic plate without tension, whose
-    energy vanishes on discrete harmonic fields.
+    ``terms`` are the derivative orders ``(a, b)`` of the terms ``G_a ⊗ G_b`` of ``K`` with
+    non-zero weight (:func:`parametric_terms`; ``[(1, 0), (0, 1)]`` for the intrinsic plate
+    under tension, whose energy vanishes on constants only); ``None`` where no structure is
+    known (the intrinsic plate without tension, whose energy vanishes on discrete harmonic
+    fields): then the count is ``None``. ``constraints`` has ``T``, ``free_index`` and, for
+    per-edge constraints, ``T_u`` and ``T_v``. See the module docstring.
     """
-    c = model.constraints
-    if model.physics == "intrinsic":
-        if model.material.w10 == 0:
-            return None
-        terms = [(1, 0), (0, 1)]           # T |∇_S d|²: zero on constants only
-    else:
-        terms = parametric_terms(model.material)
+    if terms is None:
+        return None
+    c = constraints
     cells = _allowed(terms)
     if not cells:
         return 0
-    chain_u = polynomial_chain(model.surface.basis_u)
-    chain_v = polynomial_chain(model.surface.basis_v)
+    chain_u = polynomial_chain(basis_u)
+    chain_v = polynomial_chain(basis_v)
     if c.T_u is not None and c.T_v is not None:
         du, dv = _kept_dimensions(chain_u, c.T_u), _kept_dimensions(chain_v, c.T_v)
         eu = np.diff([0] + du)
