@@ -178,8 +178,11 @@ function_samples = 64
 formats = []
 """
 
+#: the free set listed point by point, as splinedeform sculpt paints it
+PAINTED = STATIC.replace('v1 = "pinned"\n', 'v1 = "pinned"\nfree_points = [[1, 1], [2, 2], [3, 3]]\n')
+
 COVERAGE = {"plane": PLANE, "newmark": NEWMARK, "modes": MODES, "static": STATIC,
-            "analytic": ANALYTIC}
+            "analytic": ANALYTIC, "painted": PAINTED}
 
 
 def shape_scenario(shape: str, params: dict[str, object]) -> str:

@@ -173,10 +173,13 @@ def build_load(scenario: Scenario) -> Any:
 
 
 def free_region_mask(scenario: Scenario, surface: Any) -> Any:
-    """``fixed`` mask (True = fixed): control points whose Greville point lies outside the box."""
+    """``fixed`` mask (True = fixed): control points whose Greville point lies outside the box,
+    or, with ``free_points``, every control point not listed."""
     boundary = scenario.boundary
     if not boundary.has_free_region:
         return None
+    if boundary.free_points is not None:
+        return _free_points_mask(scenario, surface.shape)
     inside = []
     for name, basis in (("u", surface.basis_u), ("v", surface.basis_v)):
         g = basis.greville()
@@ -187,6 +190,22 @@ def free_region_mask(scenario: Scenario, surface: Any) -> Any:
     if not moving.any():
         raise scenario.error("boundary.free_region", "no control point has its Greville "
                                                      "abscissae inside this box; widen it")
+    return ~moving
+
+
+def _free_points_mask(scenario: Scenario, shape: tuple[int, int]) -> Any:
+    """``fixed`` mask of ``boundary.free_points``; an index off the net names its entry."""
+    import numpy as np
+
+    points = scenario.boundary.free_points or ()
+    moving = np.zeros(shape, dtype=bool)
+    for n, (i, j) in enumerate(points, start=1):
+        if not (i < shape[0] and j < shape[1]):
+            raise scenario.error(f"boundary.free_points[{n}]",
+                                 f"[{i}, {j}] is not a control point of this surface: the net "
+                                 f"has {shape[0]} x {shape[1]} points, i in 0 .. {shape[0] - 1}"
+                                 f", j in 0 .. {shape[1] - 1}")
+        moving[i, j] = True
     return ~moving
 
 

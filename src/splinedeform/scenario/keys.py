@@ -52,6 +52,7 @@ FREE_REGION_KEYS: dict[str, Key] = _keys(S.FreeRegion)
 BOUNDARY_KEYS: dict[str, Key] = {
     **_keys(S.Boundary, EDGES),
     "free_region": Key(_table_value, None, S.Boundary.model_fields["free_region"].description),
+    **_keys(S.Boundary, ("free_points",)),
 }
 
 _PROFILED = tuple(S._Profiled.model_fields)

@@ -64,6 +64,8 @@ Time = Annotated[float, Strict(), Field(ge=0, le=TIME_MAX, allow_inf_nan=False)]
 Integer = Annotated[int, Strict()]
 Text = Annotated[str, Strict()]
 Pair = tuple[Real, Real]
+#: index of a control point along one direction of the net (from 0)
+NetIndex = Annotated[int, Strict(), Field(ge=0, le=100_000)]
 Cells = Annotated[int, Strict(), Field(ge=1, le=512)]
 Knots = Literal[KNOT_KINDS]  # type: ignore[valid-type]
 Preset = Literal[PRESETS + SHELL_EDGES]  # type: ignore[valid-type]
@@ -227,6 +229,12 @@ class Boundary(_Table):
             "inline table `{ u = [a, b], v = [c, d] }`: only control points whose Greville "
             "abscissae lie in this box move; all others are fixed at rest (the paper's reduced set"
             " of moving control points)"),
+        json_schema_extra={"doc_default": 'none (all move)'})
+    free_points: Optional[list[tuple[NetIndex, NetIndex]]] = Field(
+        None, title="[i, j] pairs", description=(
+            "the moving control points listed one by one, `[i, j]` = row `i` along u, column "
+            "`j` along v, from 0 (what `splinedeform sculpt` paints); all others are fixed at "
+            "rest; not with `free_region`"),
         json_schema_extra={"doc_default": 'none (all move)'})
 
 

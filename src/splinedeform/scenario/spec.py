@@ -71,13 +71,14 @@ class BoundarySpec:
     v1: str = "free"
     free_u: tuple[float, float] | None = None
     free_v: tuple[float, float] | None = None
+    free_points: tuple[tuple[int, int], ...] | None = None
 
     def edges(self) -> dict[str, str]:
         return {e: getattr(self, e) for e in EDGES}
 
     @property
     def has_free_region(self) -> bool:
-        return self.free_u is not None or self.free_v is not None
+        return self.free_u is not None or self.free_v is not None or self.free_points is not None
 
 
 @dataclass(frozen=True)

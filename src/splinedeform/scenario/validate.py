@@ -222,6 +222,15 @@ def _validate_boundary(raw: Mapping[str, Any], problems: _Problems,
                 problems.add(f"boundary.free_region.{key}",
                              f"expected [low, high] with low < high, got [{low:g}, {high:g}]")
             box[f"free_{key}"] = (low, high)
+    points = values.get("free_points")
+    if points is not None:
+        if region is not None:
+            problems.add("boundary.free_points", "give the moving control points either as a "
+                                                 "box (free_region) or as a list (free_points), "
+                                                 "not both")
+        elif not points:
+            problems.add("boundary.free_points", "is empty; list at least one [i, j] or leave "
+                                                 "the key out (then all control points move)")
     return BoundarySpec(**values, **box)
 
 

@@ -89,7 +89,11 @@ def scenario_to_toml(scenario: Scenario) -> str:
     boundary: list[tuple[str, Any]] = [(e, getattr(s.boundary, e)) for e in EDGES]
     region = {k: getattr(s.boundary, f"free_{k}") for k in "uv"
               if getattr(s.boundary, f"free_{k}") is not None}
-    out += _toml_table("[boundary]", boundary + ([("free_region", region)] if region else []))
+    if region:
+        boundary.append(("free_region", region))
+    if s.boundary.free_points is not None:
+        boundary.append(("free_points", [list(p) for p in s.boundary.free_points]))
+    out += _toml_table("[boundary]", boundary)
     for load in s.loads:
         out += _toml_table("[[load]]", _load_items(load))
     out += _toml_table("[solve]", _solve_items(s.solve))
