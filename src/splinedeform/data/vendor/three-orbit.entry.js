@@ -3,6 +3,6 @@ export {
   WebGLRenderer, Scene, PerspectiveCamera, BufferGeometry, BufferAttribute, Mesh,
   MeshPhongMaterial, LineSegments, LineBasicMaterial, Points, PointsMaterial,
   AmbientLight, DirectionalLight, HemisphereLight, Color, Box3, Vector3, Sphere, DoubleSide,
-  REVISION,
+  REVISION, ShaderMaterial,
 } from 'three';
 export { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
