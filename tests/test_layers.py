@@ -60,3 +60,26 @@ def test_the_check_sees_relative_lazy_and_type_only_imports():
               "    from ..loads import Step\n")
     names = imported_modules(source, PACKAGE / "solvers" / "numeric.py")
     assert {n.split(".")[1] for n in names if above(n)} == {"model", "solution", "cli"}
+
+
+def test_solutions_do_not_import_the_model():
+    """``solution.py`` reads out coefficients with a :class:`~splinedeform.solution.Readout`;
+    it imports nothing of the model or of its dispatch."""
+    path = PACKAGE / "solution.py"
+    names = imported_modules(path.read_text(), path)
+    dispatch = {"model", "modal_solve", "spectrum"}
+    assert not {n for n in names if n.startswith("splinedeform.") and n.split(".")[1] in dispatch}
+
+
+def test_a_solution_holds_its_readout_not_the_model():
+    import numpy as np
+
+    import splinedeform as sd
+
+    model = sd.Model(sd.shapes.plane(cells=(4, 4)), sd.Material(w10=1, w01=1),
+                     boundary="clamped")
+    load = sd.Uniform((0.0, 0.0, -1.0))
+    for sol in (model.static(load), model.dynamic(load, 1.0),
+                model.dynamic(load, 1.0, method="newmark", times=np.linspace(0, 1, 3))):
+        assert not hasattr(sol, "model")
+        assert isinstance(sol.readout, sd.solution.Readout)

@@ -59,7 +59,7 @@ def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
         truncation.update(tolerance=report["tolerance"], bound=report["bound"])
     timings = dict(model.timings)
     timings["modal setup"] = time.perf_counter() - start
-    return ModalSolution(model, t_end, forcing, timings, basis, response, truncation,
+    return ModalSolution(model.readout, t_end, forcing, timings, basis, response, truncation,
                          correction)
 
 def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Array,

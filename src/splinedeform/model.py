@@ -21,6 +21,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
+from .assembly import _largest, mass, stiffness  # noqa: F401 (public here too)
 from .boundary import Constraints, build_constraints
 from .errors import InputError, SingularSystemError
 from .loads import Load, as_load, static_time
@@ -29,7 +30,7 @@ from .physics import PHYSICS, intrinsic
 from .quadrature import gram_matrix
 from . import modal_solve
 from .modal_solve import check_count as _check_count
-from .solution import ModalSolution, SampledSolution, StaticSolution
+from .solution import ModalSolution, Readout, SampledSolution, StaticSolution
 from . import spectrum
 from .solvers import modal_basis, numeric
 from .solvers.system import KroneckerFactors, Reduction
@@ -41,28 +42,6 @@ METHODS = ("analytic", "newmark", "radau3", "radau5", "radau7", "genalpha", "rk4
 STATIC_TRUST = 1e-6
 """Largest estimated relative error accepted from an ill-conditioned static solve."""
 STEP_METHODS = ("newmark", "radau3", "radau5", "radau7", "genalpha")   # take a step dt
-
-
-def stiffness(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], material: Material
-              ) -> sp.csr_matrix:
-    """``K = w10 G1u⊗G0v + w01 G0u⊗G1v + w20 G2u⊗G0v + 2 w11 G1u⊗G1v + w02 G0u⊗G2v``."""
-    terms = [(material.w10, 1, 0), (material.w01, 0, 1), (material.w20, 2, 0),
-             (2 * material.w11, 1, 1), (material.w02, 0, 2)]
-    K = sp.csr_matrix((gram_u[0].shape[0] * gram_v[0].shape[0],) * 2)
-    for weight, a, b in terms:
-        if weight:
-            K = K + weight * sp.kron(gram_u[a], gram_v[b], format="csr")
-    return K.tocsr()
-
-
-def mass(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], density: float,
-         lumped: bool = False) -> sp.csr_matrix:
-    """``M = μ G0u⊗G0v``, or lumped: ``μ diag(rowsum G0u ⊗ rowsum G0v)``."""
-    if lumped:
-        rows = np.kron(np.asarray(gram_u[0].sum(axis=1)).ravel(),
-                       np.asarray(gram_v[0].sum(axis=1)).ravel())
-        return sp.diags(density * rows, format="csr")
-    return (density * sp.kron(gram_u[0], gram_v[0], format="csr")).tocsr()
 
 
 class Model:
@@ -187,6 +166,11 @@ class Model:
             if self.rest == "none" else None
         return Reduction(self.constraints.T, self.surface, rest)
 
+    @property
+    def readout(self) -> Readout:
+        """What a solution of this model needs to read out its free coordinates."""
+        return Readout(self.surface, self.constraints.T, self._M, self._K)
+
     def load_vector(self, load: Load, t: float = 0.0) -> Array:
         """Reduced generalised force ``Tᵀ (F(t) [- K p0 when rest='none'])``, shape ``(n_free, 3)``."""
         F = as_load(load).vector(self.surface, t)
@@ -220,7 +204,7 @@ class Model:
                 "points (fixed=mask)")
         F = self.load_vector(as_load(load), static_time(as_load(load), t))
         d = self._solve_stiffness(F)
-        return StaticSolution(self, d, F, {"static": time.perf_counter() - start})
+        return StaticSolution(self.readout, d, F, {"static": time.perf_counter() - start})
 
     def _solve_stiffness(self, F: Array) -> Array:
         message = ("the stiffness matrix is singular for these boundary conditions and weights "
@@ -385,14 +369,9 @@ class Model:
         """States of a numerical method at ``times`` read out as a solution of this model."""
         timings = dict(self.timings)
         timings["integration"] = seconds
-        return SampledSolution(self, method, t_end, forcing, timings, times, d, v, stats)
+        return SampledSolution(self.readout, method, t_end, forcing, timings, times, d, v, stats)
 
     def _analytic(self, forcing: Any, t_end: float, d0: Array, v0: Array,
                   **options: Any) -> ModalSolution:
         """Closed-form modal solution (:func:`splinedeform.modal_solve.analytic`)."""
         return modal_solve.analytic(self, forcing, t_end, d0, v0, **options)
-
-
-def _largest(A: sp.spmatrix) -> float:
-    """``max |A_ij|`` (0 for an empty matrix; NaN propagates)."""
-    return float(np.abs(A.data).max()) if A.nnz else 0.0

@@ -1,7 +1,8 @@
 """Solutions: the deformed control net, surface and energies at any requested time.
 
 A solution holds its state in the reduced (free) coordinates ``d_free`` of the constraint
-map ``d = T d_free``; control points are ``p(t) = p_rest + T d_free(t)`` (three coordinates
+map ``d = T d_free`` and a :class:`Readout` (the rest surface, ``T`` and the reduced ``M``,
+``K``), not the model; control points are ``p(t) = p_rest + T d_free(t)`` (three coordinates
 share ``T``). Energies follow DESIGN.md §1.4: kinetic ``½ Σ_c v_cᵀ M v_c``, strain
 ``½ Σ_c d_cᵀ K d_c``, work of the current load ``Σ_c F_c(t)ᵀ d_c`` and
 ``total = kinetic + strain - work`` (conserved for a constant load without damping).
@@ -10,17 +11,15 @@ share ``T``). Energies follow DESIGN.md §1.4: kinetic ``½ Σ_c v_cᵀ M v_c``,
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable
+from typing import Any, Callable
 
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
 from .errors import InputError
+from .solvers.bases import DenseBasis, ModalBasis
 from .surface import Surface
-
-if TYPE_CHECKING:
-    from .model import Model
 
 Array = NDArray[np.float64]
 
@@ -56,6 +55,30 @@ class Frames:
     points: Array | None
 
 
+@dataclass(frozen=True)
+class Readout:
+    """What a solution needs to read its free coordinates out as a surface.
+
+    Attributes
+    ----------
+    surface : Surface
+        The rest surface (control points ``p_rest``, bases for evaluation).
+    T : sparse ``(n_u n_v, n_free)``
+        The constraint map ``d = T d_free``.
+    M, K : sparse ``(n_free, n_free)``
+        Reduced mass and stiffness, for the energies.
+    """
+
+    surface: Surface
+    T: sp.spmatrix
+    M: sp.spmatrix
+    K: sp.spmatrix
+
+    def matrices(self) -> tuple[sp.spmatrix, sp.spmatrix]:
+        """``(M, K)``."""
+        return self.M, self.K
+
+
 def _check_times(t: ArrayLike, t_end: float | None = None) -> tuple[Array, bool]:
     arr = np.asarray(t, dtype=float)
     if arr.ndim > 1:
@@ -72,12 +95,17 @@ def _check_times(t: ArrayLike, t_end: float | None = None) -> tuple[Array, bool]
 class _Displaced:
     """Shared read-out of a state in free coordinates."""
 
-    model: Model
+    readout: Readout
+
+    @property
+    def rest(self) -> Surface:
+        """The rest surface the displacements are added to."""
+        return self.readout.surface
 
     def _full(self, d_free: Array) -> Array:
         """``p_rest + T d_free`` for ``d_free`` of shape ``(..., n_free, 3)`` → ``(..., n_u, n_v, 3)``."""
-        m = self.model
-        T = m.constraints.T
+        m = self.readout
+        T = m.T
         lead = d_free.shape[:-2]
         flat = np.moveaxis(d_free, -2, 0).reshape(T.shape[1], -1)
         full = np.moveaxis((T @ flat).reshape((T.shape[0],) + lead + (3,)), 0, -2)
@@ -87,8 +115,9 @@ class _Displaced:
 class StaticSolution(_Displaced):
     """Equilibrium ``K d = F`` of a model under a load (see :meth:`Model.static`)."""
 
-    def __init__(self, model: Model, d_free: Array, force_free: Array, timings: dict[str, float]):
-        self.model = model
+    def __init__(self, readout: Readout, d_free: Array, force_free: Array,
+                 timings: dict[str, float]):
+        self.readout = readout
         self.d_free = d_free
         self.force_free = force_free
         self.timings = timings
@@ -99,15 +128,15 @@ class StaticSolution(_Displaced):
 
     def surface(self) -> Surface:
         """The deformed surface."""
-        return self.model.surface.with_control_points(self.control_points(), name="static")
+        return self.rest.with_control_points(self.control_points(), name="static")
 
     def displacement(self, u: ArrayLike, v: ArrayLike) -> Array:
         """Displacement ``d(u, v)`` of surface points, shape ``S + (3,)``."""
-        net = self.control_points() - self.model.surface.control_points
-        return self.model.surface.derivative(u, v, control_points=net)
+        net = self.control_points() - self.rest.control_points
+        return self.rest.derivative(u, v, control_points=net)
 
     def energy(self) -> Energy:
-        K = self.model.matrices()[2]
+        K = self.readout.K
         strain = 0.5 * np.sum(self.d_free * (K @ self.d_free))
         work = np.sum(self.force_free * self.d_free)
         return Energy(np.array(0.0), np.array(strain), np.array(work))
@@ -126,9 +155,9 @@ class Solution(_Displaced):
 
     exact_between_frames = True
 
-    def __init__(self, model: Model, method: str, t_end: float,
+    def __init__(self, readout: Readout, method: str, t_end: float,
                  force_free: Callable[[float], Array], timings: dict[str, float]):
-        self.model = model
+        self.readout = readout
         self.method = method
         self.t_end = float(t_end)
         self._force_free = force_free
@@ -148,20 +177,20 @@ class Solution(_Displaced):
     def velocities(self, t: ArrayLike) -> Array:
         """Control point velocities, same shapes as :meth:`control_points`."""
         times, scalar = _check_times(t)
-        vel = self._full(self.state(times)[1]) - self.model.surface.control_points
+        vel = self._full(self.state(times)[1]) - self.rest.control_points
         return vel[0] if scalar else vel
 
     def surface(self, t: float) -> Surface:
         """The deformed surface at time ``t``."""
-        return self.model.surface.with_control_points(self.control_points(float(t)),
+        return self.rest.with_control_points(self.control_points(float(t)),
                                                       name=f"t={float(t):g}")
 
     def displacement(self, t: ArrayLike, u: ArrayLike, v: ArrayLike) -> Array:
         """Displacement of surface points: ``S + (3,)`` for scalar ``t``, ``(F,) + S + (3,)`` else."""
         times, scalar = _check_times(t)
-        nets = self.control_points(times) - self.model.surface.control_points
+        nets = self.control_points(times) - self.rest.control_points
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
-        E = self.model.surface.evaluation_matrix(u, v)
+        E = self.rest.evaluation_matrix(u, v)
         flat = np.moveaxis(nets.reshape(times.size, -1, 3), 0, 1).reshape(E.shape[1], -1)
         out = np.moveaxis((E @ flat).reshape(E.shape[0], times.size, 3), 1, 0)
         out = out.reshape((times.size,) + u.shape + (3,))
@@ -180,7 +209,7 @@ class Solution(_Displaced):
         nets = self.control_points(times_arr)
         if resolution is None:
             return Frames(times_arr, nets, None)
-        surf = self.model.surface
+        surf = self.rest
         cache = self._grid_matrices
         key = resolution if np.isscalar(resolution) else tuple(resolution)
         if key not in cache:
@@ -194,7 +223,7 @@ class Solution(_Displaced):
     def energy(self, t: ArrayLike) -> Energy:
         """Kinetic, strain and load-work energies at ``t`` (see the module docstring)."""
         times, scalar = _check_times(t)
-        M, _, K = self.model.matrices()
+        M, K = self.readout.M, self.readout.K
         d, v = self.state(times)
         kinetic = 0.5 * _quadratic(M, v)
         strain = 0.5 * _quadratic(K, d)
@@ -223,12 +252,10 @@ class ModalSolution(Solution):
 
     chunk_entries = 4_000_000
 
-    def __init__(self, model: Model, t_end: float, force_free: Callable[[float], Array],
+    def __init__(self, readout: Readout, t_end: float, force_free: Callable[[float], Array],
                  timings: dict[str, float], phi: Any, response: Callable, omitted: dict,
                  correction: Callable[[Array], Array] | None = None):
-        from .solvers.modal_basis import DenseBasis, ModalBasis
-
-        super().__init__(model, "analytic", t_end, force_free, timings)
+        super().__init__(readout, "analytic", t_end, force_free, timings)
         self.basis = phi if isinstance(phi, ModalBasis) else DenseBasis(response.lam, phi)
         self.response = response
         self.truncation = omitted
@@ -286,10 +313,10 @@ class SampledSolution(Solution):
 
     exact_between_frames = False
 
-    def __init__(self, model: Model, method: str, t_end: float,
+    def __init__(self, readout: Readout, method: str, t_end: float,
                  force_free: Callable[[float], Array], timings: dict[str, float],
                  times: Array, d: Array, v: Array, stats: dict):
-        super().__init__(model, method, t_end, force_free, timings)
+        super().__init__(readout, method, t_end, force_free, timings)
         self.times, self.d, self.v = times, d, v
         self.stats = stats
 

@@ -76,7 +76,8 @@ class ShellModalSolution(Solution):
     def __init__(self, model: Any, t_end: float, force_free: Callable[[float], Array],
                  timings: dict[str, float], basis: Any, response: Any, truncation: dict,
                  correction: Callable[[Array], Array] | None = None):
-        super().__init__(model, "analytic", t_end, force_free, timings)
+        super().__init__(model, "analytic", t_end, force_free, timings)   # reads .surface
+        self.model = model
         self.basis = basis
         self.response = response
         self.truncation = truncation
