@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .errors import InputError
 from .solution import ModalSolution
-from .solvers import modal_basis, mode_count
+from .solvers import modal_basis, mode_select
 from .solvers.analytic import ModalResponse
 
 if TYPE_CHECKING:
@@ -52,11 +52,12 @@ def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
     harmonics = [(w, phase, basis.project(F)) for w, phase, F in spatial[1]]
     response = ModalResponse(lam, c, basis.project(M @ d0), basis.project(M @ v0),
                              jumps, harmonics)
-    correction, truncation = None, {}
+    correction, truncation = report.pop("correction", None), {}
     if not basis.complete:
-        correction, truncation = _truncation(model, basis, spatial, d0, v0)
+        correction, truncation = _truncation(model, basis, spatial, d0, v0, correction)
     if report:
-        truncation.update(tolerance=report["tolerance"], bound=report["bound"])
+        truncation.update({key: report[key] for key in ("tolerance", "bound", "omitted_static",
+                                                        "static_residual") if key in report})
     timings = dict(model.timings)
     timings["modal setup"] = time.perf_counter() - start
     return ModalSolution(model.readout, t_end, forcing, timings, basis, response, truncation,
@@ -66,7 +67,8 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
                      t_end: float, tolerance: Any, times: ArrayLike | None,
                      modes: int | None, omega_max: float | None) -> dict[str, Any]:
     """Lowest modes meeting ``tolerance`` (relative M-norm at ``times``): the report of
-    :func:`~splinedeform.solvers.mode_count.automatic_basis` (``modes = n_free``: all)."""
+    :func:`~splinedeform.solvers.mode_select.automatic_basis` (``modes = n_free``: all),
+    with its static correction under ``"correction"``."""
     try:
         tolerance = float(tolerance)
     except (TypeError, ValueError):
@@ -80,12 +82,13 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
                          "rest on a model without rigid modes; give modes=k otherwise")
     at = np.linspace(0.0, t_end, 201) if times is None else np.asarray(times, dtype=float)
     m = model.material
-    basis, correction, report = mode_count.automatic_basis(
+    basis, correction, report = mode_select.automatic_basis(
         model._K, model._M, spatial[0], m.damping / m.mass, m.rayleigh, at, tolerance)
     if basis is None:
         report["modes"] = model.n_free
     else:
         model._bases[("sparse", report["modes"], None)] = basis
+        report["correction"] = correction
     return report
 
 def truncation_request(model: Model, modes: int | None, omega_max: float | None
@@ -105,8 +108,9 @@ def truncation_request(model: Model, modes: int | None, omega_max: float | None
     return modes, omega_max
 
 def _truncation(model: Model, basis: modal_basis.ModalBasis, spatial: tuple[list, list],
-                d0: Array, v0: Array) -> tuple[Any, dict[str, Any]]:
-    """Mode-acceleration correction and the truncation report of a truncated basis."""
+                d0: Array, v0: Array, correction: Any = None) -> tuple[Any, dict[str, Any]]:
+    """Mode-acceleration correction and the truncation report of a truncated basis
+    (``correction``: already computed with the basis, by the automatic mode count)."""
     report: dict[str, Any] = {
         "modes": basis.size, "n_free": model.n_free,
         "omega_max_kept": float(np.sqrt(basis.lam.max())),
@@ -117,6 +121,9 @@ def _truncation(model: Model, basis: modal_basis.ModalBasis, spatial: tuple[list
         report.update(static_correction=False, omitted_static=float("nan"),
                       static_residual=float("nan"))
         return None, report
+    if correction is not None:
+        report.update(static_correction=True)
+        return correction, report
     correction, indicators = modal_basis.mode_acceleration(basis, model._K, model._M,
                                                            *spatial)
     report.update(static_correction=True, **indicators)

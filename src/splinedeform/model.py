@@ -330,11 +330,12 @@ class Model:
             ``Function`` loads, default 400); ``modes`` (keep the lowest k modes) or
             ``omega_max`` (keep ``ω <= omega_max``), both with the exact static part of the
             omitted modes (mode acceleration) and a report in ``solution.truncation``;
-            ``tolerance`` (piecewise-constant loads from rest): the lowest modes, doubled
-            from 32 until an a-priori bound of the omitted modes' dynamic response at
-            ``times`` (default 201 on ``[0, t_end]``) is at most ``tolerance`` of the largest
-            static displacement in the M-norm (:mod:`splinedeform.solvers.mode_count`), the
-            bound reached in ``solution.truncation["bound"]``;
+            ``tolerance`` (piecewise-constant loads from rest): the fewest lowest modes for
+            which an a-priori bound of the omitted modes' dynamic response at ``times``
+            (default 201 on ``[0, t_end]``; one time for one state) is at most ``tolerance``
+            of the largest static displacement in the M-norm
+            (:mod:`splinedeform.solvers.mode_select`), the bound reached in
+            ``solution.truncation["bound"]``;
             ``eigensolver`` (``"auto"``, ``"dense"``, ``"separable"``, ``"sparse"``, see
             :func:`splinedeform.solvers.modal_basis.choose`). ``newmark``: ``dt``.
             ``radau3/5/7`` (Radau IIA, order 5/9/13) and ``genalpha``: ``dt`` or

@@ -22,13 +22,12 @@ at most 1 (its energy decays) and, with ``a = c/2``:
 
 ``E`` is the largest of these on a grid of :data:`GRID` values of ``λ`` over
 :data:`DECADES` decades from ``λ_{k+1}`` (the bounds vary smoothly in ``log λ``). The number
-of modes is doubled until ``max_t Σ_j ‖R_j‖_M E(t − t_j) ≤ tol · max_t ‖K⁻¹F(t)‖_M`` at the
+of modes must make ``max_t Σ_j ‖R_j‖_M E(t − t_j) ≤ tol · max_t ‖K⁻¹F(t)‖_M`` at the
 requested times: what it costs is set by the load's jumps and the damping, not by the net.
+The fewest modes meeting it are chosen in :mod:`.mode_select`.
 """
 
 from __future__ import annotations
-
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -75,42 +74,3 @@ def error_bound(norms: Array, jump_times: Array, lam_first: float, gamma: float,
         if r > 0 and np.any(on):
             out[on] += r * omitted_envelope(lam_first, gamma, beta, tau[on])
     return out
-
-
-def automatic_basis(K: Any, M: Any, jumps: list[tuple[float, Array]], gamma: float,
-                    beta: float, times: Array, tolerance: float, start: int = 32,
-                    advice: str = "") -> tuple[Any, Any, dict[str, Any]]:
-    """The lowest ``k`` modes, ``k`` doubled from ``start`` until the bound meets ``tolerance``.
-
-    Returns the basis, its static correction and a report (``modes``, ``bound``: the relative
-    bound reached, ``tolerance``). With ``k >= n/2`` all modes are cheaper: ``(None, None,
-    report)`` tells the caller to use the complete basis.
-    """
-    from . import modal_basis
-
-    n = K.shape[0]
-    merged: dict[float, Array] = {}
-    for t_j, F in jumps:
-        merged[t_j] = merged.get(t_j, 0.0) + F
-    jump_times = np.array(sorted(merged), dtype=float)
-    k = min(start, n // 2)
-    report: dict[str, Any] = {"tolerance": tolerance}
-    while k < n // 2:
-        basis = modal_basis.sparse_basis(K, M, k, None, 0, advice or modal_basis.DEFAULT_ADVICE)
-        correction, indicators = modal_basis.mode_acceleration(
-            basis, K, M, [(t, merged[float(t)]) for t in jump_times], [])
-        statics = np.cumsum([basis.static(merged[float(t)]) for t in jump_times], axis=0)
-        scale = max((_m_norm(M, s) for s in statics), default=0.0)
-        norms = np.array([_m_norm(M, part) for part in correction.jump_parts])
-        bound = error_bound(norms, jump_times, basis.first_omitted, gamma, beta, times)
-        relative = float(bound.max(initial=0.0)) / max(scale, 1e-300)
-        report.update(modes=k, bound=relative, **indicators)
-        if relative <= tolerance:
-            return basis, correction, report
-        k *= 2
-    report.update(modes=n, bound=0.0)
-    return None, None, report
-
-
-def _m_norm(M: Any, x: Array) -> float:
-    return float(np.sqrt(max(np.sum(x * (M @ x)), 0.0)))

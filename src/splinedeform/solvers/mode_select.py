@@ -1,0 +1,160 @@
+"""The fewest modes meeting a requested accuracy, from one sparse LU of ``K``.
+
+The bound is that of :mod:`.mode_count`: with the lowest ``m`` modes and the exact static
+part of the rest, a piecewise-constant load from rest is in error by at most
+
+.. math:: ‖e(t)‖_M ≤ Σ_j ‖R_j(m)‖_M \\, E(λ_{m+1}, t − t_j),
+          \\qquad E(λ_f, τ) = \\sup_{λ ≥ λ_f} |P_{11}(λ, c(λ), τ)|.
+
+What makes choosing ``m`` cheap:
+
+* **one factorisation** of ``K`` (:func:`.sparse_eigen.factorise`) serves the eigen-solution
+  (:func:`.sparse_eigen.lowest_modes`), the static solves ``K⁻¹ΔF_j`` of the bound and the
+  static part of the omitted modes in the solution; only the coordinates that are loaded
+  are solved;
+* **every m at once**: from ``k + 1`` computed modes, one explicit ``R_j(k)`` and the modal
+  static coefficients ``g_ij/λ_i`` give ``‖R_j(m)‖²_M = ‖R_j(k)‖²_M + Σ_{m<i≤k} (g_ij/λ_i)²``
+  for all ``m ≤ k`` (sums of squares, nothing cancels);
+* **one table of E**: :func:`.mode_count.decay_bound` on a log grid of ``λ`` (from ``λ_1``
+  over :data:`DECADES` decades, :data:`GRID` points, as :func:`.mode_count.omitted_envelope`)
+  at the distinct ``τ = t − t_j > 0``, with a running maximum from the top of the grid: row
+  ``i`` is the supremum over grid values ``≥ λ_i``. A cut-off between grid points reads the
+  row below it, the supremum over a larger set, so the bound is never lowered.
+
+So ``m`` is the smallest count whose bound meets the tolerance at the requested ``times``
+(one state: the fewest modes that time allows). When even all ``k`` computed modes miss it,
+``‖R(k)‖`` (which only decreases with more modes) gives the cut-off ``λ_c`` at which the
+bound would hold, and ``k`` grows to ``1.25 k λ_c/λ_{k+1}`` (a linear eigenvalue count, as
+for a membrane), by a factor between 2 and 4; the LU is kept.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import NDArray
+
+from .mode_acceleration import StaticCorrection
+from .mode_count import decay_bound
+from .rigid import check_resolved
+from .sparse_eigen import BlockLanczos, factorise
+
+Array = NDArray[np.float64]
+GRID = 3500
+DECADES = 14.0
+START = 16
+"""Modes computed first; the selection may keep fewer."""
+
+
+def envelope_table(lam_low: float, gamma: float, beta: float, tau: Array
+                   ) -> tuple[Array, Array]:
+    """``(grid, E)``: ``E[i, u] = max_{g ≥ i} |P_11|``-bound at ``grid[g]``, ``tau[u]``."""
+    grid = lam_low * np.logspace(0.0, DECADES, GRID)
+    values = decay_bound(grid[:, None], gamma + beta * grid[:, None], tau[None, :])
+    return grid, np.maximum.accumulate(values[::-1], axis=0)[::-1]
+
+
+def _m_norm2(M: sp.spmatrix, x: Array) -> float:
+    """``Σ_c x_cᵀ M x_c`` for ``x`` of shape ``(n, c)``."""
+    return float(max(np.sum(x * (M @ x)), 0.0))
+
+
+def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Array]],
+                    gamma: float, beta: float, times: Array, tolerance: float,
+                    start: int = START, advice: str = "") -> tuple[Any, Any, dict[str, Any]]:
+    """The fewest lowest modes whose a-priori bound (module docstring) meets ``tolerance``
+    relative to ``max_t ‖K⁻¹F(t)‖_M`` at ``times``.
+
+    Parameters
+    ----------
+    K, M : reduced stiffness (positive definite) and mass.
+    jumps : ``(t_j, ΔF_j)`` with ``ΔF_j`` of shape ``(n, 3)``: ``F(t) = Σ_j ΔF_j H(t − t_j)``.
+    gamma, beta : modal damping ``c(λ) = γ + βλ``.
+    times : the times at which the accuracy is wanted.
+
+    Returns
+    -------
+    basis, correction, report
+        A truncated :class:`~.modal_basis.DenseBasis` (its static solve is the LU), the
+        :class:`~.mode_acceleration.StaticCorrection` and a report (``modes``, ``bound``,
+        ``tolerance``, ``omitted_static``, ``static_residual``, ``computed``: modes found,
+        ``solves``). ``(None, None, report)`` when ``n/2`` modes or more would be needed:
+        all modes are cheaper then.
+    """
+    from .modal_basis import DEFAULT_ADVICE, DenseBasis
+
+    n = K.shape[0]
+    merged: dict[float, Array] = {}
+    for t_j, F in jumps:
+        merged[t_j] = merged.get(t_j, 0.0) + np.asarray(F, dtype=float)
+    jump_times = np.array(sorted(merged), dtype=float)
+    width = 3 if not merged else next(iter(merged.values())).shape[1]
+    loads = (np.array([merged[float(t)] for t in jump_times]) if merged
+             else np.zeros((0, n, width)))
+    active = np.flatnonzero(np.any(loads != 0, axis=(0, 1)))
+    F = loads[:, :, active]                                   # (J, n, a)
+    J, a = F.shape[0], active.size
+    report: dict[str, Any] = {"tolerance": tolerance}
+    lu = factorise(K)
+    flat = np.ascontiguousarray(F.transpose(1, 0, 2)).reshape(n, J * a)
+    statics = (np.asarray(lu.solve(flat)).reshape(n, J, a).transpose(1, 0, 2) if J * a
+               else np.zeros((J, n, a)))
+    scale = np.sqrt(max((_m_norm2(M, s) for s in np.cumsum(statics, axis=0)), default=0.0))
+    times = np.asarray(times, dtype=float)
+    tau_all = times[:, None] - jump_times[None, :]
+    tau, where = np.unique(np.where(tau_all > 0, tau_all, np.inf), return_inverse=True)
+    where = where.reshape(tau_all.shape)
+    top = float(np.max(K.diagonal() / M.diagonal()))
+    k = min(start, n // 2)
+    table: tuple[Array, Array] | None = None
+    krylov = BlockLanczos(K, M, lu)
+    while 1 <= k < n // 2:
+        modes = krylov.lowest(k)
+        lam = check_resolved(modes.lam, 0, "sparse eigen-solution",
+                             advice or DEFAULT_ADVICE, top)
+        k = lam.size - 1
+        if table is None:
+            grid, E = envelope_table(float(lam[0]), gamma, beta, tau[np.isfinite(tau)])
+            E = np.hstack([E, np.zeros((E.shape[0], 1))])      # τ ≤ 0: no contribution
+            table = (grid, E)
+        grid, E = table
+        coef = np.array([modes.project(f) for f in F]) / lam[None, :, None]  # g_ij/λ_i
+        rest = statics - np.array([modes.combine(c[:k]) for c in coef])
+        r2 = np.array([_m_norm2(M, r) for r in rest])                     # ‖R_j(k)‖²
+        tail = np.sum(coef[:, :k] ** 2, axis=2)                           # (J, k)
+        later = np.cumsum(tail[:, ::-1], axis=1)[:, ::-1]                  # Σ_{i ≥ m}
+        norms = np.sqrt(r2[:, None] + np.hstack([later, np.zeros((J, 1))]))  # m = 0..k
+        rows = np.searchsorted(grid, lam, side="right") - 1                # λ_{m+1} = lam[m]
+        column = where                      # (T, J) into E; τ ≤ 0 reads the zero column
+        bound = np.zeros((k + 1, times.size))
+        for j in range(J):
+            bound += norms[j, :, None] * E[rows][:, column[:, j]]
+        relative = bound.max(axis=1, initial=0.0) / max(scale, 1e-300)
+        fits = np.flatnonzero(relative[1:] <= tolerance) + 1
+        report.update(computed=k, solves=modes.solves)
+        if fits.size:
+            m = int(fits[0])
+            parts = statics - np.array([modes.combine(c[:m]) for c in coef])
+            jump_parts = np.zeros((J, n, width))
+            jump_parts[:, :, active] = parts
+            basis = DenseBasis(lam[:m], modes.columns(m), "sparse", False, lu.solve,
+                               float(lam[m]))
+            omitted = [np.sqrt(_m_norm2(M, p) / max(_m_norm2(M, s), 1e-300))
+                       for p, s in zip(parts, statics)]
+            residual = [np.linalg.norm(K @ s - f) / max(np.linalg.norm(f), 1e-300)
+                        for s, f in zip(statics, F)]
+            report.update(modes=m, bound=float(relative[m]),
+                          omitted_static=float(max(omitted, default=0.0)),
+                          static_residual=float(max(residual, default=0.0)))
+            return basis, StaticCorrection(jump_times, jump_parts, []), report
+        # the cut-off at which ‖R(k)‖ (an upper bound for more modes) meets the tolerance
+        at_grid = np.zeros((grid.size, times.size))
+        for j in range(J):
+            at_grid += norms[j, k] * E[:, column[:, j]]
+        ok = np.flatnonzero(at_grid.max(axis=1) <= tolerance * scale)
+        grow = 4.0 if not ok.size else 1.25 * grid[ok[0]] / lam[k]
+        k = int(min(max(grow, 2.0), 4.0) * k)
+    report.update(modes=n, bound=0.0)
+    return None, None, report
