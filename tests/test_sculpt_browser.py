@@ -313,3 +313,30 @@ def test_a_saved_page_works_offline(server, browser, tmp_path):
     assert "offline" in page.evaluate("sculptState.errors[0]")
     page.close()
     assert all(r.startswith("file:") for r in requests), requests    # nothing left the file
+
+
+def test_a_released_surface_comes_to_rest_and_is_no_longer_drawn(page):
+    """Released, the surface rings down; once its modal energy bounds every displacement
+    below 1e-6 of its size the page sets it to rest: every displacement is then exactly
+    zero (the state is zeroed, not a small remainder) and the frames that follow compute
+    and draw nothing (their modal-sum time is 0)."""
+    page.evaluate("sculptState.reset()")
+    at = page.evaluate(f"sculptState.screen({(R // 2) * R + R // 2})")
+    page.mouse.move(at["x"], at["y"])
+    page.mouse.down()
+    for step in range(1, 6):
+        page.mouse.move(at["x"], at["y"] + 8 * step)
+        page.wait_for_timeout(40)
+    page.mouse.up()
+    assert not page.evaluate("sculptState.resting")
+    page.evaluate("sculptState.setSpeed(3)")
+    try:
+        page.wait_for_function("sculptState.resting", timeout=60000)
+        t_rest = page.evaluate("performance.now()")
+        page.wait_for_timeout(400)
+        assert max(abs(d) for d in page.evaluate("sculptState.snapshot().displacement")) == 0.0
+        later = page.evaluate(f"sculptState.frames().filter((f) => f.at > {t_rest} + 100)")
+        assert later and all(f["sum"] == 0 for f in later)
+    finally:
+        page.evaluate("sculptState.setSpeed(1)")
+    assert not page.problems
