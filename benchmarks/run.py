@@ -2,12 +2,13 @@
 
     python benchmarks/run.py              # full study, writes benchmarks/results.md and .csv
     python benchmarks/run.py --quick      # smoke run, writes benchmarks/out/quick/results.md
-    python benchmarks/run.py --sizes 4,8,16,32 --budget 120
+    python benchmarks/run.py --sizes 8,16,32 --no-regimes
     python benchmarks/run.py --render-only   # rewrite the reports from the last bench.json
 
-Runs :func:`splinedeform.bench.main` (its own files go to ``benchmarks/out/…``), then
-``benchmarks/bench_evaluate.py``'s ``run(quick)`` when that file exists, prints the ratios
-numerical / analytic, and writes the results with a note on the machine.
+Runs :func:`splinedeform.bench.main` (BLAS on one thread; its own files go to
+``benchmarks/out/…``), then ``benchmarks/bench_evaluate.py``'s ``run(quick)`` when that file
+exists, prints each line's fastest method and the goals, and writes the results with a note
+on the machine.
 """
 
 from __future__ import annotations
@@ -16,12 +17,12 @@ import argparse
 import datetime
 import importlib.util
 import json
-import math
 import sys
 from pathlib import Path
 from typing import Any
 
-from splinedeform import bench, bench_goals
+from splinedeform import bench
+from splinedeform.bench.tables import verdict
 from splinedeform.export import write_text
 
 HERE = Path(__file__).resolve().parent
@@ -33,15 +34,15 @@ NOTE = ("Timings were taken on a shared 2-core machine while other work (test su
 def parse(argv: list[str] | None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     p.add_argument("--quick", action="store_true", help="smoke run (tiny nets)")
-    p.add_argument("--sizes", help="comma-separated cells per direction, e.g. 4,8,16,32,64")
+    p.add_argument("--sizes", help="comma-separated cells per direction, e.g. 8,16,32,64,128")
     p.add_argument("--budget", type=float, help="seconds per numerical run before stopping it")
     p.add_argument("--frames", type=int, help="number of frames")
-    p.add_argument("--no-goals", action="store_true", help="skip the goals at scale")
+    p.add_argument("--goals", action="store_true",
+                   help="also the goals of the analytic path at scale (separate processes)")
+    p.add_argument("--no-regimes", action="store_true",
+                   help="only regime a (cost against net size), not b–e")
     p.add_argument("--methods", help="comma-separated numerical methods (default: the study's)")
     p.add_argument("--families", help="comma-separated problem families (clamped, region)")
-    p.add_argument("--regimes", action="store_true",
-                   help="also the regimes of splinedeform.bench_goals (horizon, load cases, "
-                        "one state) and the goals of issue 10")
     p.add_argument("--note", default=NOTE, help="sentence on the machine for the results file")
     p.add_argument("--render-only", action="store_true",
                    help="rewrite the reports from the last run's bench.json, measuring nothing "
@@ -82,37 +83,17 @@ def _text(value: Any) -> str:
     return f"{value:.4g}" if isinstance(value, float) else str(value)
 
 
-def ratio_lines(rows: list[bench.Row]) -> list[str]:
-    """``family cells: method ratio`` per size, numerical / analytic (≈ when extrapolated)."""
-    lines = []
-    for family in dict.fromkeys(r.family for r in rows):
-        for cells in sorted({r.cells for r in rows if r.family == family}):
-            here = [r for r in rows if r.family == family and r.cells == cells
-                    and r.solver != "analytic"]
-            parts = [f"{r.solver} {'≈' if r.status != 'ok' else ''}{r.ratio:.3g}×"
-                     for r in here if math.isfinite(r.ratio)]
-            lines.append(f"{family:8s} {cells:3d}×{cells:<3d}: " + ", ".join(parts))
-    return lines
-
-
-def plate_ratios(rows: list[bench.Row]) -> dict[int, tuple[float, float, str]]:
-    """Per net size of the ``clamped`` family: (analytic s, fastest integrator s, its name);
-    a run stopped at the budget counts with its extrapolated cost when that is the lowest."""
-    plate: dict[int, tuple[float, float, str]] = {}
-    for cells in sorted({r.cells for r in rows if r.family == "clamped"}):
-        here = [r for r in rows if r.family == "clamped" and r.cells == cells]
-        analytic = [r for r in here if r.solver == "analytic"]
-        numerical = [r for r in here if r.solver != "analytic"]
-        if not analytic:
-            continue
-        guess = bench.fastest_estimate(numerical)
-        best = bench.fastest(numerical)
-        if guess is not None:
-            plate[cells] = (analytic[0].seconds, guess.estimate,
-                            f"{guess.solver} (extrapolated from {guess.progress:.0%} of t_end)")
-        elif best is not None:
-            plate[cells] = (analytic[0].seconds, best.seconds, best.solver)
-    return plate
+def verdict_lines(rows: list[bench.Row]) -> list[str]:
+    """``regime line cells: fastest method, how the analytic path fares`` per line."""
+    lines: dict[tuple, list[bench.Row]] = {}
+    for r in rows:
+        lines.setdefault(r.line, []).append(r)
+    out = []
+    for (regime, case, family, cells), line in lines.items():
+        name, fares = verdict(line)
+        label = f"{regime} {family if regime == 'size' else case}"
+        out.append(f"{label:42s} {cells:3d}²: fastest {name}; analytic path {fares}")
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -126,25 +107,13 @@ def main(argv: list[str] | None = None) -> int:
                   "goals": [bench.Goal(**g) for g in record["goals"]], "files": files}
     else:
         split = lambda text: None if text is None else [x.strip() for x in text.split(",")]  # noqa: E731
-        with bench_goals.blas_threads(1) as threads:
-            print(threads, flush=True)
-            result = bench.main(sizes=sizes, quick=args.quick, outdir=out, budget=args.budget,
-                                frames=args.frames, goals=False if args.no_goals else None,
-                                methods=split(args.methods), families=split(args.families))
-    regimes = ""
-    saved = out / "regimes.json"
-    record = None
-    if args.regimes and not args.render_only:
-        record = bench_goals.goals(say=lambda s: print(s, flush=True), quick=args.quick)
-        saved.write_text(json.dumps(record, indent=1, default=str), encoding="utf-8")
-    elif args.render_only and saved.is_file():
-        record = json.loads(saved.read_text(encoding="utf-8"))
-    if record is not None:
-        regimes = ("\n## Regimes and goals (`splinedeform.bench_goals`)\n\n"
-                   + bench_goals.markdown(record, plate_ratios(result["rows"])))
+        result = bench.main(sizes=sizes, quick=args.quick, outdir=out, budget=args.budget,
+                            frames=args.frames, goals=args.goals,
+                            regimes_too=False if args.no_regimes else None,
+                            methods=split(args.methods), families=split(args.families))
     evaluate, evaluated = evaluate_section(args.quick)
-    print("\nratios numerical / analytic (time to the same frames at the same accuracy):")
-    for line in ratio_lines(result["rows"]):
+    print("\nfastest method of each line:")
+    for line in verdict_lines(result["rows"]):
         print("  " + line)
     for row in evaluated if isinstance(evaluated, list) else []:
         if isinstance(row, dict) and "ratio" in row:
@@ -156,9 +125,10 @@ def main(argv: list[str] | None = None) -> int:
     study_md = result["files"]["markdown"].read_text(encoding="utf-8")
     body = study_md.replace("\n## ", "\n### ").replace("# Cost study", "## Cost study", 1)
     stamp = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
+    command = " ".join(sys.argv[1:]) if argv is None else " ".join(argv)
     text = (f"# Benchmark results\n\n{args.note}\n\nRun {stamp} with "
-            f"`python benchmarks/run.py{' ' + ' '.join(sys.argv[1:]) if argv is None and sys.argv[1:] else ''}`"
-            f"; plots in `{out.relative_to(HERE.parent)}`.\n\n{body}{regimes}{evaluate}")
+            f"`python benchmarks/run.py{' ' + command if command else ''}`"
+            f"; plots in `{out.relative_to(HERE.parent)}`.\n\n{body}{evaluate}")
     write_text(target / "results.md", text)
     write_text(target / "results.csv", bench.csv_text(result["rows"]))
     print(f"written: {target / 'results.md'}, {target / 'results.csv'}")

@@ -11,6 +11,8 @@ import numpy as np
 import pytest
 
 from splinedeform import bench
+from splinedeform.bench import analytic, bookkeeping, config, goals, regimes, search, tables, timing
+from splinedeform.bench.bookkeeping import Row
 from splinedeform.errors import InputError
 
 
@@ -26,8 +28,10 @@ def test_quick_run_writes_the_table_the_csv_and_the_plots(quick):
         assert (out / name).is_file(), name
     assert (out / "cost_clamped.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     text = (out / "bench.md").read_text()
-    assert "## Family `clamped`" in text and "## Family `region`" in text
-    assert "| cells | free | analytic set-up | per frame |" in text
+    assert "## a. Cost against net size, family `clamped`" in text
+    assert "## a. Cost against net size, family `region`" in text
+    assert "| cells | free | analytic (automatic modes) | modes (a-priori bound) |" in text
+    assert "BLAS threads limited to 1" in text and "load average" in text
     assert not list(out.glob(".*tmp*"))                       # atomic writes left nothing
 
 
@@ -45,22 +49,25 @@ def test_quick_run_errors_are_within_the_target(quick):
     target = bench.QUICK.target
     with open(out / "bench.csv", newline="") as f:
         rows = list(csv.DictReader(f))
-    analytic = [r for r in rows if r["solver"] == "analytic"]
-    assert len(analytic) == len(bench.QUICK.sizes) * len(bench.FAMILIES)
-    # every analytic solution was checked against DOP853 at rtol 1e-12 on the quick nets
-    for r in analytic:
-        assert float(r["error"]) <= target
+    full = [r for r in rows if r["solver"] == "analytic-all"]
+    assert len(full) == len(bench.QUICK.sizes) * len(bench.FAMILIES)
+    # every all-modes solution (the reference) was checked against DOP853 at rtol 1e-12
+    for r in full:
         assert float(r["error"]) < 1e-9
-    numerical = [r for r in rows if r["solver"] != "analytic"]
+    automatic = [r for r in rows if r["solver"] == "analytic"]
+    assert len(automatic) == len(full)
+    numerical = [r for r in rows if not r["solver"].startswith("analytic")]
     assert {r["solver"] for r in numerical} == set(bench.DEFAULT_METHODS)
-    for r in numerical:
+    for r in automatic + numerical:
         if r["status"] == "ok":
             assert float(r["error"]) <= target
-            assert math.isclose(float(r["ratio"]),
-                                float(r["seconds"]) / float(next(
-                                    a["seconds"] for a in analytic
-                                    if (a["family"], a["cells"]) == (r["family"], r["cells"]))),
-                                rel_tol=1e-4)
+    # ratios are against the fastest finished run of the same net (6 significant digits)
+    for r in rows:
+        line = [x for x in rows if (x["family"], x["cells"]) == (r["family"], r["cells"])
+                and x["status"] in ("ok", "exact")]
+        best = min(float(x["seconds"]) for x in line)
+        if r["status"] in ("ok", "exact"):
+            assert math.isclose(float(r["ratio"]), float(r["seconds"]) / best, rel_tol=1e-5)
 
 
 def test_free_counts_match_the_families(quick):
@@ -69,7 +76,7 @@ def test_free_counts_match_the_families(quick):
     assert clamped == {4: (4 + 3 - 4) ** 2, 6: (6 + 3 - 4) ** 2}     # two rows per edge fixed
     region = {r.cells: r.n_free for r in result["rows"] if r.family == "region"}
     for cells, n in region.items():
-        assert n == int((~bench.region_mask(cells)).sum())
+        assert n == int((~bench.cases.region_mask(cells)).sum())
 
 
 def test_numerical_error_is_measured_against_the_analytic_reference():
@@ -77,7 +84,7 @@ def test_numerical_error_is_measured_against_the_analytic_reference():
     t_end = bench.reference_t_end("clamped")
     case = bench.Case("clamped", 4, bench.build_model("clamped", 4), bench.study_load(t_end),
                       t_end, np.linspace(0.0, t_end, 11))
-    bench.run_analytic(case)
+    analytic.all_modes(case)
     loose = bench.attempt(case, "dop853", 2, 60.0)          # rtol 1e-4
     tight = bench.attempt(case, "dop853", 8, 60.0)          # rtol 1e-10
     assert not loose.stopped and not tight.stopped
@@ -90,11 +97,11 @@ def test_search_finds_the_coarsest_level_on_a_synthetic_error_law(monkeypatch):
 
     def fake(case, method, level, budget, opts=None):
         calls.append(level)
-        return bench.Attempt(level, 0.1 * 2**level, error=3.0 * 4.0 ** -level)
+        return timing.Attempt(level, 0.1 * 2**level, error=3.0 * 4.0 ** -level)
 
-    monkeypatch.setattr(bench, "attempt", fake)
+    monkeypatch.setattr(timing, "attempt", fake)
     study = bench.Study(target=1e-6)
-    tried, best = bench.search(None, "newmark", 1, study)
+    tried, best = search.search(None, "newmark", 1, study)
     assert best == 11 == min(k for k in range(20) if 3.0 * 4.0 ** -k <= 1e-6)
     assert 10 in tried and tried[10].error > 1e-6                 # the coarser one was checked
     assert len(calls) <= 6
@@ -106,58 +113,152 @@ def test_search_stops_loosening_when_it_no_longer_saves_time(monkeypatch):
 
     def fake(case, method, level, budget, opts=None):
         calls.append(level)
-        return bench.Attempt(level, 10.0, error=1e-8)
+        return timing.Attempt(level, 10.0, error=1e-8)
 
-    monkeypatch.setattr(bench, "attempt", fake)
-    _, best = bench.search(None, "dop853", 4, bench.Study(target=1e-6))
+    monkeypatch.setattr(timing, "attempt", fake)
+    _, best = search.search(None, "dop853", 4, bench.Study(target=1e-6))
     assert calls == [4, 3] and best in (3, 4)
 
 
 def test_search_stops_at_the_budget(monkeypatch):
     def fake(case, method, level, budget, opts=None):
         if level >= 4:
-            return bench.Attempt(level, budget, stopped=True, estimate=123.0)
-        return bench.Attempt(level, 1.0, error=10.0 ** -level)
+            return timing.Attempt(level, budget, stopped=True, estimate=123.0)
+        return timing.Attempt(level, 1.0, error=10.0 ** -level)
 
-    monkeypatch.setattr(bench, "attempt", fake)
-    tried, best = bench.search(None, "rk45", 2, bench.Study(target=1e-8))
+    monkeypatch.setattr(timing, "attempt", fake)
+    tried, best = search.search(None, "rk45", 2, bench.Study(target=1e-8))
     assert best is None and tried[max(tried)].stopped
 
 
 def test_fitted_slope_recovers_a_power_law_over_the_largest_nets():
-    rows = [bench.Row("clamped", c, n, "x", "ok", seconds=2e-6 * n**1.7)
+    rows = [Row("clamped", c, n, "x", "ok", seconds=2e-6 * n**1.7)
             for c, n in ((16, 225), (32, 961))]
-    rows.insert(0, bench.Row("clamped", 4, 9, "x", "ok", seconds=1.0))      # overhead only
-    rows.append(bench.Row("clamped", 64, 3969, "x", "over budget", seconds=30.0,
+    rows.insert(0, Row("clamped", 4, 9, "x", "ok", seconds=1.0))      # overhead only
+    rows.append(Row("clamped", 64, 3969, "x", "over budget", seconds=30.0,
                           estimate=2e-6 * 3969**1.7))
-    rows.append(bench.Row("clamped", 128, 16129, "x", "skipped", estimate=1e9))
-    assert bench.fitted_slope(rows) == pytest.approx(1.7, abs=1e-12)
+    rows.append(Row("clamped", 128, 16129, "x", "skipped", estimate=1e9))
+    assert bookkeeping.fitted_slope(rows) == pytest.approx(1.7, abs=1e-12)
 
 
 def test_runs_stopped_too_early_are_not_extrapolated():
-    analytic = bench.Row("clamped", 32, 961, "analytic", "exact", seconds=0.5)
     case = bench.Case("clamped", 32, bench.build_model("clamped", 32), None, 1.0, np.zeros(2))
-    early = {3: bench.Attempt(3, 90.0, stopped=True, estimate=9e4, progress=0.001)}
-    row = bench.numerical_row(case, "bdf", early, None, analytic)
+    early = {3: timing.Attempt(3, 90.0, stopped=True, estimate=9e4, progress=0.001)}
+    row = bookkeeping.numerical_row(case, "bdf", early, None, 0.25, "")
     assert row.status == "over budget" and math.isnan(row.estimate)
-    assert row.ratio == pytest.approx(row.seconds / 0.5)              # a lower bound
-    assert "and more" in bench._cell(row)
-    later = bench.skip_row(case, "bdf", [row], 30.0, analytic)
+    fast = Row("clamped", 32, 961, "analytic", "ok", seconds=0.5)
+    bookkeeping.set_ratios([fast, row])
+    assert row.ratio == pytest.approx(row.seconds / 0.5, rel=1e-12)      # a lower bound
+    assert "and more" in tables.cell(row)
+    later = bookkeeping.skip_row(case, "bdf", [row], 30.0)
     assert later.status == "skipped" and math.isnan(later.estimate)
-    half = {3: bench.Attempt(3, 90.0, stopped=True, estimate=180.0, progress=0.5)}
-    row = bench.numerical_row(case, "bdf", half, None, analytic)
-    assert row.estimate == pytest.approx(180.0 + case.model.timings["assembly"])
+    half = {3: timing.Attempt(3, 90.0, stopped=True, estimate=180.0, progress=0.5)}
+    row = bookkeeping.numerical_row(case, "bdf", half, None, 0.25, "")
+    assert row.estimate == pytest.approx(180.25, rel=1e-12)             # assembly added
 
 
 def test_forecast_skips_after_a_run_over_budget():
-    analytic = bench.Row("clamped", 32, 961, "analytic", "exact", seconds=0.5)
-    history = [bench.Row("clamped", 8, 49, "rk45", "ok", seconds=1.0),
-               bench.Row("clamped", 16, 225, "rk45", "over budget", seconds=30.0, estimate=16.0)]
+    history = [Row("clamped", 8, 49, "rk45", "ok", seconds=1.0),
+               Row("clamped", 16, 225, "rk45", "over budget", seconds=30.0, estimate=16.0)]
     case = bench.Case("clamped", 32, bench.build_model("clamped", 32), None, 1.0, np.zeros(2))
-    row = bench.skip_row(case, "rk45", history, 30.0, analytic)
+    row = bookkeeping.skip_row(case, "rk45", history, 30.0)
     assert row.status == "skipped"
     power = math.log(16.0) / math.log(225 / 49)
-    assert row.estimate == pytest.approx(16.0 * (961 / 225) ** power)
+    assert row.estimate == pytest.approx(16.0 * (961 / 225) ** power, rel=1e-12)
+
+
+def _line(*runs):
+    """Rows of one line from ``(solver, status, seconds, estimate, progress)``."""
+    return [Row("clamped", 64, 3969, solver, status, seconds, estimate=estimate,
+                progress=progress) for solver, status, seconds, estimate, progress in runs]
+
+
+def test_ratios_are_against_the_fastest_run_of_each_line_only():
+    nan = math.nan
+    small = _line(("analytic", "ok", 2.0, nan, nan), ("radau7", "ok", 8.0, nan, nan))
+    big = [Row("clamped", 128, 16129, "analytic", "ok", 30.0),
+           Row("clamped", 128, 16129, "analytic-all", "not run", estimate=900.0),
+           Row("clamped", 128, 16129, "radau7", "ok", 20.0)]
+    bookkeeping.set_ratios(small + big)
+    assert [r.ratio for r in small] == pytest.approx([1.0, 4.0], rel=1e-12)
+    # 128²: the integrator is fastest; the forecast of a row not run is a ratio too
+    assert [r.ratio for r in big] == pytest.approx([1.5, 45.0, 1.0], rel=1e-12)
+    assert tables.verdict(big) == ("Radau IIA-7", "**we lose** ×1.5")
+    assert tables.verdict(small) == ("analytic (automatic modes)", "wins, ×4 ahead")
+    assert "not run, ≈900 s forecast" in tables.cell(big[1])
+
+
+def test_a_stopped_run_that_extrapolates_below_every_finished_run_is_the_fastest():
+    nan = math.nan
+    line = _line(("analytic", "ok", 10.0, nan, nan), ("radau7", "over budget", 30.0, 6.0, 0.5),
+                 ("genalpha", "over budget", 30.0, 1.0, 0.01))      # too early: ignored
+    name, fares = tables.verdict(line)
+    assert name == "Radau IIA-7 (extrapolated)" and fares == "**we lose** ×1.67"
+    value, analytic_row, integrator, extrapolated = goals.ratio(line)
+    assert value == pytest.approx(0.6, rel=1e-12) and extrapolated
+    assert analytic_row.solver == "analytic" and integrator.solver == "radau7"
+
+
+def test_goals_read_the_faster_analytic_row_and_the_fastest_integrator():
+    nan = math.nan
+    rows = [Row("clamped", 32, 961, s, st, t, regime="size") for s, st, t in
+            (("analytic", "ok", 0.5), ("analytic-all", "exact", 0.25), ("radau7", "ok", 1.0),
+             ("radau3", "ok", 2.0))]
+    rows += [Row("clamped", 32, 961, "analytic", "ok", 0.1, regime="load case",
+                 case="each additional load case"),
+             Row("clamped", 32, 961, "radau7", "ok", 3.0, regime="load case",
+                 case="each additional load case")]
+    found = {g.name.split(",")[0]: g for g in goals.issue_goals(rows, 200, 1e-6)}
+    plate = found["bench plate 32²"]
+    assert plate.met is True and plate.measured.startswith("×4:")       # 1.0 / 0.25
+    assert found["each additional load case on a solved model"].met is True   # ×30
+    assert found["bench plate 64²"].met is None and "not measured" in found["bench plate 64²"].measured
+    assert math.isnan(goals.ratio([])[0]) and nan != nan
+
+
+def test_the_all_modes_forecast_follows_the_growth_of_the_two_largest_nets():
+    smaller = [Row("clamped", c, n, "analytic-all", "exact", t) for c, n, t in
+               ((16, 225, 0.04), (32, 961, 0.3), (64, 3969, 12.0))]
+    case = bench.Case("clamped", 128, bench.build_model("clamped", 12), None, 1.0, np.zeros(2))
+    row = analytic.not_run(case, smaller)
+    n = case.model.n_free
+    p = math.log(12.0 / 0.3) / math.log(3969 / 961)
+    assert row.status == "not run" and math.isnan(row.seconds)
+    assert row.estimate == pytest.approx(12.0 * (n / 3969) ** p, rel=1e-12)
+    assert f"n_free^{p:.2f}" in row.note
+
+
+def test_automatic_settings_say_modes_and_bound_or_all_modes():
+    assert analytic.automatic_label(1e-6, 256, 2.1e-7, 3969) == \
+        "tolerance 1e-06: 256 modes, bound 2.1e-07"
+    assert "all modes" in analytic.automatic_label(1e-6, 0, math.nan, 9)
+    assert "all modes" in analytic.automatic_label(1e-6, 9, 0.0, 9)
+
+
+def test_a_deadline_profile_stops_a_run_and_keeps_the_load_otherwise():
+    from splinedeform import loads
+
+    load = bench.study_load(2.0)
+    wrapped, clocks = timing.timed_load(load, deadline=math.inf)
+    term = wrapped.terms()[0]
+    t = np.linspace(0.0, 2.0, 9)
+    assert np.array_equal(term.profile(t), load.profile(t))            # delegated, no arithmetic
+    assert term.profile.jumps() == load.profile.jumps()
+    assert clocks[0].reached == 2.0
+    stopped, _ = timing.timed_load(load + loads.Point(0.5, 0.5, (0, 0, 1)), deadline=-math.inf)
+    assert len(stopped.terms()) == 2
+    with pytest.raises(timing.OverBudget):
+        stopped.terms()[1].profile(0.0)
+
+
+def test_a_study_is_rebuilt_from_its_record():
+    study = config.make_study(sizes=[32, 8, 8], budget=12.0, methods=["radau7"])
+    assert study.sizes == (8, 32) and study.budget == 12.0
+    assert study.budget_for(64) == 12.0 and study.budget_for(128) == study.large_budget
+    from dataclasses import asdict
+    record = {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(study).items()}
+    record["retired_setting"] = 1                                       # older records
+    assert config.from_record(record) == study
 
 
 @pytest.mark.parametrize("kwargs, words", [
@@ -173,30 +274,34 @@ def test_bad_settings_are_refused(kwargs, words, tmp_path):
 
 
 def test_substep_levels_are_a_factor_sqrt2_apart():
-    steps = [bench.substeps(k) for k in range(2, 21)]
+    steps = [search.substeps(k) for k in range(2, 21)]
     ratios = np.array(steps[1:]) / np.array(steps[:-1])
     # √2 between levels up to the rounding of small integers (3/2 = 1.5, 4/3 ≈ 1.33)
     assert np.all(ratios <= 1.5 + 1e-12) and np.all(ratios >= 1.3)
 
 
 def test_fastest_of_a_row_is_the_quickest_finished_run():
-    rows = [bench.Row("clamped", 8, 10, "analytic", "exact", 2.0),
-            bench.Row("clamped", 8, 10, "radau7", "ok", 1.0),
-            bench.Row("clamped", 8, 10, "genalpha", "over budget", 0.5)]
-    assert bench.fastest(rows).solver == "radau7"
+    rows = [Row("clamped", 8, 10, "analytic", "exact", 2.0),
+            Row("clamped", 8, 10, "radau7", "ok", 1.0),
+            Row("clamped", 8, 10, "genalpha", "over budget", 0.5)]
+    assert bookkeeping.fastest(rows).solver == "radau7"
 
 
-def test_goal_regimes_run_and_report_their_settings():
-    from splinedeform import bench_goals
-
+def test_regimes_run_and_report_their_lines():
     lines = []
-    result = bench_goals.goals(say=lines.append, quick=True)
-    assert "threads" in result["threads"] and lines[0] == result["threads"]
-    for key in ("light", "load_case", "single"):
-        r = result[key]
-        assert r["radau7"]["status"] == "ok" and r["radau7"]["error"] <= 1e-4
-        assert math.isclose(r["ratio"], r["radau7"]["seconds"] / r["analytic_s"], rel_tol=1e-12)
-    assert {h["name"] for h in result["horizons"]} == {"light", "plate"}
+    rows = regimes.run(config.QUICK, say=lines.append, quick=True)
+    found = {(r.regime, r.case) for r in rows}
+    assert {regime for regime, _ in found} == {"horizon", "load case", "one state", "probes"}
+    assert ("horizon", "heavy damping, 3 periods") in found
+    assert ("probes", "5 probes") in found and ("probes", "whole control nets") in found
+    for r in rows:
+        if r.status == "ok":
+            assert r.error <= config.QUICK.target
+    bookkeeping.set_ratios(rows)
+    for line in {r.line for r in rows}:
+        here = [r for r in rows if r.line == line and r.status in ("ok", "exact")]
+        assert min(r.ratio for r in here) == 1.0                        # the fastest itself
+    assert lines and all(isinstance(x, str) for x in lines)
 
 
 def test_a_run_stopped_at_the_budget_reports_where_its_stepping_was(monkeypatch):
@@ -211,7 +316,7 @@ def test_a_run_stopped_at_the_budget_reports_where_its_stepping_was(monkeypatch)
     case = bench.Case("clamped", 4, bench.build_model("clamped", 4), bench.study_load(t_end),
                       t_end, times)
     ticks = itertools.count()
-    monkeypatch.setattr(bench.time, "perf_counter", lambda: float(next(ticks)))
+    monkeypatch.setattr(timing.time, "perf_counter", lambda: float(next(ticks)))
     stopped = bench.attempt(case, "radau7", 0, budget=80)
     assert stopped.stopped
     assert 0 < stopped.progress < 0.2
