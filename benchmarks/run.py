@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from splinedeform import bench
-from splinedeform.bench.tables import verdict
+from splinedeform.bench.tables import readme_tables, verdict
 from splinedeform.export import write_text
 
 HERE = Path(__file__).resolve().parent
@@ -131,7 +131,8 @@ def main(argv: list[str] | None = None) -> int:
             f"; plots in `{out.relative_to(HERE.parent)}`.\n\n{body}{evaluate}")
     write_text(target / "results.md", text)
     write_text(target / "results.csv", bench.csv_text(result["rows"]))
-    print(f"written: {target / 'results.md'}, {target / 'results.csv'}")
+    readme = write_text(out / "readme_tables.md", readme_tables(result["rows"], result["goals"]))
+    print(f"written: {target / 'results.md'}, {target / 'results.csv'}, {readme}")
     return 0
 
 

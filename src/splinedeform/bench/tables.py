@@ -207,3 +207,53 @@ def csv_text(rows: list[Row]) -> str:
         writer.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v)
                          for k, v in asdict(row).items()})
     return buffer.getvalue()
+
+
+def readme_tables(rows: Sequence[Row], goals: Sequence[Goal]) -> str:
+    """Compact tables for the README: regime a (family ``clamped``), regimes b–e, goals."""
+    out = ["| cells | free | analytic, automatic modes | analytic, all modes | fastest "
+           "integrator at the target | analytic path |", "|---:|---:|---|---|---|---|"]
+    size = [r for r in rows if r.regime == "size" and r.family == "clamped"]
+    for cells in sorted({r.cells for r in size}):
+        here = [r for r in size if r.cells == cells]
+        by = {r.solver: r for r in here}
+        numerical = [r for r in here if not r.analytic]
+        best = fastest_estimate(numerical) or fastest(numerical)
+        out.append(f"| {cells}² | {here[0].n_free} | {_short(by.get('analytic'))} | "
+                   f"{_short(by.get('analytic-all'))} | {_short(best, setting=True)} | "
+                   f"{verdict(here)[1]} |")
+    lines: dict[tuple, list[Row]] = {}
+    for r in rows:
+        if r.regime != "size":
+            lines.setdefault(r.line, []).append(r)
+    if lines:
+        out += ["", "| regime | line | cells | analytic, automatic modes | analytic, all modes "
+                "| Radau IIA-7 | analytic path |", "|---|---|---:|---|---|---|---|"]
+    for (regime, case, _, cells), line in lines.items():
+        by = {r.solver: r for r in line}
+        out.append(f"| {regime} | {case} | {cells}² | {_short(by.get('analytic'))} | "
+                   f"{_short(by.get('analytic-all'))} | {_short(by.get('radau7'), setting=True)}"
+                   f" | {verdict(line)[1]} |")
+    if goals:
+        out += ["", "| goal | target | measured | met |", "|---|---|---|---|"]
+        out += [f"| {g.name} | {g.target} | {g.measured.split(':')[0]} | "
+                f"{'—' if g.met is None else ('yes' if g.met else '**no**')} |" for g in goals]
+    return "\n".join(out) + "\n"
+
+
+def _short(row: Row | None, setting: bool = False) -> str:
+    if row is None:
+        return "—"
+    name = f"{NAMES.get(row.solver, row.solver)} " if setting else ""
+    if row.status in ("ok", "exact"):
+        extra = row.setting if setting else (
+            f"{row.modes} modes" if row.solver == "analytic" and 0 < row.modes < row.n_free
+            else "")
+        return f"{name}{fmt(row.seconds, ' s')}" + (f" ({extra})" if extra else "")
+    if row.status == "over budget" and math.isfinite(row.estimate):
+        return f"{name}≈{fmt(row.estimate, ' s')} (stopped at {row.progress:.0%}, extrapolated)"
+    if row.status == "over budget":
+        return f"{name}> {fmt(row.seconds, ' s')} (stopped at the budget)"
+    if row.status in ("not run", "skipped"):
+        return f"{name}not run, ≈{fmt(row.estimate, ' s')} forecast"
+    return f"{name}not reached"
