@@ -59,12 +59,21 @@ class FreeRegionMessage(_Message):
     v: tuple[Parameter, Parameter] | None = None
 
 
+MAX_NET_POINTS = 160000
+"""Most control points a painted free set may list (a 400 x 400 net)."""
+NetIndex = Annotated[int, Field(ge=0, le=100000)]
+
+
 class ResolveMessage(_Message):
-    """Re-solve the modes with a new material, boundary and free region (None: the whole net)."""
+    """Re-solve the modes with a new material, boundary and moving set: a box
+    (``free_region``), control points listed ``[i, j]`` (``free_points``, what the page
+    paints), or neither (the whole net moves)."""
 
     material: MaterialMessage
     boundary: BoundaryMessage
     free_region: FreeRegionMessage | None = None
+    free_points: Annotated[list[tuple[NetIndex, NetIndex]],
+                           Field(max_length=MAX_NET_POINTS)] | None = None
 
 
 class CorrectionMessage(_Message):

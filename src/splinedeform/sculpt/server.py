@@ -6,7 +6,9 @@ page shows it):
 - ``GET /``: the page, with the current modal basis inside (it keeps working offline);
 - ``GET /api/basis``: the current modal data (after a re-solve);
 - ``GET /api/status``: progress of a re-solve ``{busy, stage, elapsed, error, version}``;
-- ``POST /api/resolve``: ``{material, boundary}`` → new modes, answered with the new data;
+- ``POST /api/resolve``: ``{material, boundary, free_region | free_points}`` → new modes,
+  answered with the new data and ``carry``, the map of the old modal state onto the new
+  modes (:mod:`.carry`);
 - ``POST /api/correction``: ``{version, index}`` → the static correction column of a sample;
 - ``POST /api/save``: ``{version, t_end, pushes}`` → the scenario written to the save path.
 
@@ -97,7 +99,8 @@ def create_app(session: Session) -> Starlette:
         if isinstance(message, JSONResponse):
             return message
         await run_in_threadpool(session.resolve, message)
-        return JSONResponse(await run_in_threadpool(session.payload))
+        data = await run_in_threadpool(session.payload)
+        return JSONResponse({**data, "carry": session.transfer_payload()})
 
     async def correction(request: Request) -> Response:
         message = await _message(request, CorrectionMessage)

@@ -17,8 +17,9 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from ..scenario import build, scenario_to_toml, with_overrides
+from ..scenario import build, free_region_mask, scenario_to_toml, with_overrides
 from ..scenario.spec import Scenario
+from .carry import transfer
 from .correction import StaticCorrection, static_correction
 from .export import _b64, payload
 from .messages import PushMessage, ResolveMessage, SaveMessage
@@ -66,6 +67,8 @@ class Session:
         self._state_lock = threading.Lock()
         self.basis: SculptBasis
         self.correction: StaticCorrection
+        self.transfer: tuple[int, np.ndarray] | None = None
+        """``(old version, P)``: the last re-solve's map from old to new modal coordinates."""
         self._solve(scenario)
 
     # -- solving ------------------------------------------------------------------------
@@ -89,6 +92,10 @@ class Session:
         basis = sculpt_basis(model, self.resolution, k)
         self._stage("static correction", start)
         correction = static_correction(basis)
+        old = getattr(self, "basis", None)
+        if old is not None:
+            self._stage("carrying the motion over", start)
+            self.transfer = (self.version, transfer(old, basis))
         with self._state_lock:          # readers see one basis with its version, never a mix
             self.scenario, self.basis, self.correction = scenario, basis, correction
             self.version += 1
@@ -113,6 +120,8 @@ class Session:
             box = None if region is None else {k: list(getattr(region, k)) for k in "uv"
                                                if getattr(region, k) is not None} or None
             overrides["boundary.free_region"] = box     # None (or {}): the whole net moves
+            points = message.free_points
+            overrides["boundary.free_points"] = None if points is None else [list(p) for p in points]
             try:
                 self._solve(with_overrides(self.scenario, overrides, origin="sculpt page"))
             except Exception as exc:
@@ -139,10 +148,26 @@ class Session:
             material={k: getattr(s.material, k) for k in MATERIAL_FIELDS},
             boundary={e: getattr(s.boundary, e) for e in EDGE_NAMES},
             free_region={k: getattr(s.boundary, f"free_{k}") for k in "uv"}
-            if s.boundary.has_free_region else None,
+            if s.boundary.free_u is not None or s.boundary.free_v is not None else None,
+            free_mask=_b64(self._free_mask(), "u1"),
+            greville=[surf.basis_u.greville().tolist(), surf.basis_v.greville().tolist()],
             domain=[float(surf.basis_u.length), float(surf.basis_v.length)],
             solve_seconds=round(self.timing, 4), server=True)
         return data
+
+    def _free_mask(self) -> np.ndarray:
+        """The moving set the scenario names (box or list), row-major, True = free; the
+        edge presets may hold some of these points too (``moving_mask`` says which move)."""
+        fixed = free_region_mask(self.scenario, self.basis.model.surface)
+        shape = self.basis.model.surface.shape
+        return np.ones(shape[0] * shape[1], bool) if fixed is None else ~np.ravel(fixed)
+
+    def transfer_payload(self) -> dict[str, Any] | None:
+        """The last re-solve's ``P`` (float64, ``(k_new, k_old)`` row-major) for the page."""
+        if self.transfer is None:
+            return None
+        version, P = self.transfer
+        return {"from_version": version, "shape": list(P.shape), "transfer": _b64(P, "<f8")}
 
     def correction_column(self, version: int, index: int) -> np.ndarray:
         """``r_a`` of sample ``index`` on basis ``version`` (see :mod:`.correction`)."""
