@@ -321,3 +321,45 @@ def test_a_run_stopped_at_the_budget_reports_where_its_stepping_was(monkeypatch)
     assert stopped.stopped
     assert 0 < stopped.progress < 0.2
     assert stopped.estimate > 5 * stopped.seconds      # extrapolated well beyond the budget
+
+
+def test_beyond_the_dense_limit_all_modes_are_forecast_and_the_reference_cross_checked(
+        monkeypatch):
+    """With the dense limit set below a 6×6 net: its all-modes row is not run (a forecast
+    from the 4×4 and 5×5 nets, never a time), the reference is the automatic mode count at a
+    tighter tolerance, and an independent Radau IIA-7 run agrees with it over the switch-on;
+    only the integrator fastest on the previous net runs there."""
+    from splinedeform.bench import sweep
+
+    monkeypatch.setattr(analytic, "DENSE_LIMIT", 20)                 # 4²: 9, 5²: 16, 6²: 25
+    monkeypatch.setattr(sweep, "LARGE", 5)
+    study = config.make_study(sizes=[4, 5, 6], quick=True, methods=["radau7", "radau3"],
+                              families=["clamped"])
+    rows = sweep.study_family("clamped", study, lambda s: None)
+    big = {r.solver: r for r in rows if r.cells == 6}
+    assert big["analytic-all"].status == "not run" and math.isnan(big["analytic-all"].seconds)
+    assert big["analytic-all"].estimate > 0
+    assert "automatic mode count" in big["analytic"].note
+    difference = float(big["analytic"].note.split("differs from it by ")[1].split(" ")[0])
+    assert difference < study.target                # an independent method agrees with it
+    assert big["analytic"].error <= study.target
+    skipped = [r for r in big.values() if r.status == "skipped"]
+    assert len(skipped) == 1 and "only the fastest integrator" in skipped[0].note
+
+
+def test_search_does_not_try_a_level_known_to_miss(monkeypatch):
+    """Radau-like error 1e-3·√2^(-13k): level 2 passes 1e-6, level 1 misses by ×11; with
+    the floor at 1 (it missed by more than ten times on the previous net) it is not run."""
+    calls = []
+
+    def fake(case, method, level, budget, opts=None):
+        calls.append(level)
+        return timing.Attempt(level, 1.0 + level, error=1e-3 * math.sqrt(2.0) ** (-13 * level))
+
+    monkeypatch.setattr(timing, "attempt", fake)
+    limits = bench.Study(target=1e-6)
+    _, best = search.search(None, "radau7", 2, limits, floor=1)
+    assert best == 2 and calls == [2]
+    calls.clear()
+    _, best = search.search(None, "radau7", 2, limits)
+    assert best == 2 and calls == [2, 1]

@@ -68,10 +68,12 @@ def next_level(method: str, level: int, error: float, target: float) -> int:
     return level + min(max(jump, 1), 3)
 
 
-def search(case: Case, method: str, start: int, limits: Limits
+def search(case: Case, method: str, start: int, limits: Limits, floor: int = -1
            ) -> tuple[dict[int, Attempt], int | None]:
     """Cheapest level reaching ``limits.target`` (each run stopped after ``limits.budget`` s).
 
+    Levels at or below ``floor`` are known to miss the target (they missed it by more than
+    ten times on a smaller net, and errors grow with the net) and are not tried.
     Returns all attempts and the cheapest passing level (``None`` if none passed).
     """
     tried: dict[int, Attempt] = {}
@@ -84,7 +86,7 @@ def search(case: Case, method: str, start: int, limits: Limits
             finer = tried.get(level + 1)
             not_cheaper = (finer is not None and finer.error <= limits.target
                            and result.seconds >= 0.9 * finer.seconds)
-            if level == 0 or level - 1 in tried or not_cheaper:
+            if level == 0 or level - 1 in tried or level - 1 <= floor or not_cheaper:
                 break
             level -= 1
         else:

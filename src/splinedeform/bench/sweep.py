@@ -5,7 +5,8 @@ while affordable, else *not run* with a forecast), then every numerical method a
 cheapest setting reaching the target (:mod:`.search`), a method skipped once it exceeded the
 budget on a smaller net or its forecast exceeds four budgets (:mod:`.bookkeeping`); above
 64×64 only the integrator that was fastest on the previous net runs (the others are
-forecast), with its own budget (``Study.large_budget``). The
+forecast), with its own budget (``Study.large_budget``), and its search does not try the
+setting that missed the target more than ten times on the previous net. The
 reference is the all-modes solution, checked against DOP853 at ``rtol = 1e-12`` on the
 smallest nets; where all modes are out of reach, the automatic solution at a tolerance ten
 times tighter, cross-checked against Radau IIA-7 with twice its passing steps over the first
@@ -46,6 +47,7 @@ def study_family(family: str, study: Study, say: Callable[[str], None]) -> list[
     dense: list[Row] = []
     start_level = dict(START_LEVEL)
     leader: str | None = None
+    floors: dict[str, int] = {}
     sizes = [c for c in study.sizes if family != "region" or c <= study.region_max]
     for index, cells in enumerate(sizes):
         case = make_case(family, cells, study.frames)
@@ -72,11 +74,19 @@ def study_family(family: str, study: Study, say: Callable[[str], None]) -> list[
             if row is None and cells > LARGE and leader is not None and method != leader:
                 row = _forecast(case, method, history[method], leader)
             if row is None:
-                tried, best = search(case, method, start_level[method], _Limits(study, budget))
+                floor = floors.get(method, -1) if cells > LARGE else -1
+                tried, best = search(case, method, start_level[method], _Limits(study, budget),
+                                     floor)
                 label = setting_label(method, best) if best is not None else ""
                 row = numerical_row(case, method, tried, best, assembly, label)
                 if best is not None:
                     start_level[method] = passing[method] = best
+                    coarser = tried.get(best - 1)
+                    if coarser is not None and coarser.error > 10 * study.target:
+                        floors[method] = best - 1
+                    if floor >= 0 and best - 1 == floor:
+                        row.note = (f"{setting_label(method, floor)} not tried: it missed the "
+                                    "target more than ten times on the previous net")
             history[method].append(row)
             rows.append(row)
             say("    " + describe(row))
