@@ -64,9 +64,12 @@ def verdict(line: Sequence[Row]) -> tuple[str, str]:
         return name, "—"
     if best.analytic:
         others = [r.cost for r in line if not r.analytic and math.isfinite(r.cost)]
-        if not others:
-            return name, "wins"
-        return name, f"wins, ×{fmt(min(others) / analytic.seconds)} ahead"
+        if others:
+            return name, f"wins, ×{fmt(min(others) / analytic.seconds)} ahead"
+        stopped = [r.seconds for r in line if r.status == "over budget"]
+        if stopped:                                     # stopped too early to extrapolate
+            return name, f"wins, ≥ ×{fmt(min(stopped) / analytic.seconds)} ahead"
+        return name, "wins"
     return name, f"**we lose** ×{fmt(analytic.seconds / best.cost)}"
 
 
@@ -75,6 +78,8 @@ def _modes(row: Row | None) -> str:
         return "—"
     if row.modes >= row.n_free or not row.modes:
         return "all"
+    if not math.isfinite(row.bound):                # made finer than the bound asked
+        return f"{row.modes} (√2 steps past the bound's count)"
     return f"{row.modes} (bound {row.bound:.0e})"
 
 
