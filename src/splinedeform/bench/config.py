@@ -42,7 +42,7 @@ class Study:
     families: tuple[str, ...] = FAMILIES
     yardstick_sizes: int = 2
     region_max: int = 64
-    large_budget: float = 150.0
+    large_budget: float = 300.0
     goals: bool = False
     regimes: bool = True
 
