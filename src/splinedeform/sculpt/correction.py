@@ -76,6 +76,38 @@ class StaticCorrection:
         return out
 
 
+def offline_data(basis: SculptBasis) -> dict[str, Any] | None:
+    """What a page needs to compute ``r_a`` itself, without the server (a saved page).
+
+    ``K_r`` reordered by reverse Cuthill–McKee (a narrow profile for the page's envelope
+    Cholesky factorisation), its lower triangle in CSR, and ``G = E_s T`` with its columns
+    in the same order, CSR; the page solves ``K_r x = G[a]ᵀ`` and forms
+    ``r_a = G x − Φ_s Λ⁻¹ Φ_s[a]ᵀ`` (``Φᵀ F_a = Φ_s[a]``, the modes at the grabbed
+    sample). Indices int32, values float64; None when every mode is kept (no correction).
+    """
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+    from .export import _b64
+
+    if basis.lam.size == basis.model.n_free:
+        return None
+    model = basis.model
+    K = sp.csr_matrix(model.matrices()[2])
+    order = reverse_cuthill_mckee(K, symmetric_mode=True)
+    lower = sp.tril(K[order][:, order], format="csr")
+    lower.sort_indices()
+    uu, vv = np.meshgrid(basis.samples_u, basis.samples_v, indexing="ij")
+    G = sp.csr_matrix(model.surface.evaluation_matrix(uu.ravel(), vv.ravel())
+                      @ model.constraints.T)[:, order]
+    G.sort_indices()
+    return {"n": int(K.shape[0]),
+            "k_indptr": _b64(lower.indptr, "<i4"), "k_indices": _b64(lower.indices, "<i4"),
+            "k_values": _b64(lower.data, "<f8"),
+            "g_indptr": _b64(G.indptr, "<i4"), "g_indices": _b64(G.indices, "<i4"),
+            "g_values": _b64(G.data, "<f8")}
+
+
 def static_correction(basis: SculptBasis) -> StaticCorrection:
     """The correction of ``basis`` (zero when it keeps every mode)."""
     lam, phi = basis.model.eigen(basis.lam.size)

@@ -85,7 +85,10 @@ def create_app(session: Session) -> Starlette:
     """The starlette application serving ``session``."""
 
     async def page(request: Request) -> Response:
-        html = await run_in_threadpool(sculpt_page, session.payload())
+        # the page as served keeps working when saved: it carries what the static
+        # correction needs (the API answers do not: a page online asks the server)
+        data = await run_in_threadpool(session.page_payload)
+        html = await run_in_threadpool(sculpt_page, data)
         return HTMLResponse(html, headers={"Cache-Control": "no-store"})
 
     async def basis(request: Request) -> Response:

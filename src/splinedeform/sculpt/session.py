@@ -20,7 +20,7 @@ from ..errors import InputError
 from ..scenario import build, free_region_mask, scenario_to_toml, with_overrides
 from ..scenario.spec import Scenario
 from .carry import transfer
-from .correction import StaticCorrection, static_correction
+from .correction import StaticCorrection, offline_data, static_correction
 from .export import _b64, payload
 from .messages import PushMessage, ResolveMessage, SaveMessage
 from .modal import SculptBasis, sculpt_basis
@@ -154,6 +154,12 @@ class Session:
             domain=[float(surf.basis_u.length), float(surf.basis_v.length)],
             solve_seconds=round(self.timing, 4), server=True)
         return data
+
+    def page_payload(self) -> dict[str, Any]:
+        """:meth:`payload` plus the data of the static correction for a saved page."""
+        with self._state_lock:
+            basis = self.basis
+        return {**self.payload(), "offline": offline_data(basis)}
 
     def _free_mask(self) -> np.ndarray:
         """The moving set the scenario names (box or list), row-major, True = free; the
