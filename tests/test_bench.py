@@ -188,6 +188,14 @@ def test_ratios_are_against_the_fastest_run_of_each_line_only():
     assert "not run, ≈900 s forecast" in tables.cell(big[1])
 
 
+def test_a_lead_over_forecasts_only_is_marked_as_a_forecast():
+    line = [Row("clamped", 128, 16129, "analytic", "ok", 20.0),
+            Row("clamped", 128, 16129, "radau7", "skipped", estimate=200.0)]
+    assert tables.verdict(line)[1] == "wins, ≈×10 ahead (forecast)"
+    line.append(Row("clamped", 128, 16129, "radau3", "ok", 100.0))
+    assert tables.verdict(line)[1] == "wins, ×5 ahead"                  # measured beats forecast
+
+
 def test_a_stopped_run_that_extrapolates_below_every_finished_run_is_the_fastest():
     nan = math.nan
     line = _line(("analytic", "ok", 10.0, nan, nan), ("radau7", "over budget", 30.0, 6.0, 0.5),
@@ -293,6 +301,7 @@ def test_regimes_run_and_report_their_lines():
     found = {(r.regime, r.case) for r in rows}
     assert {regime for regime, _ in found} == {"horizon", "load case", "one state", "probes"}
     assert ("horizon", "heavy damping, 3 periods") in found
+    assert ("horizon", "light damping, 1 period") in found
     assert ("probes", "5 probes") in found and ("probes", "whole control nets") in found
     for r in rows:
         if r.status == "ok":

@@ -65,7 +65,8 @@ def horizon(cells: int, periods: float, damping: str, frames: int, target: float
     t_end = periods * lowest_period("clamped", cells, material)
     case = make_case("clamped", cells, frames, t_end, material)
     rows, best = _line(case, target, budget, start)
-    return _tag(rows, "horizon", f"{damping} damping, {periods:g} periods"), best
+    plural = "" if periods == 1 else "s"
+    return _tag(rows, "horizon", f"{damping} damping, {periods:g} period{plural}"), best
 
 
 def load_case(cells: int, frames: int, target: float, budget: float) -> list[Row]:

@@ -63,9 +63,13 @@ def verdict(line: Sequence[Row]) -> tuple[str, str]:
     if analytic is None:
         return name, "—"
     if best.analytic:
-        others = [r.cost for r in line if not r.analytic and math.isfinite(r.cost)]
+        others = [r.cost for r in line if not r.analytic and math.isfinite(r.cost)
+                  and r.status in ("ok", "over budget")]
         if others:
             return name, f"wins, ×{fmt(min(others) / analytic.seconds)} ahead"
+        forecast = [r.cost for r in line if not r.analytic and math.isfinite(r.cost)]
+        if forecast:
+            return name, f"wins, ≈×{fmt(min(forecast) / analytic.seconds)} ahead (forecast)"
         stopped = [r.seconds for r in line if r.status == "over budget"]
         if stopped:                                     # stopped too early to extrapolate
             return name, f"wins, ≥ ×{fmt(min(stopped) / analytic.seconds)} ahead"
@@ -237,7 +241,7 @@ def readme_tables(rows: Sequence[Row], goals: Sequence[Goal]) -> str:
     for (regime, case, _, cells), line in lines.items():
         by = {r.solver: r for r in line}
         out.append(f"| {regime} | {case} | {cells}² | {_short(by.get('analytic'))} | "
-                   f"{_short(by.get('analytic-all'))} | {_short(by.get('radau7'), setting=True)}"
+                   f"{_short(by.get('analytic-all'))} | {_short(by.get('radau7'), setting=True, name=False)}"
                    f" | {verdict(line)[1]} |")
     if goals:
         out += ["", "| goal | target | measured | met |", "|---|---|---|---|"]
@@ -246,19 +250,19 @@ def readme_tables(rows: Sequence[Row], goals: Sequence[Goal]) -> str:
     return "\n".join(out) + "\n"
 
 
-def _short(row: Row | None, setting: bool = False) -> str:
+def _short(row: Row | None, setting: bool = False, name: bool = True) -> str:
     if row is None:
         return "—"
-    name = f"{NAMES.get(row.solver, row.solver)} " if setting else ""
+    label = f"{NAMES.get(row.solver, row.solver)} " if setting and name else ""
     if row.status in ("ok", "exact"):
         extra = row.setting if setting else (
             f"{row.modes} modes" if row.solver == "analytic" and 0 < row.modes < row.n_free
             else "")
-        return f"{name}{fmt(row.seconds, ' s')}" + (f" ({extra})" if extra else "")
+        return f"{label}{fmt(row.seconds, ' s')}" + (f" ({extra})" if extra else "")
     if row.status == "over budget" and math.isfinite(row.estimate):
-        return f"{name}≈{fmt(row.estimate, ' s')} (stopped at {row.progress:.0%}, extrapolated)"
+        return f"{label}≈{fmt(row.estimate, ' s')} (stopped at {row.progress:.0%}, extrapolated)"
     if row.status == "over budget":
-        return f"{name}> {fmt(row.seconds, ' s')} (stopped at the budget)"
+        return f"{label}> {fmt(row.seconds, ' s')} (stopped at the budget)"
     if row.status in ("not run", "skipped"):
-        return f"{name}not run, ≈{fmt(row.estimate, ' s')} forecast"
-    return f"{name}not reached"
+        return f"{label}not run, ≈{fmt(row.estimate, ' s')} forecast"
+    return f"{label}not reached"
