@@ -45,7 +45,7 @@ def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
             modes, eigensolver = report["modes"], "sparse"
     basis = model.modal_basis(eigensolver, modes, omega_max)
     start = time.perf_counter()
-    M = model._M
+    M, _, K = model.matrices()
     lam = basis.lam
     c = model.material.damping / model.material.mass + model.material.rayleigh * lam
     jumps = [(t_j, basis.project(F)) for t_j, F in spatial[0]]
@@ -82,8 +82,9 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
                          "rest on a model without rigid modes; give modes=k otherwise")
     at = np.linspace(0.0, t_end, 201) if times is None else np.asarray(times, dtype=float)
     m = model.material
+    M, _, K = model.matrices()
     basis, correction, report = mode_select.automatic_basis(
-        model._K, model._M, spatial[0], m.damping / m.mass, m.rayleigh, at, tolerance)
+        K, M, spatial[0], m.damping / m.mass, m.rayleigh, at, tolerance)
     if basis is None:
         report["modes"] = model.n_free
     else:
@@ -111,11 +112,12 @@ def _truncation(model: Model, basis: modal_basis.ModalBasis, spatial: tuple[list
                 d0: Array, v0: Array, correction: Any = None) -> tuple[Any, dict[str, Any]]:
     """Mode-acceleration correction and the truncation report of a truncated basis
     (``correction``: already computed with the basis, by the automatic mode count)."""
+    M, _, K = model.matrices()
     report: dict[str, Any] = {
         "modes": basis.size, "n_free": model.n_free,
         "omega_max_kept": float(np.sqrt(basis.lam.max())),
         "omega_first_omitted": float(np.sqrt(basis.first_omitted)),
-        "initial_residual": max(_outside(basis, model._M, d0), _outside(basis, model._M, v0)),
+        "initial_residual": max(_outside(basis, M, d0), _outside(basis, M, v0)),
     }
     if not basis.can_solve_static:
         report.update(static_correction=False, omitted_static=float("nan"),
@@ -124,8 +126,7 @@ def _truncation(model: Model, basis: modal_basis.ModalBasis, spatial: tuple[list
     if correction is not None:
         report.update(static_correction=True)
         return correction, report
-    correction, indicators = modal_basis.mode_acceleration(basis, model._K, model._M,
-                                                           *spatial)
+    correction, indicators = modal_basis.mode_acceleration(basis, K, M, *spatial)
     report.update(static_correction=True, **indicators)
     return correction, report
 

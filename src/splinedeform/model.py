@@ -33,6 +33,7 @@ from .modal_solve import check_count as _check_count
 from .solution import ModalSolution, Readout, SampledSolution, StaticSolution
 from . import spectrum
 from .solvers import modal_basis, numeric
+from .solvers.forcing import ReducedForcing
 from .solvers.system import KroneckerFactors, Reduction
 from .surface import Surface
 
@@ -353,7 +354,7 @@ class Model:
             raise InputError(f"t_end must be finite and > 0, got {t_end}")
         load = as_load(load)
         d0, v0 = self.initial_state(initial_displacement, initial_velocity)
-        forcing = numeric.ReducedForcing(self, load)
+        forcing = ReducedForcing(self.reduction, load)
         if method == "analytic":
             if options.get("tolerance") is not None:
                 options["times"] = times
@@ -362,15 +363,10 @@ class Model:
         M, C, K = self.matrices()
         out_times, d, v, stats = numeric.run(M, C, K, forcing, forcing.breakpoints, method,
                                              t_end, times, d0, v0, **options)
-        return self.sampled_solution(method, t_end, forcing, out_times, d, v, stats,
-                                     time.perf_counter() - start)
-
-    def sampled_solution(self, method: str, t_end: float, forcing: Any, times: Array,
-                         d: Array, v: Array, stats: dict, seconds: float) -> SampledSolution:
-        """States of a numerical method at ``times`` read out as a solution of this model."""
         timings = dict(self.timings)
-        timings["integration"] = seconds
-        return SampledSolution(self.readout, method, t_end, forcing, timings, times, d, v, stats)
+        timings["integration"] = time.perf_counter() - start
+        return SampledSolution(self.readout, method, t_end, forcing, timings, out_times, d, v,
+                               stats)
 
     def _analytic(self, forcing: Any, t_end: float, d0: Array, v0: Array,
                   **options: Any) -> ModalSolution:

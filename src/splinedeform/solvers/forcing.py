@@ -6,8 +6,6 @@ integrators restart) and its modal terms (jumps and harmonics, for the closed-fo
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 from numpy.typing import NDArray
 
@@ -20,14 +18,14 @@ Array = NDArray[np.float64]
 class ReducedForcing:
     """The reduced load ``F_r(t) = F_rest + Σ_terms s(t) Tᵀ F_term(t)`` on a constraint map.
 
-    ``system`` is a :class:`~.system.Reduction` (or anything holding one as ``reduction``,
-    such as a model); ``F_rest = −Tᵀ K p0`` for a model without rest shape, else 0. Spatial
-    vectors of loads whose field does not change in time are computed once.
+    ``reduction`` gives ``T``, the surface the load fields are evaluated on and
+    ``F_rest = −Tᵀ K p0`` for a model without rest shape (else 0). Spatial vectors of loads
+    whose field does not change in time are computed once.
     Callable: ``forcing(t) -> (n_free, 3)``.
     """
 
-    def __init__(self, system: Reduction | Any, load: Load):
-        self.reduction: Reduction = getattr(system, "reduction", system)
+    def __init__(self, reduction: Reduction, load: Load):
+        self.reduction = reduction
         self.terms = load.terms()
         self._fixed = [None if term.time_dependent_field
                        else self.reduction.reduce(term.field_vector(self.reduction.surface))

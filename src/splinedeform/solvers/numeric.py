@@ -17,7 +17,6 @@ returns the states at those times; the model wraps them in a
 
 from __future__ import annotations
 
-import time
 from typing import Any, Callable
 
 import numpy as np
@@ -85,21 +84,6 @@ def run(M: sp.spmatrix, C: sp.spmatrix, K: sp.spmatrix, forcing: Callable[[float
         d, v, stats = ivp(M, C, K, forcing, breakpoints, IVP_METHODS[method], t_end,
                           out_times, d0, v0, **options)
     return out_times, d, v, stats
-
-
-def integrate(system: Any, forcing: ReducedForcing, method: str, t_end: float,
-              times: ArrayLike | None, d0: Array, v0: Array, **options: Any) -> Any:
-    """:func:`run` on ``system.matrices()``, wrapped by ``system.sampled_solution``.
-
-    For callers that hold a model (``system``): the model reads out the states as a
-    :class:`~splinedeform.solution.SampledSolution` with the integration's time.
-    """
-    start = time.perf_counter()
-    M, C, K = system.matrices()
-    out_times, d, v, stats = run(M, C, K, forcing, forcing.breakpoints, method, t_end, times,
-                                 d0, v0, **options)
-    return system.sampled_solution(method, t_end, forcing, out_times, d, v, stats,
-                                   time.perf_counter() - start)
 
 
 def newmark(M: sp.spmatrix, C: sp.spmatrix, K: sp.spmatrix, forcing: Callable[[float], Array],
