@@ -223,7 +223,7 @@ class BlockLanczos:
             if self.next is None:
                 self._step()
             if self.p >= check or self.p >= self.n or self.p >= cap:
-                check = max(self.p + 1, int(1.12 * self.p))
+                check = max(self.p + 1, int(1.08 * self.p))
                 nu, S, rel = self._ritz(min(want, self.p))
                 if self.p >= self.n or self.p >= cap or (self.p >= want
                                                            and np.all(rel <= self.tol)):
