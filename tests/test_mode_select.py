@@ -79,3 +79,22 @@ def test_the_envelope_table_dominates_the_envelope():
         direct = mode_count.omitted_envelope(grid[i], 0.8, 5e-4, tau)
         assert np.all(E[i] >= direct * (1 - 1e-6))
     assert np.all(np.diff(E, axis=0) <= 0)
+
+
+def test_a_further_load_case_reuses_the_eigen_solution():
+    """A second load on a solved model: the same answer as on a fresh model (two Krylov
+    spaces with converged pairs: 1e-9 of the static scale covers their 1e-10 residuals),
+    and no new solves beyond its statics when it needs no more modes."""
+    surf = sd.shapes.plane(cells=(20, 20))
+    times = np.array([1.3, 3.1])
+    second = sd.Point(0.7, 0.6, (0, 0, -2), profile=sd.Step(0.5))
+    model = sd.Model(surf, PLATE, boundary="clamped")
+    model.dynamic(LOAD, 4.0, tolerance=1e-6, times=times)
+    from splinedeform import modal_solve
+    solves = modal_solve._KRYLOV[model].solves
+    again = model.dynamic(second, 4.0, tolerance=1e-6, times=times).control_points(times)
+    fresh = sd.Model(surf, PLATE, boundary="clamped").dynamic(
+        second, 4.0, tolerance=1e-6, times=times).control_points(times)
+    rest = model.surface.control_points
+    assert np.abs(again - fresh).max() <= 1e-9 * np.abs(fresh - rest).max()
+    assert modal_solve._KRYLOV[model].solves == solves

@@ -9,6 +9,7 @@
 from __future__ import annotations
 
 import time
+import weakref
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -18,12 +19,16 @@ from numpy.typing import ArrayLike, NDArray
 from .errors import InputError
 from .solution import ModalSolution
 from .solvers import modal_basis, mode_select
+from .solvers.sparse_eigen import BlockLanczos
 from .solvers.analytic import ModalResponse
 
 if TYPE_CHECKING:
     from .model import Model
 
 Array = NDArray[np.float64]
+_KRYLOV: weakref.WeakKeyDictionary[Any, BlockLanczos] = weakref.WeakKeyDictionary()
+"""Per model: the Krylov space and LU of the automatic mode count, kept for further load
+cases (a model's ``K`` and ``M`` never change; the space lives as long as the model)."""
 
 
 def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
@@ -83,8 +88,11 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
     at = np.linspace(0.0, t_end, 201) if times is None else np.asarray(times, dtype=float)
     m = model.material
     M, _, K = model.matrices()
+    krylov = _KRYLOV.get(model)
+    if krylov is None:
+        krylov = _KRYLOV[model] = BlockLanczos(K, M)
     basis, correction, report = mode_select.automatic_basis(
-        K, M, spatial[0], m.damping / m.mass, m.rayleigh, at, tolerance)
+        K, M, spatial[0], m.damping / m.mass, m.rayleigh, at, tolerance, krylov=krylov)
     if basis is None:
         report["modes"] = model.n_free
     else:
