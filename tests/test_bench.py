@@ -165,6 +165,8 @@ def test_forecast_skips_after_a_run_over_budget():
     assert row.status == "skipped"
     power = math.log(16.0) / math.log(225 / 49)
     assert row.estimate == pytest.approx(16.0 * (961 / 225) ** power, rel=1e-12)
+    later = bookkeeping.skip_row(case, "rk45", history + [row], 30.0)
+    assert "over the budget on the 16×16 net" in later.note          # where it was, not 32²
 
 
 def _line(*runs):

@@ -162,9 +162,10 @@ def skip_row(case: Case, method: str, history: list[Row], budget: float) -> Row 
     if last.status in ("over budget", "skipped"):
         predicted = (predicted_seconds(history, case.model.n_free)
                      if math.isfinite(last.estimate) else math.nan)
+        over = next((r for r in history if r.status == "over budget"), last)
         return Row(case.family, case.cells, case.model.n_free, method, "skipped",
                    estimate=predicted,
-                   note=f"over the budget on the {last.cells}×{last.cells} net"
+                   note=f"over the budget on the {over.cells}×{over.cells} net"
                    + ("; forecast" if math.isfinite(predicted) else ""))
     predicted = predicted_seconds(history, case.model.n_free)
     if predicted > 4 * budget:
