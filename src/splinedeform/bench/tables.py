@@ -37,6 +37,8 @@ def cell(row: Row | None) -> str:
     ratio = f"×{fmt(row.ratio)}"
     if row.status in ("ok", "exact"):
         error = f"; {row.error:.0e}" if math.isfinite(row.error) else ""
+        if row.error == 0.0:                  # fell back to all modes: the reference itself
+            error = "; = all modes"
         return f"{fmt(row.seconds, ' s')} ({ratio}{error})"
     if row.status == "over budget" and not math.isfinite(row.estimate):
         return f"> budget: {fmt(row.seconds, ' s')} for {row.progress:.0%} of t_end ({ratio} and more)"
@@ -183,9 +185,10 @@ LEGEND = ("Cells: total time (×ratio to the fastest run of the line; error reac
           "reached (below 5 % of t_end nothing is extrapolated and the ratio is a lower bound); "
           "`skipped`: forecast from the smaller nets; `not run`: forecast from the measured "
           "growth of the smaller nets, never measured. Automatic modes: `Model.dynamic(..., "
-          "times=frames, tolerance=tol)`, tol tightened while the error measured against the "
-          "reference misses the target; the a-priori bound is in the M-norm, relative to the "
-          "largest static displacement.")
+          "times=frames, tolerance=target)`, then √2 times more modes (`modes=`) while the "
+          "error measured against the reference misses the target; the a-priori bound is in "
+          "the M-norm, relative to the largest static displacement. `= all modes`: the "
+          "automatic count fell back to all modes, the reference itself.")
 
 
 def markdown(rows: list[Row], goals: list[Goal], study: Study, seconds: float,
