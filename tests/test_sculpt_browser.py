@@ -11,27 +11,13 @@ timings are printed (never asserted: the machine is shared).
 
 from __future__ import annotations
 
-import signal
-import subprocess
-import sys
-import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-CHROMIUM = "/usr/bin/chromium"
-ARGS = ["--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader",
-        "--disable-background-networking", "--disable-component-update", "--disable-sync",
-        "--no-first-run"]
-
-if not Path(CHROMIUM).exists():
-    pytest.skip(f"Chromium is not installed at {CHROMIUM} (Debian package `chromium`)",
-                allow_module_level=True)
-sync_api = pytest.importorskip("playwright.sync_api",
-                               reason="Playwright for Python is not installed (extra `test`)")
-pytest.importorskip("starlette", reason="the sculpt server needs the extra 'sculpt'")
-pytest.importorskip("uvicorn", reason="the sculpt server needs the extra 'sculpt'")
+# skips this module, saying why, without Chromium or Playwright
+from chromium import sculpt_page, sculpt_server  # noqa: E402
 
 SHEET = """
 title = "browser sheet"
@@ -60,38 +46,14 @@ MODES = 30      # of 49: the rest enters through the static correction
 @pytest.fixture(scope="module")
 def server(tmp_path_factory):
     folder = tmp_path_factory.mktemp("sculpt")
-    (folder / "sheet.toml").write_text(SHEET)
-    proc = subprocess.Popen([sys.executable, "-m", "splinedeform.cli", "sculpt", "sheet.toml",
-                             "--no-browser", "--resolution", str(R), "--modes", str(MODES),
-                             "--save", "saved.toml"], cwd=folder, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
-    line = proc.stdout.readline()
-    if "http://" not in line:
-        proc.kill()
-        pytest.fail(f"sculpt did not start: {line!r} {proc.stderr.read()}")
-    yield line.split()[2], folder
-    proc.send_signal(signal.SIGINT)
-    assert proc.wait(timeout=30) == 0
-
-
-@pytest.fixture(scope="module")
-def browser():
-    with sync_api.sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-        yield b
-        b.close()
+    with sculpt_server(folder, "sheet.toml", SHEET, "--resolution", str(R),
+                       "--modes", str(MODES), "--save", "saved.toml") as url:
+        yield url, folder
 
 
 @pytest.fixture(scope="module")
 def page(server, browser):
-    url, _ = server
-    page = browser.new_page(viewport={"width": 900, "height": 600})
-    problems: list[str] = []
-    page.on("pageerror", lambda exc: problems.append(str(exc)))
-    page.goto(url)
-    page.wait_for_function("window.sculptState !== undefined && sculptState.time > 0.2",
-                           timeout=60000)
-    page.problems = problems
+    page = sculpt_page(browser, server[0])
     yield page
     page.close()
 
