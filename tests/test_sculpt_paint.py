@@ -82,6 +82,10 @@ def test_painted_points_alone_move_and_save_writes_them(page, server):
     _, folder = server
     page.check("#paint")
     assert page.evaluate("document.getElementById('show-net').checked")   # the net is shown
+    # all free at the start; clamped u edges hold two rows each (2·2·9), pinned v edges one
+    # column each of the five rows left (2·5): 46 points held, counted by hand
+    assert page.inner_text("#paint-info").startswith(
+        f"{NET * NET} of {NET * NET} control points free (green), 46 of them held by the edges")
     page.click("#paint-none")
     assert sum(page.evaluate("sculptState.freeMask")) == 0
     page.fill("#brush", "0.1")

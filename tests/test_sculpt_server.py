@@ -106,6 +106,26 @@ def test_resolve_with_a_free_region_moves_only_its_points(client, session):
     assert reply.json()["free_region"] is None and reply.json()["n_free"] > data["n_free"]
 
 
+def test_the_still_mask_is_where_the_net_cannot_move(client, session):
+    """``still_mask`` names the control points no load can move: checked against the static
+    displacement under a load on every control point (exactly zero there: they are no
+    unknowns; elsewhere the uniform load moves every free point)."""
+    from splinedeform import loads
+
+    for body in (None, {**GOOD_RESOLVE, "free_region": {"u": [0.3, 0.7], "v": [0.2, 0.8]}}):
+        data = client.post("/api/resolve", json=body).json() if body else \
+            client.get("/api/basis").json()
+        still = decode(data["still_mask"], "u1").astype(bool)
+        model = session.basis.model
+        d = model.static(loads.Uniform((0.0, 0.0, -1.0))).control_points() \
+            - model.surface.control_points
+        assert np.array_equal(still, np.all(d == 0.0, axis=-1).ravel())   # booleans: exact
+        nu, nv = model.surface.shape
+        grid = still.reshape(nu, nv)
+        assert grid[:2].all() and grid[:, -1].all()     # u0 clamped: two rows; v1 pinned
+        assert 0 < (~still).sum() == model.n_free
+
+
 HOSTILE = [
     ("/api/resolve", json.dumps({**GOOD_RESOLVE,
                                  "free_region": {"u": [0.8, 0.2]}}).encode(), 400),

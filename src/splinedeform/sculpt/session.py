@@ -150,6 +150,7 @@ class Session:
             free_region={k: getattr(s.boundary, f"free_{k}") for k in "uv"}
             if s.boundary.free_u is not None or s.boundary.free_v is not None else None,
             free_mask=_b64(self._free_mask(), "u1"),
+            still_mask=_b64(self._still_mask(), "u1"),
             greville=[surf.basis_u.greville().tolist(), surf.basis_v.greville().tolist()],
             domain=[float(surf.basis_u.length), float(surf.basis_v.length)],
             solve_seconds=round(self.timing, 4), server=True)
@@ -163,10 +164,18 @@ class Session:
 
     def _free_mask(self) -> np.ndarray:
         """The moving set the scenario names (box or list), row-major, True = free; the
-        edge presets may hold some of these points too (``moving_mask`` says which move)."""
+        edge presets may hold some of these points too (:meth:`_still_mask` says which)."""
         fixed = free_region_mask(self.scenario, self.basis.model.surface)
         shape = self.basis.model.surface.shape
         return np.ones(shape[0] * shape[1], bool) if fixed is None else ~np.ravel(fixed)
+
+    def _still_mask(self) -> np.ndarray:
+        """The control points that cannot move in the solved model, row-major: the empty
+        rows of its constraint map ``d = T d_free`` (held by an edge preset or outside the
+        free set)."""
+        T = self.basis.model.constraints.T.tocsr()
+        T.eliminate_zeros()
+        return np.diff(T.indptr) == 0
 
     def transfer_payload(self) -> dict[str, Any] | None:
         """The last re-solve's ``P`` (float64, ``(k_new, k_old)`` row-major) for the page."""
