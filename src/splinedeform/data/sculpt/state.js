@@ -1,0 +1,105 @@
+// sculpt page, part state: the modal data, the modal state (q, q', f) per mode carried in closed form from event to event, the session (time, pushes, the held grab).
+// The parts are concatenated in order inside one function scope (see sculpt/page.py).
+  let data = JSON.parse(document.getElementById("splinedeform-data").textContent);
+  const online = location.protocol === "http:" || location.protocol === "https:";
+  const messageBox = document.getElementById("message");
+  const errors = [];
+  let messageTimer = null;
+  function showMessage(text, info) {
+    messageBox.textContent = text;
+    messageBox.className = info ? "info" : "";
+    messageBox.style.display = "block";
+    if (!info) errors.push(text);
+    clearTimeout(messageTimer);
+    messageTimer = setTimeout(() => { messageBox.style.display = "none"; }, info ? 4000 : 10000);
+  }
+  function decode(text, Type) {
+    const raw = atob(text), bytes = new Uint8Array(raw.length);
+    for (let k = 0; k < raw.length; k++) bytes[k] = raw.charCodeAt(k);
+    return new Type(bytes.buffer);
+  }
+
+  // -- modal data ------------------------------------------------------------------------
+  // K modes, N samples: phi (N x K, float32, sample-major), lam and damping (float64)
+  let K, N, ru, rv, lam, damp, phi, rest, phiNet, netRest, NN;
+  // the free set (1 = free, row-major over the net, what Apply sends) and where it came from:
+  // "box" (the u/v box of the panel), "points" (a list: the scenario's or painted)
+  let freeMask, freeSource, gU, gV, stillMask;
+  function unpack(d) {
+    K = d.modes; [ru, rv] = d.grid; N = ru * rv;
+    lam = decode(d.lam, Float64Array); damp = decode(d.damping, Float64Array);
+    phi = decode(d.phi, Float32Array); rest = decode(d.rest, Float32Array);
+    phiNet = decode(d.phi_net, Float32Array); netRest = decode(d.net_rest, Float32Array);
+    NN = d.net_shape[0] * d.net_shape[1];
+    freeMask = decode(d.free_mask, Uint8Array).slice();
+    stillMask = decode(d.still_mask, Uint8Array);   // cannot move in the solved model
+    freeSource = d.free_region ? "box" : "points";
+    [gU, gV] = d.greville;
+  }
+  unpack(data);
+
+  // -- modal state: (q, q', f) per mode and coordinate at the last event tEvent --------------
+  // q(τ) = f/λ + e^{-στ}(a C + (b + σ a) S), q'(τ) = e^{-στ}(b C - (λ a + σ b) S),
+  // a = q0 - f/λ, b = q0', σ = c/2, s = σ² - λ, C = Σ (sτ²)^n/(2n)!, S = τ Σ (sτ²)^n/(2n+1)!
+  // (cos/sin, 1/τ or cosh/sinh): see splinedeform/sculpt/state.py, its Python twin.
+  let q, v, f, qt, eV, eC, eS, gq, gv;
+  function allocate() {
+    q = new Float64Array(K * 3); v = new Float64Array(K * 3); f = new Float64Array(K * 3);
+    qt = new Float64Array(K * 3); eV = new Float64Array(K * 3); eC = new Float64Array(K); eS = new Float64Array(K);
+    gq = new Float64Array(K * 3); gv = new Float64Array(K * 3);
+    phiPeak = -1;
+  }
+  function dampedCS(tau) {
+    for (let i = 0; i < K; i++) {
+      const sigma = damp[i] / 2, s = sigma * sigma - lam[i], x = s * tau * tau;
+      const decay = Math.exp(-sigma * tau);
+      if (Math.abs(x) < 1e-3) {
+        eC[i] = decay * (1 + x * (1 / 2 + x * (1 / 24 + x / 720)));
+        eS[i] = decay * tau * (1 + x * (1 / 6 + x * (1 / 120 + x / 5040)));
+      } else if (s < 0) {
+        const w = Math.sqrt(-s);
+        eC[i] = decay * Math.cos(w * tau); eS[i] = decay * Math.sin(w * tau) / w;
+      } else {
+        const d = Math.sqrt(s), grow = Math.exp((d - sigma) * tau), fall = Math.exp((-d - sigma) * tau);
+        eC[i] = (grow + fall) / 2; eS[i] = (grow - fall) / (2 * d);
+      }
+    }
+  }
+  // state after tau under the constant modal force f; into (outQ, outV) (outV may be null)
+  function propagate(q0, v0, force, tau, outQ, outV) {
+    dampedCS(tau);
+    for (let i = 0; i < K; i++) {
+      const l = lam[i], sigma = damp[i] / 2, c = eC[i], sn = eS[i];
+      for (let j = 3 * i; j < 3 * i + 3; j++) {
+        const r = force[j] / l, a = q0[j] - r, b = v0[j];
+        outQ[j] = r + a * c + (b + sigma * a) * sn;
+        if (outV) outV[j] = b * c - (l * a + sigma * b) * sn;
+      }
+    }
+  }
+
+  // -- session: time, pushes, the held grab --------------------------------------------------
+  let t = 0, tEvent = 0, paused = false, speed = 1;
+  let pushes = [];           // {index, force: [3], t_on, t_off|null}: what "Save" sends
+  let grab = null;           // {index, force: [3], push, flex, normal, depth, pointer}
+  const corrections = new Map();   // sample index -> Float32Array(N) static correction column
+  // a change of the held force at the current time: carry the state to t, then switch
+  function setForce(index, force) {
+    propagate(q, v, f, t - tEvent, q, v);
+    tEvent = t;
+    dirty = true;                      // redraw even when paused (the static part changes)
+    f.fill(0);
+    if (force) {
+      const base = index * K;
+      for (let i = 0; i < K; i++) {
+        const p = phi[base + i];
+        f[3 * i] = p * force[0]; f[3 * i + 1] = p * force[1]; f[3 * i + 2] = p * force[2];
+      }
+    }
+  }
+  function reset() {
+    q.fill(0); v.fill(0); f.fill(0); t = 0; tEvent = 0; pushes = []; grab = null; carriedMotion = false;
+    controls.enabled = true;
+    dirty = true;
+  }
+
