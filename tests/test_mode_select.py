@@ -98,3 +98,20 @@ def test_a_further_load_case_reuses_the_eigen_solution():
     rest = model.surface.control_points
     assert np.abs(again - fresh).max() <= 1e-9 * np.abs(fresh - rest).max()
     assert modal_solve._KRYLOV[model].solves == solves
+
+
+def test_a_small_net_takes_all_modes_without_starting_the_sparse_path():
+    """49 free coordinates (at most DENSE_BELOW): the tolerance is met exactly, by every mode."""
+    from splinedeform import modal_solve
+
+    surf = sd.shapes.plane(cells=(8, 8))
+    model = sd.Model(surf, PLATE, boundary="clamped")
+    assert model.n_free == 49 <= modal_solve.DENSE_BELOW
+    times = np.linspace(0.0, 4.0, 11)
+    sol = model.dynamic(LOAD, 4.0, tolerance=1e-6, times=times)
+    assert sol.basis.complete and sol.basis.lam.size == 49
+    assert sol.truncation["bound"] == 0.0 and model not in modal_solve._KRYLOV
+    full = sd.Model(surf, PLATE, boundary="clamped").dynamic(LOAD, 4.0)
+    err = relative_errors(model, sol.control_points(times), full.control_points(times),
+                          times, LOAD)
+    assert err.max() <= 1e-12        # the same complete solution: round-off only
