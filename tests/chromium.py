@@ -74,3 +74,17 @@ def sculpt_page(browser: object, url: str, ready: float = 0.2):
                            timeout=60000)
     page.problems = problems
     return page
+
+
+def grab_and_pull(page, index: int, dy: float, steps: int = 6) -> int:
+    """Press on sample ``index`` of the sculpting page and move the pointer ``dy`` pixels down
+    the screen in ``steps`` moves 40 ms apart, the button held; returns the grabbed sample."""
+    at = page.evaluate(f"sculptState.screen({index})")
+    page.mouse.move(at["x"], at["y"])
+    page.mouse.down()
+    grabbed = page.evaluate("sculptState.grabbed")
+    assert grabbed is not None, "the press on the surface did not grab it"
+    for step in range(1, steps + 1):
+        page.mouse.move(at["x"], at["y"] + dy * step / steps)
+        page.wait_for_timeout(40)
+    return grabbed["index"]

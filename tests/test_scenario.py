@@ -15,6 +15,8 @@ from splinedeform.scenario import (SHAPE_PARAMETERS, Scenario, build, build_load
                                    documented_keys, free_region_mask, key_lines, load_scenario,
                                    parse_scenario, scenario_to_toml, with_overrides)
 
+from tiny_scenario import BASE
+
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "scenario.md"
 
@@ -148,35 +150,10 @@ force = [0, 0, -1]
 kind = "static"
 """
 
-ANALYTIC = """
-[surface]
-shape = "plane"
-cells = 3
-
-[material]
-w10 = 1.0
-w01 = 1.0
-
-[boundary]
-u0 = "clamped"
-u1 = "clamped"
-
-[[load]]
-kind = "uniform"
-force = [0.0, 0.0, -1.0]
-profile = "piecewise"
-points = [[0.0, 1.0], [0.5, 0.0]]
-
-[solve]
-kind = "dynamic"
-method = "analytic"
-t_end = 1.0
-frames = 3
-function_samples = 64
-
-[output]
-formats = []
-"""
+ANALYTIC = (BASE
+            .replace('profile = "step"', 'profile = "piecewise"\npoints = [[0.0, 1.0], [0.5, 0.0]]')
+            .replace("t_end = 2.0\nframes = 5",
+                     'method = "analytic"\nt_end = 1.0\nframes = 3\nfunction_samples = 64'))
 
 #: the free set listed point by point, as splinedeform sculpt paints it
 PAINTED = STATIC.replace('v1 = "pinned"\n', 'v1 = "pinned"\nfree_points = [[1, 1], [2, 2], [3, 3]]\n')

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 # skips this module, saying why, without Chromium or Playwright
-from chromium import sculpt_page, sculpt_server  # noqa: E402
+from chromium import grab_and_pull, sculpt_page, sculpt_server  # noqa: E402
 
 SHEET = """
 title = "browser sheet"
@@ -123,15 +123,9 @@ def test_held_push_on_the_page_equals_python_with_static_correction(page, server
 
     _, folder = server
     page.evaluate("sculptState.reset()")
-    at = page.evaluate(f"sculptState.screen({(R // 2) * R + 5})")
-    page.mouse.move(at["x"], at["y"])
-    page.mouse.down()
-    for step in range(1, 7):
-        page.mouse.move(at["x"], at["y"] + 8 * step)
-        page.wait_for_timeout(40)
+    index = grab_and_pull(page, (R // 2) * R + 5, 48)
     page.wait_for_timeout(300)
     page.evaluate("sculptState.setPaused(true)")
-    index = page.evaluate("sculptState.grabbed.index")
     page.wait_for_function(f"sculptState.corrections.includes({index})", timeout=30000)
     page.wait_for_timeout(500)                      # the spring force settles at frozen time
     snap = page.evaluate("sculptState.snapshot()")
@@ -259,14 +253,7 @@ def test_a_saved_page_works_offline(server, browser, tmp_path):
     page.wait_for_function("window.sculptState !== undefined && sculptState.time > 0.2",
                            timeout=60000)
     assert page.evaluate("sculptState.online") is False
-    centre = (R // 2) * R + R // 2
-    at = page.evaluate(f"sculptState.screen({centre})")
-    page.mouse.move(at["x"], at["y"])
-    page.mouse.down()
-    index = page.evaluate("sculptState.grabbed.index")
-    for step in range(1, 9):
-        page.mouse.move(at["x"], at["y"] + 8 * step)
-        page.wait_for_timeout(40)
+    index = grab_and_pull(page, (R // 2) * R + R // 2, 64, steps=8)
     page.wait_for_timeout(600)
     assert page.evaluate(f"sculptState.displacement({index})")[2] < -1e-3
     page.mouse.up()
@@ -283,12 +270,7 @@ def test_a_released_surface_comes_to_rest_and_is_no_longer_drawn(page):
     zero (the state is zeroed, not a small remainder) and the frames that follow compute
     and draw nothing (their modal-sum time is 0)."""
     page.evaluate("sculptState.reset()")
-    at = page.evaluate(f"sculptState.screen({(R // 2) * R + R // 2})")
-    page.mouse.move(at["x"], at["y"])
-    page.mouse.down()
-    for step in range(1, 6):
-        page.mouse.move(at["x"], at["y"] + 8 * step)
-        page.wait_for_timeout(40)
+    grab_and_pull(page, (R // 2) * R + R // 2, 40, steps=5)
     page.mouse.up()
     assert not page.evaluate("sculptState.resting")
     page.evaluate("sculptState.setSpeed(3)")

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 # skips this module, saying why, without Chromium or Playwright
-from chromium import sculpt_page, sculpt_server  # noqa: E402
+from chromium import grab_and_pull, sculpt_page, sculpt_server  # noqa: E402
 
 SHEET = """
 title = "painted sheet"
@@ -67,13 +67,7 @@ def resolved(page, version: int) -> None:
 
 def drag(page, index: int, dy: float, hold_ms: int = 600) -> None:
     """Grab sample ``index`` and pull it ``dy`` pixels down the screen, then let go."""
-    at = page.evaluate(f"sculptState.screen({index})")
-    page.mouse.move(at["x"], at["y"])
-    page.mouse.down()
-    assert page.evaluate("sculptState.grabbed") is not None
-    for step in range(1, 7):
-        page.mouse.move(at["x"], at["y"] + dy * step / 6)
-        page.wait_for_timeout(40)
+    grab_and_pull(page, index, dy)
     page.wait_for_timeout(hold_ms)
     page.mouse.up()
 
@@ -198,14 +192,7 @@ def test_a_stiff_spring_on_a_small_free_set_stays_stable(page):
     already after one frame; with stiffness 8, k α ≈ 8)."""
     page.evaluate("sculptState.reset()")
     page.fill("#spring", "8")
-    index = (R // 2) * R + R // 2
-    at = page.evaluate(f"sculptState.screen({index})")
-    page.mouse.move(at["x"], at["y"])
-    page.mouse.down()
-    grabbed = page.evaluate("sculptState.grabbed.index")
-    for step in range(1, 7):
-        page.mouse.move(at["x"], at["y"] + 10 * step)
-        page.wait_for_timeout(40)
+    grabbed = grab_and_pull(page, (R // 2) * R + R // 2, 60)
     track = []
     for _ in range(10):
         page.wait_for_timeout(100)
