@@ -112,6 +112,12 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
     """Stiffness ``K`` and consistent mass ``M`` over the ``3n`` interleaved displacements."""
     if min(surface.basis_u.degree, surface.basis_v.degree) < 2:
         raise InputError("the Kirchhoff–Love shell needs degree >= 2 in u and v (curvatures)")
+    for name, basis in (("u", surface.basis_u), ("v", surface.basis_v)):
+        if getattr(basis, "continuity", basis.degree - 1) < 1:
+            raise InputError(
+                f"the Kirchhoff–Love shell needs a C1 basis in {name}, but its knot vector "
+                f"repeats an interior knot {basis.degree} times (the surface may kink there, "
+                "where bending energy is undefined); use a knot vector without such knots")
     G = metric.grid(surface, extra_points=1)
     N = metric.shape_derivatives(G)
     index = metric.global_index(G, surface.basis_v.size)

@@ -1,18 +1,15 @@
 """A Kirchhoff–Love shell model: boundary conditions on ``3n`` coupled unknowns, solves.
 
-Boundary kinds per edge (``"u0"``, ``"u1"``, ``"v0"``, ``"v1"``):
+Boundary kinds per edge (``"u0"``, ``"u1"``, ``"v0"``, ``"v1"``): ``free``, ``pinned``,
+``clamped``, ``diaphragm``, ``symmetry`` and ``pole``, imposed on the trace of the edge and
+the derivative across it for any knot layout (:mod:`.shell_edges`).
 
-- ``free``; ``pinned``: the edge row of control points does not move; ``clamped``: the
-  edge row and the next one do not move (no rotation);
-- ``diaphragm``: rigid in its own plane, free out of it (Scordelis–Lo ends); the edge must
-  lie in a coordinate plane ``x_c = const``; the two other components are fixed;
-- ``symmetry``: the edge lies in a symmetry plane ``x_c = const``: component ``c`` of the
-  edge row is fixed and the two others of the next row are tied to the edge row (zero slope
-  across the plane).
-
-Rigid motions left free by the boundary are removed by Lagrange multipliers
-``∫ ρt d·r dA = 0`` (``M`` orthogonality to each free rigid motion ``r``), so a
-self-equilibrated load on a free shell has its unique elastic answer.
+The rigid motions ``r = t + ω × p`` the boundary leaves free span ``null K_r`` (the shell's
+energy vanishes on rigid motions only); every combination of translations and rotations
+in ``range T`` is found (:meth:`ShellModel._free_rigid_motions`). They are removed by
+Lagrange multipliers ``∫ ρt d·r dA = 0`` (``M`` orthogonality to each), so a
+self-equilibrated load on a free shell has its unique elastic answer; a static load that
+does work on a free rigid motion has no equilibrium and is refused, naming the motion.
 """
 
 from __future__ import annotations
@@ -33,11 +30,11 @@ from ..solvers.analytic import ModalResponse
 from ..surface import Surface
 from . import metric
 from .shell import ShellMaterial, matrices
+from .shell_edges import EDGES, KINDS, check_edges, constraint_matrix  # noqa: F401
+from .shell_rigid import describe, free_rigid_motions
 from .shell_solution import ShellModalSolution, ShellStaticSolution
 
 Array = NDArray[np.float64]
-EDGES = ("u0", "u1", "v0", "v1")
-KINDS = ("free", "pinned", "clamped", "diaphragm", "symmetry")
 
 
 @dataclass(frozen=True)
@@ -61,63 +58,6 @@ class AreaForce(Load):
         return total[:, None] * np.asarray(self.force, dtype=float)[None, :]
 
 
-def _edge_rows(shape: tuple[int, int], edge: str, depth: int) -> NDArray[np.int64]:
-    """Flat control point indices of row ``depth`` (0 = on the edge) of an edge, ``(len,)``."""
-    grid = np.arange(shape[0] * shape[1]).reshape(shape)
-    return {"u0": grid[depth], "u1": grid[-1 - depth], "v0": grid[:, depth],
-            "v1": grid[:, -1 - depth]}[edge]
-
-
-def _plane_axis(surface: Surface, edge: str, kind: str) -> int:
-    P = surface.control_points.reshape(-1, 3)[_edge_rows(surface.shape, edge, 0)]
-    spread = np.ptp(P, axis=0)
-    axis = int(np.argmin(spread))
-    if spread[axis] > 1e-9 * max(1.0, float(np.abs(P).max())):
-        raise InputError(f"a {kind} edge must lie in a coordinate plane (x, y or z constant); "
-                         f"edge {edge} of {surface.name!r} spreads {spread} in x, y, z")
-    return axis
-
-
-def constraint_matrix(surface: Surface, boundary: Mapping[str, str], fixed: Array | None
-                      ) -> sp.csr_matrix:
-    """``T`` with ``d = T d_free`` over the interleaved ``3n`` displacements."""
-    n = surface.shape[0] * surface.shape[1]
-    parent = np.arange(3 * n)
-    is_fixed = np.zeros(3 * n, bool)
-    if fixed is not None:
-        mask = np.asarray(fixed, bool)
-        if mask.shape == surface.shape:          # whole control points, as for Model
-            mask = np.repeat(mask[..., None], 3, axis=-1)
-        is_fixed = mask.ravel().copy()
-    if is_fixed.size != 3 * n:
-        raise InputError(f"fixed must be a boolean mask of shape {surface.shape} (control "
-                         f"points) or {surface.shape + (3,)} (components)")
-    for edge, kind in boundary.items():
-        if edge not in EDGES or kind not in KINDS:
-            raise InputError(f"shell boundary: edge must be one of {EDGES} and kind one of "
-                             f"{KINDS}, got {edge!r}: {kind!r}")
-        row0, row1 = _edge_rows(surface.shape, edge, 0), _edge_rows(surface.shape, edge, 1)
-        if kind in ("pinned", "clamped"):
-            for row in (row0, row1)[: 1 + (kind == "clamped")]:
-                is_fixed[(3 * row[:, None] + np.arange(3)).ravel()] = True
-        elif kind == "diaphragm":
-            axis = _plane_axis(surface, edge, kind)
-            is_fixed[(3 * row0[:, None] + np.delete(np.arange(3), axis)).ravel()] = True
-        elif kind == "symmetry":
-            axis = _plane_axis(surface, edge, kind)
-            is_fixed[3 * row0 + axis] = True
-            for c in np.delete(np.arange(3), axis):
-                parent[3 * row1 + c] = parent[3 * row0 + c]
-    parent = parent[parent]                     # ties are one level deep (row1 → row0)
-    keep = ~is_fixed[parent]
-    columns = np.unique(parent[keep])
-    col_of = np.full(3 * n, -1)
-    col_of[columns] = np.arange(columns.size)
-    rows = np.nonzero(keep)[0]
-    return sp.csr_matrix((np.ones(rows.size), (rows, col_of[parent[rows]])),
-                         shape=(3 * n, columns.size))
-
-
 class ShellModel:
     """A linear Kirchhoff–Love shell on a B-spline surface (``physics = "shell"``).
 
@@ -139,7 +79,8 @@ class ShellModel:
         self.surface, self.material = surface, material
         self.physics = "shell"
         self.K_full, self.M_full = matrices(surface, material)
-        self.T = constraint_matrix(surface, dict(boundary or {}), fixed)
+        self.edges = check_edges(surface, dict(boundary or {}))
+        self.T = constraint_matrix(surface, self.edges, fixed)
         self._K = (self.T.T @ self.K_full @ self.T).tocsc()
         self._M = (self.T.T @ self.M_full @ self.T).tocsc()
         self._C = (material.damping / (material.density * material.thickness) * self._M
@@ -160,20 +101,12 @@ class ShellModel:
         return self._M, self._C, self._K
 
     def _free_rigid_motions(self) -> Array:
-        """Reduced rigid motions (translations, rotations ``ω × p``) the boundary leaves free."""
+        """Reduced rigid motions (any combination of translations and rotations ``ω × p``)
+        the boundary leaves free (:func:`.shell_rigid.free_rigid_motions`)."""
+        motions = free_rigid_motions(self.T, self.surface.control_points)
         P = self.surface.control_points.reshape(-1, 3)
-        motions = [np.tile(np.eye(3)[c], (P.shape[0], 1)) for c in range(3)]
-        motions += [np.cross(np.eye(3)[c], P) for c in range(3)]
-        R = np.stack([m.ravel() for m in motions], axis=1)
-        reduced = np.column_stack([spla.lsqr(self.T, R[:, i], atol=1e-14, btol=1e-14)[0]
-                                   for i in range(6)])
-        residual = np.linalg.norm(self.T @ reduced - R, axis=0) / np.linalg.norm(R, axis=0)
-        # combinations of the rigid motions that the constraints allow exactly
-        candidates = reduced[:, residual < 1e-8]
-        if candidates.shape[1] == 0:
-            return np.zeros((self.n_free, 0))
-        u, s, _ = np.linalg.svd(candidates, full_matrices=False)
-        return u[:, s > 1e-10 * s.max()]
+        self.rigid_motions = describe(motions.twists, float(np.ptp(P, axis=0).max()))
+        return motions.reduced
 
     def load_vector(self, load: Load | None, t: float = 0.0) -> Array:
         """Reduced generalised force ``Tᵀ F(t)`` over the interleaved unknowns."""
@@ -186,8 +119,24 @@ class ShellModel:
         """
         start = time.perf_counter()
         F = self.load_vector(load, static_time(as_load(load), t))
+        self._check_equilibrium(F)
         d = self._static_solve(F)
         return ShellStaticSolution(self, d, F, {"static": time.perf_counter() - start})
+
+    def _check_equilibrium(self, F: Array) -> None:
+        """Refuse a load doing work ``Fᵀ r`` on a free rigid motion ``r``: no equilibrium."""
+        if self.rigid.shape[1] == 0:
+            return
+        work = np.abs(self.rigid.T @ F)
+        if work.max() <= 1e-9 * max(np.linalg.norm(F), 1e-300):
+            return
+        held = {e: k for e, k in self.edges.items() if k != "free"} or "none"
+        raise SingularSystemError(
+            f"the shell's boundary (edges {held}) leaves {self.rigid.shape[1]} rigid "
+            f"motion(s) free: {'; '.join(self.rigid_motions)}. The load does work on them, "
+            "so no static equilibrium exists (the constrained stiffness is singular). Hold "
+            "the shell against them (pin or clamp an edge, or fix components), or apply a "
+            "self-equilibrated load")
 
     def _static_solve(self, F: Array) -> Array:
         C = self._M @ self.rigid
