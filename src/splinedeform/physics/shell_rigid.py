@@ -66,30 +66,49 @@ def _vector(v: Array) -> str:
     return "(" + ", ".join(f"{x:.4g}" for x in v + 0.0) + ")"
 
 
-def describe(twists: Array, size: float = 1.0) -> list[str]:
-    """Words for a basis of the free motions: translations, then rotations about axes.
+def _canonical(span: Array) -> list[Array]:
+    """Unit vectors spanning ``span (3, r)``: the coordinate axes it contains first."""
+    r = span.shape[1]
+    if r == 0:
+        return []
+    Q = np.linalg.qr(span)[0]
+    out = [e for e in np.eye(3) if np.linalg.norm(Q.T @ e) > 1 - 1e-9][:r]
+    while len(out) < r:
+        rest = Q - np.column_stack(out) @ (np.column_stack(out).T @ Q) if out else Q
+        u, s, _ = np.linalg.svd(rest)
+        out.append(u[:, 0])
+    return out
 
-    The rotation parts ``ω`` of the basis are split by SVD; motions without rotation are
-    translations along ``t``; each rotation ``ω`` is about the axis through
-    ``p0 = ω × t/|ω|²`` (its screw part along ``ω`` named when present). ``size`` is the
-    extent of the net, the length that makes ``|ω| size`` comparable with ``|t|``.
+
+def describe(twists: Array, size: float = 1.0) -> list[str]:
+    """Words for a basis of the free motions: rotations about axes, then translations.
+
+    The rotation parts ``ω`` span a subspace (its coordinate axes named first); each such
+    ``ω`` comes with a combination of the motions giving it, a rotation about the axis
+    through ``p0 = ω × t/|ω|²`` (its screw part named when present), the free translations
+    taken out of ``t`` (the axis nearest the origin); the combinations without rotation
+    are translations. ``size`` is the extent of the net,
+    the length that makes ``|ω| size`` comparable with ``|t|``.
     """
+    if twists.shape[1] == 0:
+        return []
     t, w = twists[:3], twists[3:]
-    _, s, vt = np.linalg.svd(w, full_matrices=True)
+    u, s, vt = np.linalg.svd(w, full_matrices=True)
     scale = max(float(np.abs(t).max(initial=0.0)), size * float(np.abs(w).max(initial=0.0)))
     rank = int(np.sum(s * size > 1e-8 * scale))
     words = []
-    basis = vt.T                                          # combinations of the columns
-    for j in range(basis.shape[1]):
-        tj, wj = t @ basis[:, j], w @ basis[:, j]
-        if j >= rank:
-            words.append(f"translation along {_vector(tj)}")
-            continue
-        norm = np.linalg.norm(wj)
-        through = np.cross(wj, tj) / norm ** 2
-        screw = float(wj @ tj) / norm
+    translations = _canonical(t @ vt[rank:].T)
+    for axis in _canonical(u[:, :rank]):
+        c = np.linalg.lstsq(w, axis, rcond=None)[0]
+        tj = t @ c
+        for e in translations:                         # the axis nearest the origin
+            tj = tj - (e @ tj) * e
+        through = np.cross(axis, tj)
         through = np.where(np.abs(through) < 1e-9 * size, 0.0, through) + 0.0
-        words.append(f"rotation about the axis along {_vector(wj)} through "
-                     f"({', '.join(f'{x:.4g}' for x in through)})" + (f" (a screw, pitch {screw / norm:.3g})"
-                                              if abs(screw) > 1e-8 * scale else ""))
+        screw = float(axis @ tj)
+        words.append(f"rotation about the axis along {_vector(axis)} through "
+                     f"({', '.join(f'{x:.4g}' for x in through)})"
+                     + (f" (a screw, pitch {screw:.3g})" if abs(screw) > 1e-8 * size else ""))
+    for direction in translations:
+        words.append(f"translation along {_vector(direction)}")
     return words
