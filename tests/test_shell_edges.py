@@ -7,6 +7,7 @@ on a flat plate, so the shell must meet the plate's values for every knot layout
 diaphragm (rigid in its plane, flexible out of it) must support like a simple support.
 """
 
+import re
 from math import pi
 
 import numpy as np
@@ -119,3 +120,32 @@ def test_a_c0_knot_line_is_refused_as_for_the_plate():
     with pytest.raises(InputError, match="needs a C1 basis in u, but its knot vector repeats "
                                          "an interior knot 2 times"):
         ShellModel(plate, MATERIAL, {e: "pinned" for e in ALL})
+
+
+def quarter_hemisphere(cells: int, oblique: float) -> Surface:
+    """The quarter of the pinched hemisphere (18° hole), latitude ``θ = v + c u (π/2 − u)
+    v (θ_top − v)``: the same surface and edges, crossed obliquely by the u lines for c > 0."""
+    top = 72 * pi / 180
+
+    def f(u, v):
+        theta = v + oblique * u * (pi / 2 - u) * v * (top - v)
+        return 10.0 * np.stack([np.cos(theta) * np.cos(u), np.cos(theta) * np.sin(u),
+                                np.sin(theta)], -1)
+    return sd.shapes.from_function(f, cells=cells, domain=((0, pi / 2), (0, top)))
+
+
+def test_a_symmetry_edge_crossed_obliquely_is_refused_with_its_angle():
+    symmetric = {"u0": "symmetry", "u1": "symmetry"}
+    # the perpendicular map is accepted (its answer, 0.0935, is checked in
+    # tests/test_physics_shell.py); the oblique one converged to 0.0744 before it was refused
+    ShellModel(quarter_hemisphere(4, 0.0), MATERIAL, symmetric)
+    with pytest.raises(InputError, match=r"symmetry edge u0 .* plane y = const at ([\d.]+)°"
+                       ) as info:
+        ShellModel(quarter_hemisphere(4, 0.8), MATERIAL, symmetric)
+    # at u = 0 the crossing direction is x_φ + 0.8 (π/2) v (θ_top − v) x_θ, |x_θ| = 10 and
+    # |x_φ| = 10 cos v: the angle from the plane's normal e_y is the arctangent of their ratio
+    v = np.linspace(0, 72 * pi / 180, 2001)
+    angle = np.degrees(np.arctan(0.8 * pi / 2 * v * (72 * pi / 180 - v) / np.cos(v))).max()
+    measured = float(re.search(r"at ([\d.]+)°", str(info.value)).group(1))
+    # 3 digits in the message; the spline fit on 4 cells and 9 samples per cell: 0.5 %
+    assert measured == pytest.approx(angle, rel=5e-3)
