@@ -151,22 +151,44 @@ class ShellModel:
                                       "energy") from None
         return x[: self.n_free]
 
-    def eigen(self, k: int) -> tuple[Array, Array]:
-        """Lowest ``k`` eigenpairs of ``K_r φ = λ M_r φ`` (``Φᵀ M_r Φ = I``, rigid ``λ = 0``)."""
+    def spectrum_advice(self) -> str:
+        """What to change when the shell's eigen-solution cannot be trusted."""
+        m = self.material
+        return (f"The shell's bending stiffness E t³/(12(1−ν²)) is t²/12 = {m.thickness ** 2 / 12:.3g} "
+                "(a length²) times its membrane stiffness E t/(1−ν²), so a thin shell on a "
+                "fine net spreads its eigenvalues over many decades: raise the thickness "
+                f"t = {m.thickness:g}, or use fewer cells or a lower degree. Young's modulus "
+                f"E = {m.E:g} scales every eigenvalue alike and Poisson's ratio ν = {m.nu:g} "
+                "hardly changes the spread, so neither helps. check_spectrum=False goes on "
+                "with these modes at your own risk")
+
+    def _guard(self, check_spectrum: bool) -> dict:
+        return {"advice": self.spectrum_advice(),
+                "guard": "residual" if check_spectrum else "off"}
+
+    def eigen(self, k: int, check_spectrum: bool = True) -> tuple[Array, Array]:
+        """Lowest ``k`` eigenpairs of ``K_r φ = λ M_r φ`` (``Φᵀ M_r Φ = I``, rigid ``λ = 0``).
+
+        Each computed pair is tested by its residual ``‖K_r φ − λ M_r φ‖`` (the error bounds
+        of :mod:`splinedeform.solvers.eigen_trust`) and refused if its frequency or shape
+        is not resolved; ``check_spectrum=False`` skips the test (at the caller's risk).
+        """
         k = _count(k, self.n_free)
         if k > self.n_free // 2:
-            basis = modal_basis.dense_basis(self._K, self._M, self.rigid.shape[1])
+            basis = modal_basis.dense_basis(self._K, self._M, self.rigid.shape[1],
+                                            **self._guard(check_spectrum))
             return basis.lam[:k], basis.phi[:, :k]
-        basis = modal_basis.sparse_basis(self._K, self._M, k, None, self.rigid.shape[1])
+        basis = modal_basis.sparse_basis(self._K, self._M, k, None, self.rigid.shape[1],
+                                         **self._guard(check_spectrum))
         return basis.lam, basis.phi
 
-    def frequencies(self, k: int = 6) -> Array:
-        """Lowest ``k`` angular frequencies ``ω = √λ`` (rigid ones 0)."""
-        return np.sqrt(self.eigen(k)[0])
+    def frequencies(self, k: int = 6, check_spectrum: bool = True) -> Array:
+        """Lowest ``k`` angular frequencies ``ω = √λ`` (rigid ones 0); see :meth:`eigen`."""
+        return np.sqrt(self.eigen(k, check_spectrum)[0])
 
-    def modes(self, k: int = 6) -> tuple[Array, Array]:
+    def modes(self, k: int = 6, check_spectrum: bool = True) -> tuple[Array, Array]:
         """Lowest ``k`` frequencies and mode shapes as control net displacements ``(k, n_u, n_v, 3)``."""
-        lam, phi = self.eigen(k)
+        lam, phi = self.eigen(k, check_spectrum)
         shapes = np.asarray(self.T @ phi).T.reshape((phi.shape[1],) + self.surface.shape + (3,))
         return np.sqrt(lam), shapes
 
@@ -189,7 +211,8 @@ class ShellModel:
     def dynamic(self, load: Load | None, t_end: float, method: str = "analytic",
                 modes: int | None = None, initial_displacement: ArrayLike | None = None,
                 initial_velocity: ArrayLike | None = None,
-                function_samples: int | None = None) -> ShellModalSolution:
+                function_samples: int | None = None, check_spectrum: bool = True
+                ) -> ShellModalSolution:
         """Motion on ``[0, t_end]`` in closed form, mode by mode.
 
         ``M_r d'' + C_r d' + K_r d = Tᵀ F(t)`` with ``C_r = (γ/(ρt)) M_r + β K_r``, so mode
@@ -200,6 +223,7 @@ class ShellModel:
         ``k`` by sparse Lanczos plus the exact static part of the omitted modes (mode
         acceleration) where the stiffness is not singular. ``function_samples`` is accepted
         for the scalar models' interface; shell loads have no time-dependent field.
+        ``check_spectrum`` as for :meth:`eigen`.
         """
         start = time.perf_counter()
         if method != "analytic":
@@ -219,10 +243,11 @@ class ShellModel:
                 raise InputError(f"all modes of {self.n_free} coupled unknowns need a dense "
                                  f"eigenproblem above the limit {modal_basis.DENSE_MAX}: give "
                                  "modes=k for the lowest modes plus the static correction")
-            basis = modal_basis.dense_basis(self._K, self._M, rigid)
+            basis = modal_basis.dense_basis(self._K, self._M, rigid,
+                                            **self._guard(check_spectrum))
         else:
             basis = modal_basis.sparse_basis(self._K, self._M, _count(modes, self.n_free), None,
-                                             rigid)
+                                             rigid, **self._guard(check_spectrum))
         load = as_load(load)
         jumps, harmonics = self._force_terms(load)
         project = lambda F: basis.project(F)[:, None]  # noqa: E731
