@@ -9,9 +9,11 @@ the residual ``r = K φ − λ M φ`` bounds the errors (Parlett, *The Symmetric
 Problem*, §15):
 
 * some eigenvalue lies within ``η = ‖r‖_{M⁻¹} = √(rᵀ M⁻¹ r)`` of ``λ``;
-* the angle (in the ``M`` inner product) between ``φ`` and its eigenvector, or the
-  eigenspace of a cluster, is at most ``η / gap``, ``gap`` the distance from ``λ`` to the
-  nearest computed eigenvalue outside the cluster.
+* the angle (in the ``M`` inner product) between ``φ`` and the eigenspace of its cluster
+  is at most ``η / gap``, ``gap`` the distance from ``λ`` to the nearest computed
+  eigenvalue outside the cluster (Davis–Kahan). A cluster gathers eigenvalues within
+  ``TRUST`` of each other: mixing their vectors changes ``K Φ`` no more than the
+  frequencies' own tolerance.
 
 The residual is evaluated in floating point, so its own round-off (``ε |K| |φ|``, the
 condition number's fear) is part of what is measured.
@@ -38,17 +40,25 @@ def residual_bounds(K: sp.spmatrix, M: sp.spmatrix, lam: Array, phi: Array
                     ) -> tuple[Array, Array]:
     """Per pair, the eigenvalue bound ``η_i`` and the angle bound ``η_i / gap_i``.
 
-    ``phi`` is rescaled to ``φᵀ M φ = 1`` first. Pairs closer than ``η_i + η_j`` form a
-    cluster; the last pair has no computed neighbour above it, so its gap is the one below.
+    ``phi`` is rescaled to ``φᵀ M φ = 1`` first. Neighbours closer than ``TRUST λ`` or than
+    ``η_i + η_j`` form a cluster, whose eigenspace (not each vector) is what the bound
+    concerns; ``gap_i`` is the distance to the nearest computed eigenvalue outside the
+    cluster (the last pair has no computed neighbour above it, so its gap is the one below).
     """
     Mphi = M @ phi
     phi = phi / np.sqrt(np.einsum("ik,ik->k", phi, Mphi))[None, :]
     r = K @ phi - (M @ phi) * lam[None, :]
     Mlu = spla.splu(sp.csc_matrix(M))
     eta = np.sqrt(np.maximum(np.einsum("ik,ik->k", r, Mlu.solve(r)), 0.0))
+    order = np.argsort(lam)
+    ls, es = lam[order], eta[order]
+    # a cluster: neighbours closer than TRUST of ω² (mixing them changes K Φ by no more
+    # than the frequencies' own tolerance) or than their error bounds
+    split = np.diff(ls) > TRUST * np.abs(ls[1:]) + es[1:] + es[:-1]
+    cluster = np.empty_like(order)
+    cluster[order] = np.concatenate([[0], np.cumsum(split)])
     distance = np.abs(lam[:, None] - lam[None, :])
-    apart = distance > eta[:, None] + eta[None, :]
-    gap = np.where(apart, distance, np.inf).min(axis=1)
+    gap = np.where(cluster[:, None] != cluster[None, :], distance, np.inf).min(axis=1)
     return eta, eta / gap
 
 
