@@ -36,7 +36,7 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from ..errors import InputError
-from ..surface import Surface
+from ..surface import Basis, Surface
 from . import metric
 
 Array = NDArray[np.float64]
@@ -125,9 +125,11 @@ def obliqueness(surface: Surface, edge: str, axis: int) -> tuple[float, float]:
     return float(angle[i]), float((v if edge[0] == "u" else u)[ok][i])
 
 
-def end_map(basis: object, start: tuple[int, ...], end: tuple[int, ...]
+def end_map(basis: Basis, start: tuple[int, ...], end: tuple[int, ...]
             ) -> tuple[sp.csr_matrix, NDArray[np.int64]]:
-    """1-D map ``c = T c_kept`` and the kept coefficients, with ``D^j b(x_e) · c = 0`` for ``j`` in ``start``/``end``.
+    """1-D map ``c = T c_kept`` and the kept coefficients, with ``D^j b(x_e) · c = 0``.
+
+    ``j`` runs over the derivative orders ``start`` (at ``x = 0``) and ``end`` (at ``L``).
 
     Each end's rows are solved for as many of its outermost coefficients (pivoted where
     those are ill-conditioned): ``c_E = −C_E⁻¹ C_R c_R`` (DESIGN.md §1.6, as for the plate).

@@ -27,6 +27,7 @@ from ..errors import InputError, SingularSystemError
 from ..loads import Constant, Harmonic, Load, Profile, _profile, _vector3, as_load, static_time
 from ..solvers import modal_basis
 from ..solvers.analytic import ModalResponse
+from ..solvers.rigid import UnresolvedSpectrum
 from ..surface import Surface
 from . import metric
 from .shell import ShellMaterial, matrices
@@ -154,8 +155,8 @@ class ShellModel:
     def spectrum_advice(self) -> str:
         """What to change when the shell's eigen-solution cannot be trusted."""
         m = self.material
-        return (f"The shell's bending stiffness E t³/(12(1−ν²)) is t²/12 = {m.thickness ** 2 / 12:.3g} "
-                "(a length²) times its membrane stiffness E t/(1−ν²), so a thin shell on a "
+        return ("The shell's bending stiffness E t³/(12(1−ν²)) is t²/12 = "
+                f"{m.thickness ** 2 / 12:.3g} (a length²) times its membrane stiffness E t/(1−ν²), so a thin shell on a "
                 "fine net spreads its eigenvalues over many decades: raise the thickness "
                 f"t = {m.thickness:g}, or use fewer cells or a lower degree. Young's modulus "
                 f"E = {m.E:g} scales every eigenvalue alike and Poisson's ratio ν = {m.nu:g} "
@@ -178,9 +179,21 @@ class ShellModel:
             basis = modal_basis.dense_basis(self._K, self._M, self.rigid.shape[1],
                                             **self._guard(check_spectrum))
             return basis.lam[:k], basis.phi[:, :k]
-        basis = modal_basis.sparse_basis(self._K, self._M, k, None, self.rigid.shape[1],
-                                         **self._guard(check_spectrum))
+        basis = self._sparse_basis(k, check_spectrum)
         return basis.lam, basis.phi
+
+    def _sparse_basis(self, k: int, check_spectrum: bool) -> modal_basis.DenseBasis:
+        """The lowest ``k`` modes by shift-invert Lanczos, refusals in the shell's words."""
+        try:
+            return modal_basis.sparse_basis(self._K, self._M, k, None, self.rigid.shape[1],
+                                            **self._guard(check_spectrum))
+        except UnresolvedSpectrum:
+            raise
+        except SingularSystemError:
+            raise SingularSystemError(
+                "the shell's stiffness is singular for this boundary beyond its free rigid "
+                f"motions ({'; '.join(self.rigid_motions) or 'none'}): some deformation "
+                "costs no energy. Check the thickness, Young's modulus and the edges") from None
 
     def frequencies(self, k: int = 6, check_spectrum: bool = True) -> Array:
         """Lowest ``k`` angular frequencies ``ω = √λ`` (rigid ones 0); see :meth:`eigen`."""
@@ -246,8 +259,7 @@ class ShellModel:
             basis = modal_basis.dense_basis(self._K, self._M, rigid,
                                             **self._guard(check_spectrum))
         else:
-            basis = modal_basis.sparse_basis(self._K, self._M, _count(modes, self.n_free), None,
-                                             rigid, **self._guard(check_spectrum))
+            basis = self._sparse_basis(_count(modes, self.n_free), check_spectrum)
         load = as_load(load)
         jumps, harmonics = self._force_terms(load)
         project = lambda F: basis.project(F)[:, None]  # noqa: E731
