@@ -12,10 +12,9 @@ plate), so component ``c`` has ``T_c = T_u^c ⊗ T_v^c`` and ``T`` interleaves t
   ``∂d = 0`` (``j = 0, 1``), which holds the rotation of the normal about the edge;
 - ``diaphragm`` in the plane ``x_a = const`` containing the edge and the surface normal
   (Scordelis–Lo ends): rigid in that plane, ``d_b = 0`` for ``b ≠ a``; ``d_a`` free;
-- ``symmetry`` about the plane ``x_a = const``: ``d_a = 0`` and ``∂d_b = 0`` for ``b ≠ a``
-  (no rotation about the edge tangent), right where the parameter lines crossing the edge
-  are perpendicular to the plane; an edge crossed obliquely (angle above
-  :data:`OBLIQUE_TOL`) is refused, naming the angle;
+- ``symmetry`` about the plane ``x_a = const``: ``d_a = 0`` and no slope across the plane,
+  ``∂_ν d_b = 0`` for ``b ≠ a`` with ``ν = e_a`` in the physical frame, whatever angle the
+  parameter lines make with it (:mod:`.shell_symmetry`, imposed as ``T ← T S``);
 - ``pole`` (or found: an edge whose control points coincide, with open knots across it):
   the surface collapses to one point there; ``T ← T S`` ties the control points of the
   edge to one displacement (``S`` a null-space basis of ``d_k − d_k0 = 0`` on the few
@@ -38,14 +37,11 @@ from numpy.typing import NDArray
 from ..errors import InputError
 from ..surface import Basis, Surface
 from . import metric
+from .shell_symmetry import slope_rows
 
 Array = NDArray[np.float64]
 EDGES = ("u0", "u1", "v0", "v1")
 KINDS = ("free", "pinned", "clamped", "diaphragm", "symmetry", "pole")
-OBLIQUE_TOL = 1e-3
-"""Largest accepted angle (radians) between the parameter lines crossing a symmetry edge and
-the normal of its plane: ``∂_u d_b = 0`` stands for ``∂_n d_b = 0`` only where they agree,
-and the error of the answer grows like this angle."""
 SAMPLES = 9        # points per cell along an edge where planes and angles are measured
 
 
@@ -109,22 +105,6 @@ def plane_axis(surface: Surface, edge: str, kind: str) -> int:
     return int(flat[np.argmin(tilt)])
 
 
-def obliqueness(surface: Surface, edge: str, axis: int) -> tuple[float, float]:
-    """Largest angle (radians) between the crossing parameter line and ``e_axis``, and where.
-
-    The crossing direction is ``a_u`` on a u edge, ``a_v`` on a v edge; points where it
-    vanishes (a pole) are skipped. Returns ``(angle, parameter along the edge)``.
-    """
-    u, v = _edge_parameters(surface, edge)
-    cross = surface.derivative(u, v, *((1, 0) if edge[0] == "u" else (0, 1)))
-    length = np.linalg.norm(cross, axis=-1)
-    ok = length > 1e-9 * max(length.max(), 1e-300)
-    cosine = np.clip(np.abs(cross[ok, axis]) / length[ok], 0.0, 1.0)
-    angle = np.arccos(cosine)
-    i = int(np.argmax(angle))
-    return float(angle[i]), float((v if edge[0] == "u" else u)[ok][i])
-
-
 def end_map(basis: Basis, start: tuple[int, ...], end: tuple[int, ...]
             ) -> tuple[sp.csr_matrix, NDArray[np.int64]]:
     """1-D map ``c = T c_kept`` and the kept coefficients, with ``D^j b(x_e) · c = 0``.
@@ -174,7 +154,7 @@ def _orders(kind: str, axis: int | None, c: int) -> tuple[int, ...]:
     if kind == "diaphragm":
         return () if c == axis else (0,)
     if kind == "symmetry":
-        return (0,) if c == axis else (1,)
+        return (0,) if c == axis else ()      # the slope: shell_symmetry.slope_rows
     return ()
 
 
@@ -197,17 +177,6 @@ def constraint_matrix(surface: Surface, boundary: Mapping[str, str],
     for edge, kind in edges.items():
         if kind in ("diaphragm", "symmetry"):
             axes[edge] = plane_axis(surface, edge, kind)
-        if kind == "symmetry":
-            angle, at = obliqueness(surface, edge, axes[edge])
-            if angle > OBLIQUE_TOL:
-                raise InputError(
-                    f"symmetry edge {edge} of {surface.name!r}: the parameter lines crossing "
-                    f"it meet the symmetry plane {'xyz'[axes[edge]]} = const at "
-                    f"{np.degrees(angle):.3g}° from its normal (at parameter {at:.4g} along "
-                    f"the edge; at most {np.degrees(OBLIQUE_TOL):.2g}° is accepted). The "
-                    "condition holds the slope along those lines, which is the slope across "
-                    "the plane only where they are perpendicular to it; draw the surface "
-                    "with parameter lines that cross the plane at right angles")
     blocks, dofs = [], []
     for c in range(3):
         T_u, keep_u = end_map(surface.basis_u,
@@ -218,8 +187,10 @@ def constraint_matrix(surface: Surface, boundary: Mapping[str, str],
         dofs.append(3 * (keep_u[:, None] * n_v + keep_v[None, :]).ravel() + c)
     T = _interleave(blocks, np.concatenate(dofs), n)
     T = T[:, ~is_fixed[np.sort(np.concatenate(dofs))]].tocsr()
+    for edge in (e for e, kind in edges.items() if kind == "symmetry"):
+        T = _impose(T, slope_rows(surface, edge, axes[edge]) @ T)
     for edge in (e for e, kind in edges.items() if kind == "pole"):
-        T = _tie_pole(T, surface, edge)
+        T = _impose(T, _pole_rows(T, surface, edge))
     if T.shape[1] == 0:
         raise InputError("the shell's boundary conditions and fixed components leave no "
                          "displacement free")
@@ -245,14 +216,23 @@ def _interleave(blocks: list[sp.csr_matrix], dofs: NDArray[np.int64], n: int
     return T
 
 
-def _tie_pole(T: sp.csr_matrix, surface: Surface, edge: str) -> sp.csr_matrix:
-    """``T S`` with ``range S`` the reduced coordinates giving one displacement on the pole."""
+def _pole_rows(T: sp.csr_matrix, surface: Surface, edge: str) -> sp.csc_matrix:
+    """Rows ``(T_k − T_k0) x = 0`` over the reduced coordinates: one point on the pole."""
     n_u, n_v = surface.shape
     grid = np.arange(n_u * n_v).reshape(n_u, n_v)
     points = {"u0": grid[0], "u1": grid[-1], "v0": grid[:, 0], "v1": grid[:, -1]}[edge]
     dofs = 3 * points[:, None] + np.arange(3)                    # (points, 3)
-    A = sp.vstack([T[dofs[1:, c]] - T[np.full(len(points) - 1, dofs[0, c])]
-                   for c in range(3)]).tocsc()
+    return sp.vstack([T[dofs[1:, c]] - T[np.full(len(points) - 1, dofs[0, c])]
+                      for c in range(3)]).tocsc()
+
+
+def _impose(T: sp.csr_matrix, A: sp.spmatrix) -> sp.csr_matrix:
+    """``T S`` with ``range S = null A`` (``A`` over the reduced coordinates ``x``).
+
+    Only the columns ``A`` touches change: ``S`` is the identity on the others and a dense
+    null-space basis (SVD, rank-revealing) on the few involved.
+    """
+    A = sp.csc_matrix(A)
     involved = np.flatnonzero(np.diff(A.indptr))
     if involved.size == 0:
         return T
