@@ -51,7 +51,7 @@ def slope_rows(surface: Surface, edge: str, axis: int) -> sp.csr_matrix:
                   np.stack([np.sum(a_along * a_cross, -1), np.sum(a_along * a_along, -1)], -1)],
                  -2)
     rhs = np.stack([a_cross[:, axis], a_along[:, axis]], -1)
-    coef = np.linalg.solve(g, rhs[..., None])[..., 0]                 # ν ≈ α a_cross + β a_along
+    coef = np.linalg.solve(g, rhs[..., None])[..., 0]      # ν ≈ α a_cross + β a_along
     nu = coef[:, :1] * a_cross + coef[:, 1:] * a_along
     tilt = np.arccos(np.clip(np.linalg.norm(nu, axis=-1), 0.0, 1.0))
     if tilt.max() > TILT_TOL:
