@@ -6,7 +6,7 @@ the derivative across it for any knot layout (:mod:`.shell_edges`).
 
 The rigid motions ``r = t + ω × p`` the boundary leaves free span ``null K_r`` (the shell's
 energy vanishes on rigid motions only); every combination of translations and rotations
-in ``range T`` is found (:meth:`ShellModel._free_rigid_motions`). They are removed by
+in ``range T`` is found (:func:`.shell_rigid.free_rigid_motions`). They are removed by
 Lagrange multipliers ``∫ ρt d·r dA = 0`` (``M`` orthogonality to each), so a
 self-equilibrated load on a free shell has its unique elastic answer; a static load that
 does work on a free rigid motion has no equilibrium and is refused, naming the motion.
@@ -86,7 +86,12 @@ class ShellModel:
         self._M = (self.T.T @ self.M_full @ self.T).tocsc()
         self._C = (material.damping / (material.density * material.thickness) * self._M
                    + material.rayleigh * self._K).tocsc()
-        self.rigid = self._free_rigid_motions()
+        motions = free_rigid_motions(self.T, surface.control_points)
+        self.rigid = motions.reduced
+        #: words for a basis of the free rigid motions (rotation axes, translations)
+        self.rigid_motions = describe(motions.twists,
+                                      float(np.ptp(surface.control_points.reshape(-1, 3),
+                                                   axis=0).max()))
         self.timings = {"assembly": time.perf_counter() - start}
 
     @property
@@ -100,14 +105,6 @@ class ShellModel:
     def matrices(self) -> tuple[sp.csc_matrix, sp.csc_matrix, sp.csc_matrix]:
         """Reduced ``(M_r, C_r, K_r)``, each ``(n_free, n_free)``, ``C_r = (γ/(ρt)) M_r + β K_r``."""
         return self._M, self._C, self._K
-
-    def _free_rigid_motions(self) -> Array:
-        """Reduced rigid motions (any combination of translations and rotations ``ω × p``)
-        the boundary leaves free (:func:`.shell_rigid.free_rigid_motions`)."""
-        motions = free_rigid_motions(self.T, self.surface.control_points)
-        P = self.surface.control_points.reshape(-1, 3)
-        self.rigid_motions = describe(motions.twists, float(np.ptp(P, axis=0).max()))
-        return motions.reduced
 
     def load_vector(self, load: Load | None, t: float = 0.0) -> Array:
         """Reduced generalised force ``Tᵀ F(t)`` over the interleaved unknowns."""
