@@ -42,7 +42,7 @@ from .shell_symmetry import slope_rows
 Array = NDArray[np.float64]
 EDGES = ("u0", "u1", "v0", "v1")
 KINDS = ("free", "pinned", "clamped", "diaphragm", "symmetry", "pole")
-SAMPLES = 9        # points per cell along an edge where planes and angles are measured
+SAMPLES = 9        # points per cell along an edge where its plane is measured
 
 
 def check_edges(surface: Surface, boundary: Mapping[str, str]) -> dict[str, str]:
