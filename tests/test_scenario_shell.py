@@ -102,3 +102,23 @@ def test_shell_keys_and_edges_are_refused_on_the_plate_models():
     missing = PLATE.format(solve='kind = "static"', extra="").replace("E = 1.0e4\n", "")
     with pytest.raises(ScenarioError, match='material.E: missing \\(physics "shell" needs it\\)'):
         parse_scenario(missing, source="plate.toml")
+
+
+@pytest.mark.parametrize("shape, edge, kind, located", [
+    ("half_sphere", "v1", "pole", None),
+    ("half_sphere", "v1", "diaphragm", "boundary: .*v1 of 'half_sphere' is a pole"),
+    ("cylinder", "u0", "clamped", "boundary: .*a closed direction has no edges"),
+])
+def test_shell_poles_and_closed_directions_in_a_scenario(shape, edge, kind, located):
+    from splinedeform.scenario.build import build
+    text = PLATE.format(solve='kind = "static"', extra="").replace(
+        'shape = "plane"\ncells = 8', f'shape = "{shape}"\ncells = [8, 4]')
+    text = text.replace('u0 = "pinned"\nu1 = "pinned"\nv0 = "pinned"\nv1 = "pinned"',
+                        f'v0 = "clamped"\n{edge} = "{kind}"' if edge != "v0" else
+                        f'{edge} = "{kind}"')
+    s = parse_scenario(text, source="shell.toml")
+    if located is None:
+        assert build(s).model.edges[edge] == "pole"
+    else:
+        with pytest.raises(ScenarioError, match=located):
+            build(s)

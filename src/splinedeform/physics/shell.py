@@ -112,9 +112,16 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
     """Stiffness ``K`` and consistent mass ``M`` over the ``3n`` interleaved displacements."""
     if min(surface.basis_u.degree, surface.basis_v.degree) < 2:
         raise InputError("the Kirchhoff–Love shell needs degree >= 2 in u and v (curvatures)")
+    for name, basis in (("u", surface.basis_u), ("v", surface.basis_v)):
+        if getattr(basis, "continuity", basis.degree - 1) < 1:
+            raise InputError(
+                f"the Kirchhoff–Love shell needs a C1 basis in {name}, but its knot vector "
+                f"repeats an interior knot {basis.degree} times (the surface may kink there, "
+                "where bending energy is undefined); use a knot vector without such knots")
     G = metric.grid(surface, extra_points=1)
+    q = (surface.basis_u.degree + 2, surface.basis_v.degree + 2)    # Gauss points per cell
     N = metric.shape_derivatives(G)
-    index = metric.global_index(G, surface.basis_v.size)
+    index = metric.global_index(G, surface.basis_v.size)[::q[0], ::q[1]]   # one row per cell
     dofs = (3 * index[..., :, None] + np.arange(3)).reshape(index.shape[:2] + (-1,))
     size = 3 * surface.basis_u.size * surface.basis_v.size
     E, nu, t = material.E, material.nu, material.thickness
@@ -126,9 +133,25 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
     D = np.zeros(B.shape[:2] + (6, 6))
     D[..., :3, :3] = (E * t / (1 - nu ** 2) * dA)[..., None, None] * H
     D[..., 3:, 3:] = (E * t ** 3 / (12 * (1 - nu ** 2)) * dA)[..., None, None] * H
-    K = np.swapaxes(B, -1, -2) @ (D @ B)                 # Bmᵀ Dm Bm + Bbᵀ Db Bb per point
+    K = cell_sums(B, D @ B, q)                    # Σ_q Bmᵀ Dm Bm + Bbᵀ Db Bb per cell
     # mass ρt ∫ N_k N_l dA for each coordinate alike: the scalar matrix ⊗ I₃ (interleaved)
-    N0 = N[0, 0]
-    mass = (material.density * t * dA)[..., None, None] * N0[..., :, None] * N0[..., None, :]
+    N0 = N[0, 0][..., None, :]
+    mass = cell_sums((material.density * t * dA)[..., None, None] * N0, N0, q)
     M = sp.kron(metric.assemble(index, mass, size // 3), sp.identity(3), format="csr")
     return metric.assemble(dofs, K, size), M
+
+
+def cell_sums(left: Array, right: Array, q: tuple[int, int]) -> Array:
+    """``Σ_{points of a cell} leftᵀ right`` for every cell at once, ``(c_u, c_v, k, l)``.
+
+    ``left (Q_u, Q_v, r, k)`` and ``right (Q_u, Q_v, r, l)`` hold the ``q_u × q_v`` Gauss
+    points of each cell consecutively (:func:`~splinedeform.quadrature.gauss_points`);
+    the points and the ``r`` rows of a cell are stacked into one axis, so each cell's
+    block is one matrix product (batched over the cells).
+    """
+    (Qu, Qv), (qu, qv) = left.shape[:2], q
+
+    def by_cell(A: Array) -> Array:
+        A = A.reshape((Qu // qu, qu, Qv // qv, qv) + A.shape[2:]).swapaxes(1, 2)
+        return A.reshape(A.shape[:2] + (qu * qv * A.shape[-2], A.shape[-1]))
+    return np.swapaxes(by_cell(left), -1, -2) @ by_cell(right)

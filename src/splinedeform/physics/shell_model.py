@@ -1,18 +1,15 @@
 """A Kirchhoff–Love shell model: boundary conditions on ``3n`` coupled unknowns, solves.
 
-Boundary kinds per edge (``"u0"``, ``"u1"``, ``"v0"``, ``"v1"``):
+Boundary kinds per edge (``"u0"``, ``"u1"``, ``"v0"``, ``"v1"``): ``free``, ``pinned``,
+``clamped``, ``diaphragm``, ``symmetry`` and ``pole``, imposed on the trace of the edge and
+the derivative across it for any knot layout (:mod:`.shell_edges`).
 
-- ``free``; ``pinned``: the edge row of control points does not move; ``clamped``: the
-  edge row and the next one do not move (no rotation);
-- ``diaphragm``: rigid in its own plane, free out of it (Scordelis–Lo ends); the edge must
-  lie in a coordinate plane ``x_c = const``; the two other components are fixed;
-- ``symmetry``: the edge lies in a symmetry plane ``x_c = const``: component ``c`` of the
-  edge row is fixed and the two others of the next row are tied to the edge row (zero slope
-  across the plane).
-
-Rigid motions left free by the boundary are removed by Lagrange multipliers
-``∫ ρt d·r dA = 0`` (``M`` orthogonality to each free rigid motion ``r``), so a
-self-equilibrated load on a free shell has its unique elastic answer.
+The rigid motions ``r = t + ω × p`` the boundary leaves free span ``null K_r`` (the shell's
+energy vanishes on rigid motions only); every combination of translations and rotations
+in ``range T`` is found (:func:`.shell_rigid.free_rigid_motions`). They are removed by
+Lagrange multipliers ``∫ ρt d·r dA = 0`` (``M`` orthogonality to each), so a
+self-equilibrated load on a free shell has its unique elastic answer; a static load that
+does work on a free rigid motion has no equilibrium and is refused, naming the motion.
 """
 
 from __future__ import annotations
@@ -30,14 +27,15 @@ from ..errors import InputError, SingularSystemError
 from ..loads import Constant, Harmonic, Load, Profile, _profile, _vector3, as_load, static_time
 from ..solvers import modal_basis
 from ..solvers.analytic import ModalResponse
+from ..solvers.rigid import UnresolvedSpectrum
 from ..surface import Surface
 from . import metric
 from .shell import ShellMaterial, matrices
+from .shell_edges import EDGES, KINDS, check_edges, constraint_matrix  # noqa: F401
+from .shell_rigid import describe, free_rigid_motions
 from .shell_solution import ShellModalSolution, ShellStaticSolution
 
 Array = NDArray[np.float64]
-EDGES = ("u0", "u1", "v0", "v1")
-KINDS = ("free", "pinned", "clamped", "diaphragm", "symmetry")
 
 
 @dataclass(frozen=True)
@@ -61,63 +59,6 @@ class AreaForce(Load):
         return total[:, None] * np.asarray(self.force, dtype=float)[None, :]
 
 
-def _edge_rows(shape: tuple[int, int], edge: str, depth: int) -> NDArray[np.int64]:
-    """Flat control point indices of row ``depth`` (0 = on the edge) of an edge, ``(len,)``."""
-    grid = np.arange(shape[0] * shape[1]).reshape(shape)
-    return {"u0": grid[depth], "u1": grid[-1 - depth], "v0": grid[:, depth],
-            "v1": grid[:, -1 - depth]}[edge]
-
-
-def _plane_axis(surface: Surface, edge: str, kind: str) -> int:
-    P = surface.control_points.reshape(-1, 3)[_edge_rows(surface.shape, edge, 0)]
-    spread = np.ptp(P, axis=0)
-    axis = int(np.argmin(spread))
-    if spread[axis] > 1e-9 * max(1.0, float(np.abs(P).max())):
-        raise InputError(f"a {kind} edge must lie in a coordinate plane (x, y or z constant); "
-                         f"edge {edge} of {surface.name!r} spreads {spread} in x, y, z")
-    return axis
-
-
-def constraint_matrix(surface: Surface, boundary: Mapping[str, str], fixed: Array | None
-                      ) -> sp.csr_matrix:
-    """``T`` with ``d = T d_free`` over the interleaved ``3n`` displacements."""
-    n = surface.shape[0] * surface.shape[1]
-    parent = np.arange(3 * n)
-    is_fixed = np.zeros(3 * n, bool)
-    if fixed is not None:
-        mask = np.asarray(fixed, bool)
-        if mask.shape == surface.shape:          # whole control points, as for Model
-            mask = np.repeat(mask[..., None], 3, axis=-1)
-        is_fixed = mask.ravel().copy()
-    if is_fixed.size != 3 * n:
-        raise InputError(f"fixed must be a boolean mask of shape {surface.shape} (control "
-                         f"points) or {surface.shape + (3,)} (components)")
-    for edge, kind in boundary.items():
-        if edge not in EDGES or kind not in KINDS:
-            raise InputError(f"shell boundary: edge must be one of {EDGES} and kind one of "
-                             f"{KINDS}, got {edge!r}: {kind!r}")
-        row0, row1 = _edge_rows(surface.shape, edge, 0), _edge_rows(surface.shape, edge, 1)
-        if kind in ("pinned", "clamped"):
-            for row in (row0, row1)[: 1 + (kind == "clamped")]:
-                is_fixed[(3 * row[:, None] + np.arange(3)).ravel()] = True
-        elif kind == "diaphragm":
-            axis = _plane_axis(surface, edge, kind)
-            is_fixed[(3 * row0[:, None] + np.delete(np.arange(3), axis)).ravel()] = True
-        elif kind == "symmetry":
-            axis = _plane_axis(surface, edge, kind)
-            is_fixed[3 * row0 + axis] = True
-            for c in np.delete(np.arange(3), axis):
-                parent[3 * row1 + c] = parent[3 * row0 + c]
-    parent = parent[parent]                     # ties are one level deep (row1 → row0)
-    keep = ~is_fixed[parent]
-    columns = np.unique(parent[keep])
-    col_of = np.full(3 * n, -1)
-    col_of[columns] = np.arange(columns.size)
-    rows = np.nonzero(keep)[0]
-    return sp.csr_matrix((np.ones(rows.size), (rows, col_of[parent[rows]])),
-                         shape=(3 * n, columns.size))
-
-
 class ShellModel:
     """A linear Kirchhoff–Love shell on a B-spline surface (``physics = "shell"``).
 
@@ -139,12 +80,18 @@ class ShellModel:
         self.surface, self.material = surface, material
         self.physics = "shell"
         self.K_full, self.M_full = matrices(surface, material)
-        self.T = constraint_matrix(surface, dict(boundary or {}), fixed)
+        self.edges = check_edges(surface, dict(boundary or {}))
+        self.T = constraint_matrix(surface, self.edges, fixed)
         self._K = (self.T.T @ self.K_full @ self.T).tocsc()
         self._M = (self.T.T @ self.M_full @ self.T).tocsc()
         self._C = (material.damping / (material.density * material.thickness) * self._M
                    + material.rayleigh * self._K).tocsc()
-        self.rigid = self._free_rigid_motions()
+        motions = free_rigid_motions(self.T, surface.control_points)
+        self.rigid = motions.reduced
+        #: words for a basis of the free rigid motions (rotation axes, translations)
+        self.rigid_motions = describe(motions.twists,
+                                      float(np.ptp(surface.control_points.reshape(-1, 3),
+                                                   axis=0).max()))
         self.timings = {"assembly": time.perf_counter() - start}
 
     @property
@@ -159,22 +106,6 @@ class ShellModel:
         """Reduced ``(M_r, C_r, K_r)``, each ``(n_free, n_free)``, ``C_r = (γ/(ρt)) M_r + β K_r``."""
         return self._M, self._C, self._K
 
-    def _free_rigid_motions(self) -> Array:
-        """Reduced rigid motions (translations, rotations ``ω × p``) the boundary leaves free."""
-        P = self.surface.control_points.reshape(-1, 3)
-        motions = [np.tile(np.eye(3)[c], (P.shape[0], 1)) for c in range(3)]
-        motions += [np.cross(np.eye(3)[c], P) for c in range(3)]
-        R = np.stack([m.ravel() for m in motions], axis=1)
-        reduced = np.column_stack([spla.lsqr(self.T, R[:, i], atol=1e-14, btol=1e-14)[0]
-                                   for i in range(6)])
-        residual = np.linalg.norm(self.T @ reduced - R, axis=0) / np.linalg.norm(R, axis=0)
-        # combinations of the rigid motions that the constraints allow exactly
-        candidates = reduced[:, residual < 1e-8]
-        if candidates.shape[1] == 0:
-            return np.zeros((self.n_free, 0))
-        u, s, _ = np.linalg.svd(candidates, full_matrices=False)
-        return u[:, s > 1e-10 * s.max()]
-
     def load_vector(self, load: Load | None, t: float = 0.0) -> Array:
         """Reduced generalised force ``Tᵀ F(t)`` over the interleaved unknowns."""
         return np.asarray(self.T.T @ as_load(load).vector(self.surface, t).ravel())
@@ -186,8 +117,24 @@ class ShellModel:
         """
         start = time.perf_counter()
         F = self.load_vector(load, static_time(as_load(load), t))
+        self._check_equilibrium(F)
         d = self._static_solve(F)
         return ShellStaticSolution(self, d, F, {"static": time.perf_counter() - start})
+
+    def _check_equilibrium(self, F: Array) -> None:
+        """Refuse a load doing work ``Fᵀ r`` on a free rigid motion ``r``: no equilibrium."""
+        if self.rigid.shape[1] == 0:
+            return
+        work = np.abs(self.rigid.T @ F)
+        if work.max() <= 1e-9 * max(np.linalg.norm(F), 1e-300):
+            return
+        held = {e: k for e, k in self.edges.items() if k != "free"} or "none"
+        raise SingularSystemError(
+            f"the shell's boundary (edges {held}) leaves {self.rigid.shape[1]} rigid "
+            f"motion(s) free: {'; '.join(self.rigid_motions)}. The load does work on them, "
+            "so no static equilibrium exists (the constrained stiffness is singular). Hold "
+            "the shell against them (pin or clamp an edge, or fix components), or apply a "
+            "self-equilibrated load")
 
     def _static_solve(self, F: Array) -> Array:
         C = self._M @ self.rigid
@@ -202,22 +149,56 @@ class ShellModel:
                                       "energy") from None
         return x[: self.n_free]
 
-    def eigen(self, k: int) -> tuple[Array, Array]:
-        """Lowest ``k`` eigenpairs of ``K_r φ = λ M_r φ`` (``Φᵀ M_r Φ = I``, rigid ``λ = 0``)."""
+    def spectrum_advice(self) -> str:
+        """What to change when the shell's eigen-solution cannot be trusted."""
+        m = self.material
+        return ("The shell's bending stiffness E t³/(12(1−ν²)) is t²/12 = "
+                f"{m.thickness ** 2 / 12:.3g} (a length²) times its membrane stiffness E t/(1−ν²), so a thin shell on a "
+                "fine net spreads its eigenvalues over many decades: raise the thickness "
+                f"t = {m.thickness:g}, or use fewer cells or a lower degree. Young's modulus "
+                f"E = {m.E:g} scales every eigenvalue alike and Poisson's ratio ν = {m.nu:g} "
+                "hardly changes the spread, so neither helps. check_spectrum=False goes on "
+                "with these modes at your own risk")
+
+    def _guard(self, check_spectrum: bool) -> dict:
+        return {"advice": self.spectrum_advice(),
+                "guard": "residual" if check_spectrum else "off"}
+
+    def eigen(self, k: int, check_spectrum: bool = True) -> tuple[Array, Array]:
+        """Lowest ``k`` eigenpairs of ``K_r φ = λ M_r φ`` (``Φᵀ M_r Φ = I``, rigid ``λ = 0``).
+
+        Each computed pair is tested by its residual ``‖K_r φ − λ M_r φ‖`` (the error bounds
+        of :mod:`splinedeform.solvers.eigen_trust`) and refused if its frequency or shape
+        is not resolved; ``check_spectrum=False`` skips the test (at the caller's risk).
+        """
         k = _count(k, self.n_free)
         if k > self.n_free // 2:
-            basis = modal_basis.dense_basis(self._K, self._M, self.rigid.shape[1])
+            basis = modal_basis.dense_basis(self._K, self._M, self.rigid.shape[1],
+                                            **self._guard(check_spectrum))
             return basis.lam[:k], basis.phi[:, :k]
-        basis = modal_basis.sparse_basis(self._K, self._M, k, None, self.rigid.shape[1])
+        basis = self._sparse_basis(k, check_spectrum)
         return basis.lam, basis.phi
 
-    def frequencies(self, k: int = 6) -> Array:
-        """Lowest ``k`` angular frequencies ``ω = √λ`` (rigid ones 0)."""
-        return np.sqrt(self.eigen(k)[0])
+    def _sparse_basis(self, k: int, check_spectrum: bool) -> modal_basis.DenseBasis:
+        """The lowest ``k`` modes by shift-invert Lanczos, refusals in the shell's words."""
+        try:
+            return modal_basis.sparse_basis(self._K, self._M, k, None, self.rigid.shape[1],
+                                            **self._guard(check_spectrum))
+        except UnresolvedSpectrum:
+            raise
+        except SingularSystemError:
+            raise SingularSystemError(
+                "the shell's stiffness is singular for this boundary beyond its free rigid "
+                f"motions ({'; '.join(self.rigid_motions) or 'none'}): some deformation "
+                "costs no energy. Check the thickness, Young's modulus and the edges") from None
 
-    def modes(self, k: int = 6) -> tuple[Array, Array]:
+    def frequencies(self, k: int = 6, check_spectrum: bool = True) -> Array:
+        """Lowest ``k`` angular frequencies ``ω = √λ`` (rigid ones 0); see :meth:`eigen`."""
+        return np.sqrt(self.eigen(k, check_spectrum)[0])
+
+    def modes(self, k: int = 6, check_spectrum: bool = True) -> tuple[Array, Array]:
         """Lowest ``k`` frequencies and mode shapes as control net displacements ``(k, n_u, n_v, 3)``."""
-        lam, phi = self.eigen(k)
+        lam, phi = self.eigen(k, check_spectrum)
         shapes = np.asarray(self.T @ phi).T.reshape((phi.shape[1],) + self.surface.shape + (3,))
         return np.sqrt(lam), shapes
 
@@ -240,7 +221,8 @@ class ShellModel:
     def dynamic(self, load: Load | None, t_end: float, method: str = "analytic",
                 modes: int | None = None, initial_displacement: ArrayLike | None = None,
                 initial_velocity: ArrayLike | None = None,
-                function_samples: int | None = None) -> ShellModalSolution:
+                function_samples: int | None = None, check_spectrum: bool = True
+                ) -> ShellModalSolution:
         """Motion on ``[0, t_end]`` in closed form, mode by mode.
 
         ``M_r d'' + C_r d' + K_r d = Tᵀ F(t)`` with ``C_r = (γ/(ρt)) M_r + β K_r``, so mode
@@ -251,6 +233,7 @@ class ShellModel:
         ``k`` by sparse Lanczos plus the exact static part of the omitted modes (mode
         acceleration) where the stiffness is not singular. ``function_samples`` is accepted
         for the scalar models' interface; shell loads have no time-dependent field.
+        ``check_spectrum`` as for :meth:`eigen`.
         """
         start = time.perf_counter()
         if method != "analytic":
@@ -270,10 +253,10 @@ class ShellModel:
                 raise InputError(f"all modes of {self.n_free} coupled unknowns need a dense "
                                  f"eigenproblem above the limit {modal_basis.DENSE_MAX}: give "
                                  "modes=k for the lowest modes plus the static correction")
-            basis = modal_basis.dense_basis(self._K, self._M, rigid)
+            basis = modal_basis.dense_basis(self._K, self._M, rigid,
+                                            **self._guard(check_spectrum))
         else:
-            basis = modal_basis.sparse_basis(self._K, self._M, _count(modes, self.n_free), None,
-                                             rigid)
+            basis = self._sparse_basis(_count(modes, self.n_free), check_spectrum)
         load = as_load(load)
         jumps, harmonics = self._force_terms(load)
         project = lambda F: basis.project(F)[:, None]  # noqa: E731

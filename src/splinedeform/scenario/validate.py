@@ -205,10 +205,6 @@ def _validate_boundary(raw: Mapping[str, Any], problems: _Problems,
             problems.add(f"boundary.{edge}", f"{kind!r} is an edge of the Kirchhoff–Love shell "
                                              f"only (material.physics = \"shell\"), not of "
                                              f"physics {physics!r}")
-        elif kind == "pole" and physics == "shell":
-            problems.add(f"boundary.{edge}", "'pole' is not an edge of the shell (physics "
-                                             "\"shell\"): use free, pinned, clamped, diaphragm "
-                                             "or symmetry")
     region = values.pop("free_region", None)
     box: dict[str, tuple[float, float] | None] = {"free_u": None, "free_v": None}
     if region is not None:

@@ -36,6 +36,7 @@ from ..errors import InputError, SingularSystemError
 from . import kronecker_eigen
 from .bases import DenseBasis, ModalBasis, SeparableBasis, _zero_small  # noqa: F401 (public here too)
 from .mode_acceleration import StaticCorrection, mode_acceleration  # noqa: F401 (public here too)
+from .eigen_trust import GUARDS, check_by_residual
 from .rigid import check_resolved, count_by_gap
 from .system import KroneckerFactors
 
@@ -50,18 +51,30 @@ DENSE_MAX = 8000
 DEFAULT_ADVICE = "Raise the smallest weight, or use fewer cells or a lower degree"
 
 
+def _resolved(K: sp.spmatrix, M: sp.spmatrix, lam: Array, phi: Array, rigid: int,
+              what: str, advice: str, top: float | None, guard: str) -> Array:
+    """``lam`` with its rigid part zeroed, checked by ``guard`` (:data:`GUARDS`):
+    ``condition`` (:func:`.rigid.check_resolved`), ``residual`` or ``off``
+    (:func:`.eigen_trust.check_by_residual`)."""
+    if guard not in GUARDS:
+        raise InputError(f"guard must be one of {GUARDS}, got {guard!r}")
+    if guard == "condition":
+        return check_resolved(lam, rigid, what, advice, top)
+    return check_by_residual(K, M, lam, phi, rigid, what, advice, top, guard)
+
+
 def dense_basis(K: sp.spmatrix, M: sp.spmatrix, rigid: int | None = None,
-                advice: str = DEFAULT_ADVICE) -> DenseBasis:
+                advice: str = DEFAULT_ADVICE, guard: str = "condition") -> DenseBasis:
     """All modes by dense ``eigh(K_r, M_r)`` (LAPACK ``sygvd``).
 
     The ``rigid`` lowest eigenvalues (the dimension of ``null K_r``, decided from the
     constraints by :mod:`.rigid`; ``None``: counted at round-off level behind a clear gap)
-    are set to 0; the rest must be resolved (:func:`.rigid.check_resolved`).
+    are set to 0; the rest must be resolved (``guard``, see :func:`_resolved`).
     """
     lam, phi = sla.eigh(K.toarray(), M.toarray(), check_finite=False)
     if rigid is None:
         rigid = count_by_gap(lam, "dense eigen-solution")
-    lam = check_resolved(lam, rigid, "dense eigen-solution", advice)
+    lam = _resolved(K, M, lam, phi, rigid, "dense eigen-solution", advice, None, guard)
     return DenseBasis(lam, phi, "dense", True)
 
 
@@ -131,7 +144,7 @@ def _eigsh(K: sp.spmatrix, M: sp.spmatrix, k: int, shift: float, lu: Any) -> tup
 
 def sparse_basis(K: sp.spmatrix, M: sp.spmatrix, k: int | None = None,
                  omega_max: float | None = None, rigid: int | None = 0,
-                 advice: str = DEFAULT_ADVICE) -> DenseBasis:
+                 advice: str = DEFAULT_ADVICE, guard: str = "condition") -> DenseBasis:
     """Lowest modes by shift-invert Lanczos (``eigsh`` with a sparse LU of ``K - σM``).
 
     ``k`` modes, or all with ``ω <= omega_max`` (found by doubling the request). One mode more
@@ -140,7 +153,7 @@ def sparse_basis(K: sp.spmatrix, M: sp.spmatrix, k: int | None = None,
     ``K`` is kept for the static part; with rigid modes (or ``None``, unknown: counted at
     round-off level behind a gap) ``K`` is singular, a small negative shift is used and
     there is no static solve. The ``rigid`` lowest eigenvalues are set to 0 and the rest
-    checked against ``λ_max ≈ max K_ii/M_ii`` (:func:`.rigid.check_resolved`).
+    checked against ``λ_max ≈ max K_ii/M_ii`` (``guard``, see :func:`_resolved`).
     """
     n = K.shape[0]
     unconstrained = rigid != 0
@@ -168,7 +181,8 @@ def sparse_basis(K: sp.spmatrix, M: sp.spmatrix, k: int | None = None,
     top = float(np.max(K.diagonal() / M.diagonal()))       # a Rayleigh quotient <= λ_max
     if rigid is None:
         rigid = count_by_gap(lam, "sparse eigen-solution", top)
-    lam = check_resolved(lam, min(rigid, lam.size), "sparse eigen-solution", advice, top)
+    lam = _resolved(K, M, lam, phi, min(rigid, lam.size), "sparse eigen-solution", advice,
+                    top, guard)
     first = lam[k] if k < lam.size else np.inf
     return DenseBasis(lam[:k], phi[:, :k], "sparse", k == n, solve, first)
 

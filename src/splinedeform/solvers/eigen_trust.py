@@ -1,0 +1,105 @@
+"""Whether computed eigenpairs can be trusted, judged by their residuals.
+
+:func:`.rigid.check_resolved` estimates the error of the lowest elastic eigenvalue from the
+condition number ``κ = λ_max/λ_e`` (a backward-stable solver's worst case ``ε κ``). That
+worst case is often far from the truth: a net whose largest eigenvalues come from a few
+small cells (near a pole) resolves its low modes well. This module tests the computed pairs
+themselves. For ``K φ = λ M φ`` symmetric with ``M`` positive definite and ``φᵀ M φ = 1``,
+the residual ``r = K φ − λ M φ`` bounds the errors (Parlett, *The Symmetric Eigenvalue
+Problem*, §15):
+
+* some eigenvalue lies within ``η = ‖r‖_{M⁻¹} = √(rᵀ M⁻¹ r)`` of ``λ``;
+* the angle (in the ``M`` inner product) between ``φ`` and the eigenspace of its cluster
+  is at most ``η / gap``, ``gap`` the distance from ``λ`` to the nearest computed
+  eigenvalue outside the cluster (Davis–Kahan). A cluster gathers eigenvalues within
+  ``TRUST`` of each other: mixing their vectors changes ``K Φ`` no more than the
+  frequencies' own tolerance.
+
+The residual is evaluated in floating point, so its own round-off (``ε |K| |φ|``, the
+condition number's fear) is part of what is measured.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from numpy.typing import NDArray
+
+from .rigid import ROUNDOFF, TRUST, UnresolvedSpectrum
+
+Array = NDArray[np.float64]
+SHAPE_TRUST = 1e-3
+"""Largest accepted angle bound ``η/gap`` (radians) of a mode shape or of its cluster."""
+CHECKED = 32
+"""How many of the lowest elastic modes are tested (the higher ones are relatively better)."""
+GUARDS = ("condition", "residual", "off")
+
+
+def residual_bounds(K: sp.spmatrix, M: sp.spmatrix, lam: Array, phi: Array
+                    ) -> tuple[Array, Array]:
+    """Per pair, the eigenvalue bound ``η_i`` and the angle bound ``η_i / gap_i``.
+
+    ``phi`` is rescaled to ``φᵀ M φ = 1`` first. Neighbours closer than ``TRUST λ`` or than
+    ``η_i + η_j`` form a cluster, whose eigenspace (not each vector) is what the bound
+    concerns; ``gap_i`` is the distance to the nearest computed eigenvalue outside the
+    cluster (the last pair has no computed neighbour above it, so its gap is the one below).
+    """
+    Mphi = M @ phi
+    phi = phi / np.sqrt(np.einsum("ik,ik->k", phi, Mphi))[None, :]
+    r = K @ phi - (M @ phi) * lam[None, :]
+    Mlu = spla.splu(sp.csc_matrix(M))
+    eta = np.sqrt(np.maximum(np.einsum("ik,ik->k", r, Mlu.solve(r)), 0.0))
+    order = np.argsort(lam)
+    ls, es = lam[order], eta[order]
+    # a cluster: neighbours closer than TRUST of ω² (mixing them changes K Φ by no more
+    # than the frequencies' own tolerance) or than their error bounds
+    split = np.diff(ls) > TRUST * np.abs(ls[1:]) + es[1:] + es[:-1]
+    cluster = np.empty_like(order)
+    cluster[order] = np.concatenate([[0], np.cumsum(split)])
+    distance = np.abs(lam[:, None] - lam[None, :])
+    gap = np.where(cluster[:, None] != cluster[None, :], distance, np.inf).min(axis=1)
+    return eta, eta / gap
+
+
+def check_by_residual(K: sp.spmatrix, M: sp.spmatrix, lam: Array, phi: Array, rigid: int,
+                      what: str, advice: str, top: float | None = None,
+                      guard: str = "residual") -> Array:
+    """Eigenvalues (ascending) with the ``rigid`` lowest set to 0, refused if unresolved.
+
+    ``guard``: ``"residual"`` tests the lowest :data:`CHECKED` elastic pairs by their
+    residuals (module docstring): refused when ``η/λ > TRUST`` or ``η/gap > SHAPE_TRUST``;
+    ``"off"`` trusts them (at the caller's risk). A structurally rigid mode with
+    ``|λ| > ROUNDOFF λ_max`` is refused under both, unless ``"off"``.
+    """
+    if guard not in ("residual", "off"):
+        raise ValueError(f"guard must be 'residual' or 'off', got {guard!r}")
+    lam = np.array(lam, dtype=float)
+    if rigid >= lam.size:
+        return np.zeros_like(lam)
+    top = float(np.abs(lam).max()) if top is None else float(top)
+    if guard == "off":
+        lam[:rigid] = 0.0
+        return lam
+    if rigid and np.abs(lam[:rigid]).max() > ROUNDOFF * top:
+        raise UnresolvedSpectrum(
+            f"{what}: the constraints leave {rigid} rigid mode(s) but the eigensolver found "
+            f"eigenvalue {np.abs(lam[:rigid]).max():.3g} among them (largest {top:.3g}); the "
+            f"eigen-solution is not trustworthy. {advice}")
+    lam[:rigid] = 0.0
+    pick = slice(rigid, min(lam.size, rigid + CHECKED))
+    eta, angle = residual_bounds(K, M, lam[pick], np.asarray(phi)[:, pick])
+    relative = eta / np.maximum(lam[pick], 1e-300)
+    bad = np.flatnonzero((relative > TRUST) | (angle > SHAPE_TRUST))
+    if bad.size:
+        i = int(bad[0])
+        known = (f"its frequency is known only to {relative[i] / 2:.1g} of itself"
+                 if relative[i] < 1 else "its frequency is not resolved at all (the bound "
+                 "exceeds ω²)")
+        if 0 < angle[i] < np.inf:
+            known += f", its shape to an angle of {min(angle[i], np.pi / 2):.1g} rad"
+        raise UnresolvedSpectrum(
+            f"{what}: mode {rigid + i + 1} (ω² = {lam[rigid + i]:.6g}) has the residual "
+            f"‖Kφ − ω²Mφ‖ = {eta[i]:.2g} (in the M⁻¹ norm): {known}. {advice}")
+    return lam
+
