@@ -177,21 +177,29 @@ def test_page_closed_form_equals_the_python_twin(page, server):
     assert np.max(np.abs(ours - expect)) <= 1e-5 * scale
 
 
+# the session token the page was served with (what its own script sends)
+TOKEN = "document.querySelector('meta[name=\"splinedeform-token\"]').content"
+
+
 def test_malformed_message_is_refused_and_the_page_lives(page):
     status = page.evaluate("""async () => {
-        const r = await fetch('api/resolve', {method: 'POST', body: '{"material": [1, 2'});
+        const r = await fetch('api/resolve', {method: 'POST', body: '{"material": [1, 2',
+                                              headers: {'X-Sculpt-Token': TOKEN}});
         return [r.status, (await r.json()).error];
-    }""")
+    }""".replace("TOKEN", TOKEN))
     assert status[0] == 400 and "JSON" in status[1]
     hostile = page.evaluate("""async () => {
-        const r = await fetch('api/save', {method: 'POST', body: JSON.stringify(
+        const r = await fetch('api/save', {method: 'POST', headers: {'X-Sculpt-Token': TOKEN},
+                                           body: JSON.stringify(
             {version: 1, t_end: 1, pushes: [{index: -5, force: [0, 0, 'x'], t_on: 0}]})});
         return [r.status, (await r.json()).error];
-    }""")
+    }""".replace("TOKEN", TOKEN))
     assert hostile[0] == 422 and "pushes" in hostile[1]
     t0 = page.evaluate("sculptState.time")
     page.wait_for_function(f"sculptState.time > {t0 + 0.2}", timeout=30000)   # still running
-    assert page.evaluate("fetch('api/status').then((r) => r.status)") == 200
+    assert page.evaluate("fetch('api/status').then((r) => r.status)") == 403      # no token
+    assert page.evaluate("fetch('api/status', {headers: {'X-Sculpt-Token': TOKEN}})"
+                         ".then((r) => r.status)".replace("TOKEN", TOKEN)) == 200
 
 
 def test_save_writes_a_scenario_of_the_pushes(page, server):

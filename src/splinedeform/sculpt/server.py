@@ -13,7 +13,9 @@ page shows it):
 - ``POST /api/save``: ``{version, t_end, pushes}`` → the scenario written to the save path.
 
 The server binds to 127.0.0.1 unless told otherwise; it never reads or writes a file named
-by a message (the save path is fixed when it starts).
+by a message (the save path is fixed when it starts). Every request passes the
+:class:`~.guard.Guard` first: addressed to the bound address (``Host``), from the server's
+own origin (``Origin``), and, for ``/api/``, with the session token the served page carries.
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ from starlette.routing import Route
 
 from ..errors import InputError
 from .export import _b64
+from .guard import ASGIApp, Guard, guarded
 from .messages import (MAX_BODY, CorrectionMessage, ResolveMessage, SaveMessage,
                        describe_error)
 from .page import sculpt_page
@@ -81,14 +84,14 @@ def _guarded(handler: Handler) -> Handler:
     return guarded
 
 
-def create_app(session: Session) -> Starlette:
-    """The starlette application serving ``session``."""
+def create_app(session: Session, guard: Guard) -> ASGIApp:
+    """The starlette application serving ``session``, behind ``guard``."""
 
     async def page(request: Request) -> Response:
         # the page as served keeps working when saved: it carries what the static
         # correction needs (the API answers do not: a page online asks the server)
         data = await run_in_threadpool(session.page_payload)
-        html = await run_in_threadpool(sculpt_page, data)
+        html = await run_in_threadpool(sculpt_page, data, guard.token)
         return HTMLResponse(html, headers={"Cache-Control": "no-store"})
 
     async def basis(request: Request) -> Response:
@@ -134,7 +137,7 @@ def create_app(session: Session) -> Starlette:
               Route("/api/resolve", _guarded(resolve), methods=["POST"]),
               Route("/api/correction", _guarded(correction), methods=["POST"]),
               Route("/api/save", _guarded(save), methods=["POST"])]
-    return Starlette(routes=routes)
+    return guarded(Starlette(routes=routes), guard)
 
 
 def bind(host: str, port: int) -> socket.socket:
@@ -155,11 +158,18 @@ def bind(host: str, port: int) -> socket.socket:
     return sock
 
 
-def serve(session: Session, sock: socket.socket, quiet: bool = False) -> None:
-    """Serve until Ctrl-C (uvicorn handles SIGINT/SIGTERM and shuts down cleanly)."""
+def serve(session: Session, sock: socket.socket, quiet: bool = False,
+          names: tuple[str, ...] = ()) -> None:
+    """Serve until Ctrl-C (uvicorn handles SIGINT/SIGTERM and shuts down cleanly).
+
+    Requests must address the socket's address and port (or ``names``, e.g. the
+    ``--host`` name it was bound by) and carry the token of the page served.
+    """
     import uvicorn
 
-    config = uvicorn.Config(create_app(session), log_level="warning" if not quiet else "error",
+    host, port = sock.getsockname()[:2]
+    guard = Guard.for_address(host, port, also=names)
+    config = uvicorn.Config(create_app(session, guard), log_level="warning" if not quiet else "error",
                             access_log=False, lifespan="off")
     uvicorn.Server(config).run(sockets=[sock])
 

@@ -124,7 +124,7 @@
 
   async function post(path, body) {
     if (!online) throw new Error("this page is not served by splinedeform sculpt (offline copy)");
-    const response = await fetch(path, { method: "POST", headers: { "Content-Type": "application/json" },
+    const response = await fetch(path, { method: "POST", headers: Object.assign({ "Content-Type": "application/json" }, apiHeaders),
                                          body: JSON.stringify(body) });
     let reply;
     try { reply = await response.json(); } catch (err) { reply = { error: "no JSON answer (" + response.status + ")" }; }
@@ -142,7 +142,7 @@
     const started = performance.now();
     const poll = setInterval(async () => {
       try {
-        const s = await (await fetch("api/status")).json();
+        const s = await (await fetch("api/status", { headers: apiHeaders })).json();
         if (!solving) return;              // answered after the re-solve: its result stays
         progressBox.textContent = "re-solving: " + s.stage + " (" + ((performance.now() - started) / 1000).toFixed(1) + " s)";
       } catch (err) { /* the answer of the re-solve reports errors */ }
