@@ -149,6 +149,8 @@ HOSTILE = [
     ("/api/resolve", json.dumps({**GOOD_RESOLVE, "material": {"w10": "NaN"}}).encode(), 422),
     ("/api/resolve", json.dumps({**GOOD_RESOLVE, "material": {"w10": 1e308}}).encode(), 422),
     ("/api/resolve", json.dumps({**GOOD_RESOLVE, "material": {"mass": 0}}).encode(), 422),
+    ("/api/resolve", json.dumps({**GOOD_RESOLVE, "material": {"mass": True}}).encode(), 422),
+    ("/api/correction", json.dumps({"version": 1, "index": True}).encode(), 422),
     ("/api/resolve", json.dumps({**GOOD_RESOLVE,
                                  "boundary": {"u0": "../../etc/passwd"}}).encode(), 422),
     ("/api/correction", json.dumps({"version": 1, "index": 10**9}).encode(), 400),
