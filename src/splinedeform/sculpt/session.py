@@ -4,11 +4,14 @@ The session keeps the scenario it was started from; a new material or boundary i
 as overrides of that scenario (validated by the scenario reader, so a value the physics
 refuses is named like a key of a file) and the model is rebuilt from it. "Save" writes
 the same scenario with the pushes as ``[[load]]`` point forces with step profiles, so
-``splinedeform run`` replays the session.
+``splinedeform run`` replays the session; a surface read from a file (``file``, ``cad``) is
+named relative to the saved scenario, copied beside it when it lies outside its folder.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import shutil
 import threading
 import time
 from pathlib import Path
@@ -250,7 +253,34 @@ class Session:
                   + ("." if self.correction.complete else
                      f" (the page kept {self.basis.lam.size} of {model.n_free} and added the "
                      "static part of the others)."), ""]
-        text = "\n".join(header) + scenario_to_toml(scenario)
+        text = "\n".join(header) + scenario_to_toml(self._portable(scenario))
         path = write_text(self.save_path, text)
         return path, text
+
+    def _portable(self, scenario: Scenario) -> Scenario:
+        """``scenario`` with its surface file (if any) named relative to the save file's
+        folder, which ``splinedeform run`` reads without ``--allow-outside-paths``: the
+        file as it is when it lies in that folder or below, else a copy beside the save."""
+        from ..export import write_with
+
+        source = scenario.surface.path
+        if source is None:
+            return scenario
+        source = Path(source).resolve()
+        folder = self.save_path.parent.resolve()
+        if not source.is_relative_to(folder):
+            target = folder / source.name
+            if target.exists() and not _same_file(target, source):
+                target = folder / f"{self.save_path.stem}-{source.name}"
+            if not (target.exists() and _same_file(target, source)):
+                write_with(target, lambda tmp: shutil.copyfile(source, tmp))
+            source = target
+        relative = Path(source.relative_to(folder).as_posix())
+        return dataclasses.replace(scenario,
+                                   surface=dataclasses.replace(scenario.surface, path=relative))
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether two files hold the same bytes."""
+    return a.stat().st_size == b.stat().st_size and a.read_bytes() == b.read_bytes()
 
