@@ -243,6 +243,19 @@ def test_resolve_from_the_page_shows_progress_and_resets(page):
     page.wait_for_function("sculptState.errors.length > 0", timeout=60000)
     assert "rigid" in page.evaluate("sculptState.errors.slice(-1)[0]")
     assert page.evaluate("sculptState.version") == 3
+    # refused: the form shows the boundary in use again, not the refused one
+    assert page.evaluate("['u0', 'u1', 'v0', 'v1'].map((e) => "
+                         "document.getElementById('boundary-' + e).value)") == ["clamped"] * 4
+    # no stiffness at all: refused in the page's words (its field), not at a line of the file
+    for key in ("w10", "w01", "w20", "w11", "w02"):
+        page.fill(f"#material-{key}", "0")
+    page.click("#resolve")
+    page.wait_for_function("sculptState.errors.length > 1", timeout=60000)
+    refusal = page.evaluate("sculptState.errors.slice(-1)[0]")
+    assert refusal.startswith("re-solve refused: Material: all stiffness weights are zero")
+    assert "sheet.toml" not in refusal and "line" not in refusal
+    assert page.evaluate("document.getElementById('material-w10').value") == "2"
+    assert page.evaluate("sculptState.version") == 3
 
 
 def test_a_saved_page_works_offline(server, browser, tmp_path):

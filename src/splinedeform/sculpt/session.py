@@ -11,6 +11,7 @@ named relative to the saved scenario, copied beside it when it lies outside its 
 from __future__ import annotations
 
 import dataclasses
+import re
 import shutil
 import threading
 import time
@@ -19,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, ScenarioError
 from ..scenario import build, free_region_mask, scenario_to_toml, with_overrides
 from ..scenario.spec import Scenario
 from .carry import transfer
@@ -127,6 +128,10 @@ class Session:
             overrides["boundary.free_points"] = None if points is None else [list(p) for p in points]
             try:
                 self._solve(with_overrides(self.scenario, overrides, origin="sculpt page"))
+            except ScenarioError as exc:    # the page's settings, not a line of the file
+                message = in_page_words(str(exc), self.scenario.source)
+                self.progress.update(error=message, stage="failed")
+                raise InputError(message) from None
             except Exception as exc:
                 self.progress.update(error=str(exc), stage="failed")
                 raise
@@ -278,6 +283,35 @@ class Session:
         relative = Path(source.relative_to(folder).as_posix())
         return dataclasses.replace(scenario,
                                    surface=dataclasses.replace(scenario.surface, path=relative))
+
+
+PAGE_FIELDS = {"material": "Material", "boundary": "Boundary",
+               "boundary.free_region": "Free set: the free region box",
+               "boundary.free_points": "Free set: the painted control points"}
+"""What the page calls a key of the scenario (material weights and edges: ``Material
+w10``, ``Boundary u0``)."""
+
+
+def page_field(key: str) -> str:
+    """The page's name of a scenario key path (``material.w10`` → ``Material w10``)."""
+    for prefix in sorted(PAGE_FIELDS, key=len, reverse=True):
+        if key == prefix or key.startswith(prefix + ".") or key.startswith(prefix + "["):
+            rest = key[len(prefix):].lstrip(".")
+            return PAGE_FIELDS[prefix] + (f" {rest}" if rest else "")
+    return key
+
+
+def in_page_words(message: str, source: str) -> str:
+    """A scenario error about the page's settings, worded for the page: each
+    ``file:line: key: text`` (or ``file (sculpt page): key: text``) becomes
+    ``<page field>: text``; the file and its lines are not the page's."""
+    where = re.compile(rf"^(\s*){re.escape(source)}(?::\d+| \([^)]*\))?: ([\w.\[\]]+): ")
+    head = re.compile(rf"^{re.escape(source)}: (\d+) problems in the scenario$")
+    lines = []
+    for line in message.splitlines():
+        line = head.sub(r"\1 problems with the page's settings:", line)
+        lines.append(where.sub(lambda m: m.group(1) + page_field(m.group(2)) + ": ", line))
+    return "\n".join(lines)
 
 
 def _same_file(a: Path, b: Path) -> bool:

@@ -88,7 +88,10 @@
       label.querySelector(".name").textContent = edge;
       const select = label.querySelector("select");
       select.id = "boundary-" + edge;
-      for (const preset of ["free", "pinned", "clamped", "pole"]) {
+      // a periodic direction has no edges: nothing to choose there
+      const periodic = data.periodic && data.periodic[edge[0] === "u" ? 0 : 1];
+      if (periodic) { select.disabled = true; select.title = "periodic in " + edge[0] + ": no edge"; }
+      for (const preset of periodic ? ["free"] : ["free", "pinned", "clamped", "pole"]) {
         const option = document.createElement("option");
         option.value = option.textContent = preset;
         select.appendChild(option);
@@ -157,6 +160,7 @@
          "motion carried over (largest jump " + (100 * s.jump / s.scale).toPrecision(2) + " % of |d|)");
     } catch (err) {
       progressBox.textContent = "";
+      restoreAccepted();
       showMessage("re-solve refused: " + err.message);
     } finally {
       clearInterval(poll);
@@ -164,6 +168,14 @@
     }
   }
   document.getElementById("resolve").addEventListener("click", resolve);
+  // a refused re-solve changes nothing: the forms and the free set show the basis in use again
+  function restoreAccepted() {
+    freeMask = decode(data.free_mask, Uint8Array).slice();
+    freeSource = data.free_region ? "box" : "points";
+    freeEdited = false;
+    buildForms();
+    paintNet();
+  }
 
   async function save() {
     const list = pushes.map((p) => ({ index: p.index, force: p.force, t_on: p.t_on, t_off: p.t_off }));
