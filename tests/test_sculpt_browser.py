@@ -204,17 +204,24 @@ def test_malformed_message_is_refused_and_the_page_lives(page):
 
 def test_save_writes_a_scenario_of_the_pushes(page, server):
     from splinedeform.scenario import load_scenario
+    from splinedeform.sculpt.grabs import grab_chains
+    from splinedeform.sculpt.messages import PushMessage
 
     _, folder = server
-    count = len(page.evaluate("sculptState.pushes"))
+    pushes = [{k: p[k] for k in ("index", "force", "t_on", "t_off")}
+              for p in page.evaluate("sculptState.pushes")]
+    count = len(pushes)
     assert count > 0
     reply = page.evaluate("sculptState.save()")
     saved = Path(reply["path"])
     if not saved.is_absolute():
         saved = folder / saved
     scenario = load_scenario(saved)
-    assert len(scenario.loads) == count == reply["loads"]
-    assert all(load.profile == "step" and load.kind == "point" for load in scenario.loads)
+    assert count == reply["steps"] and len(scenario.loads) == reply["loads"]
+    # one piecewise load per grab and axis the force moved along, not one per frame
+    grabs = grab_chains([PushMessage(**p) for p in pushes])
+    assert len(grabs) < count and 0 < len(scenario.loads) <= 3 * len(grabs)
+    assert all(load.profile == "piecewise" and load.kind == "point" for load in scenario.loads)
     assert scenario.solve.kind == "dynamic"
 
 

@@ -135,3 +135,28 @@ def test_a_wildcard_bind_takes_ip_literals_but_no_domain_name():
     assert not v6.host_ok("::1:5000") and not v6.host_ok("[::2]:5000")
     assert v6.origin_ok("http://[::1]:5000", "[::1]:5000")
     assert not v6.origin_ok("http://[::1]:5001", "[::1]:5000")
+
+
+def test_a_dropped_upload_is_logged_as_a_disconnect(served, capsys):
+    """The page goes away mid-upload: the server says so, and it is no internal error."""
+    import asyncio
+
+    client, guard, session = served
+    sent = []
+
+    async def receive():
+        return {"type": "http.disconnect"}
+
+    async def send(message):
+        sent.append(message)
+
+    scope = {"type": "http", "method": "POST", "path": "/api/save", "raw_path": b"/api/save",
+             "query_string": b"", "scheme": "http", "http_version": "1.1",
+             "server": ("127.0.0.1", PORT), "client": ("127.0.0.1", 50000), "root_path": "",
+             "headers": [(b"host", f"127.0.0.1:{PORT}".encode()), (b"origin", ORIGIN.encode()),
+                         (TOKEN_HEADER.lower().encode(), guard.token.encode()),
+                         (b"content-type", b"application/json")]}
+    asyncio.run(client.app(scope, receive, send))
+    err = capsys.readouterr().err
+    assert "disconnected" in err and "internal error" not in err
+    assert not session.save_path.exists()

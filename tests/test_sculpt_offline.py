@@ -4,6 +4,7 @@ normal, not zero. Skipped with the reason when Chromium or Playwright is missing
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -120,5 +121,8 @@ def test_a_periodic_direction_offers_no_edge_condition(browser, tmp_path):
     assert options[0] == options[1] == [True, ["free"], "free"]
     assert options[2] == [False, ["free", "pinned", "clamped", "pole"], "clamped"]
     assert options[3] == [False, ["free", "pinned", "clamped", "pole"], "pole"]
+    # at rest, before any push, the largest displacement is nothing (not the colour floor)
+    page.wait_for_function("document.getElementById('hud').textContent.includes('max |d|')")
+    assert re.search(r"max \|d\| = 0(\s|$)", page.inner_text("#hud")), page.inner_text("#hud")
     assert not page.problems
     page.close()

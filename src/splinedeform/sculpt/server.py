@@ -27,7 +27,7 @@ from collections.abc import Awaitable, Callable
 from pydantic import BaseModel, ValidationError
 from starlette.applications import Starlette
 from starlette.concurrency import run_in_threadpool
-from starlette.requests import Request
+from starlette.requests import ClientDisconnect, Request
 from starlette.responses import HTMLResponse, JSONResponse, Response
 from starlette.routing import Route
 
@@ -78,6 +78,10 @@ def _guarded(handler: Handler) -> Handler:
             return _error(str(exc), 409)
         except InputError as exc:
             return _error(str(exc))
+        except ClientDisconnect:      # the page went away mid-upload: no error of ours
+            print(f"sculpt: {request.url.path}: the page disconnected before its message "
+                  "arrived; nothing done", file=sys.stderr)
+            return _error("disconnected before the message arrived", 400)
         except Exception as exc:  # noqa: BLE001  (never let one message stop the server)
             print(f"sculpt: internal error: {type(exc).__name__}: {exc}", file=sys.stderr)
             return _error(f"internal error: {type(exc).__name__}: {exc}", 500)
@@ -125,9 +129,11 @@ def create_app(session: Session, guard: Guard) -> ASGIApp:
         assert isinstance(message, SaveMessage)
         if not message.pushes:
             raise InputError("nothing to save yet: push the surface first")
-        path, _ = await run_in_threadpool(session.save, message)
-        print(f"sculpt: saved {len(message.pushes)} force steps to {path}", file=sys.stderr)
-        return JSONResponse({"path": str(path), "loads": len(message.pushes)})
+        path, text = await run_in_threadpool(session.save, message)
+        loads = text.splitlines().count("[[load]]")       # table headers: lines of their own
+        print(f"sculpt: saved {len(message.pushes)} force steps as {loads} loads to {path}",
+              file=sys.stderr)
+        return JSONResponse({"path": str(path), "loads": loads, "steps": len(message.pushes)})
 
     async def no_icon(request: Request) -> Response:
         return Response(status_code=204)

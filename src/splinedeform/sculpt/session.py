@@ -26,6 +26,7 @@ from ..scenario.spec import Scenario
 from .carry import transfer
 from .correction import StaticCorrection, offline_data, static_correction
 from .export import _b64, payload
+from .grabs import chain_tables, grab_chains
 from .messages import PushMessage, ResolveMessage, SaveMessage
 from .modal import SculptBasis, sculpt_basis
 
@@ -212,14 +213,19 @@ class Session:
 
     # -- save --------------------------------------------------------------------------------
     def to_scenario(self, message: SaveMessage) -> Scenario:
-        """The session as a scenario: pushes as step point loads, probes at grabbed points."""
+        """The session as a scenario: each grab one piecewise point load (:mod:`.grabs`),
+        probes at the grabbed points."""
         self._check_version(message.version)
-        loads, probes = [], []
         for n, push in enumerate(message.pushes, start=1):
-            loads.append(self._load_table(push, n))
-            at = loads[-1]["at"]
+            self._check_push(push, n)
+        loads, probes = [], []
+        for chain in grab_chains(message.pushes):
+            at = self._sample_point(chain[0].index)
+            loads += chain_tables(chain, at)
             if at not in probes and len(probes) < MAX_PROBES:
                 probes.append(at)
+        if not loads:
+            raise InputError("nothing to save: every push of the session has zero force")
         overrides: dict[str, Any] = {
             "load": loads,
             "title": f"sculpted: {self.scenario.title or self.scenario.name}",
@@ -232,19 +238,15 @@ class Session:
             overrides["output"]["probes"] = probes
         return with_overrides(self.scenario, overrides, origin="sculpt save")
 
-    def _load_table(self, push: PushMessage, n: int) -> dict[str, Any]:
+    def _check_push(self, push: PushMessage, n: int) -> None:
         self._check_index(push.index, f"pushes[{n}].index")
         if push.t_off is not None and not push.t_off > push.t_on:
             raise InputError(f"pushes[{n}]: t_off = {push.t_off} must be after t_on = {push.t_on}")
+
+    def _sample_point(self, index: int) -> list[float]:
+        """``[u, v]`` of sample ``index`` (row-major over the sample grid)."""
         rv = self.basis.samples_v.size
-        u = float(self.basis.samples_u[push.index // rv])
-        v = float(self.basis.samples_v[push.index % rv])
-        table: dict[str, Any] = {"kind": "point", "at": [u, v],
-                                 "force": [float(f) for f in push.force],
-                                 "profile": "step", "t_on": float(push.t_on)}
-        if push.t_off is not None:
-            table["t_off"] = float(push.t_off)
-        return table
+        return [float(self.basis.samples_u[index // rv]), float(self.basis.samples_v[index % rv])]
 
     def save(self, message: SaveMessage) -> tuple[Path, str]:
         """Write the session scenario to :attr:`save_path` (atomically); return it and its text."""
@@ -252,7 +254,8 @@ class Session:
 
         scenario = self.to_scenario(message)
         model = self.basis.model
-        header = [f"# Saved by splinedeform sculpt: {len(message.pushes)} force steps on "
+        header = [f"# Saved by splinedeform sculpt: {len(message.pushes)} force steps in "
+                  f"{len(scenario.loads)} piecewise loads on "
                   f"{model.surface.shape[0]}x{model.surface.shape[1]} control points.",
                   "# splinedeform run replays it with every mode"
                   + ("." if self.correction.complete else

@@ -44,7 +44,7 @@
     hudBox.textContent = "t = " + t.toFixed(2) + (paused ? " (paused)" : "") +
       "   " + (mean > 0 ? (1000 / mean).toFixed(0) : "-") + " fps, " + work.toFixed(1) + " ms per frame" +
       "\n" + K + (data.complete ? " modes (all)" : " of " + data.n_free + " modes" +
-      (online || data.offline ? " + static correction" : "")) + ", " + ru + "×" + rv + " samples, max |d| = " + vmax.toPrecision(3) +
+      (online || data.offline ? " + static correction" : "")) + ", " + ru + "×" + rv + " samples, max |d| = " + (dmax > 0 ? dmax.toPrecision(3) : "0") +
       (grab ? "\ngrabbed sample " + grab.index : "");
   }
 
@@ -182,7 +182,7 @@
     const note = carriedMotion ? " (from the last re-solve on; the motion carried over it is not in the file: a scenario starts at rest)" : "";
     try {
       const reply = await post("api/save", { version: data.version, t_end: Math.max(t, 1e-3), pushes: list });
-      document.getElementById("saved").textContent = "saved " + reply.loads + " force steps to " + reply.path + note;
+      document.getElementById("saved").textContent = "saved " + reply.steps + " force steps as " + reply.loads + " loads (one per grab and direction) to " + reply.path + note;
       showMessage("saved " + reply.path, true);
       return reply;
     } catch (err) {
