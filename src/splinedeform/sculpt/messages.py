@@ -128,3 +128,18 @@ def describe_error(exc: ValidationError) -> str:
     if more > 0:
         lines.append(f"... and {more} more")
     return "; ".join(lines)
+
+
+class BakeMessage(_Message):
+    """Make the shape of modal state ``q`` (``3 k`` numbers, mode-major ``[q_1x, q_1y, q_1z,
+    q_2x, …]``) on basis ``version`` the rest shape."""
+
+    version: Annotated[Count, Field(ge=0)]
+    q: Annotated[list[Annotated[Real, Field(ge=-1e12, le=1e12)]],
+                 Field(min_length=3, max_length=3 * MAX_NET_POINTS)]
+
+
+class HistoryMessage(_Message):
+    """Undo or redo from basis ``version`` (the one the page shows)."""
+
+    version: Annotated[Count, Field(ge=0)]

@@ -10,7 +10,11 @@ page shows it):
   answered with the new data and ``carry``, the map of the old modal state onto the new
   modes (:mod:`.carry`);
 - ``POST /api/correction``: ``{version, index}`` → the static correction column of a sample;
-- ``POST /api/save``: ``{version, t_end, pushes}`` → the scenario written to the save path.
+- ``POST /api/save``: ``{version, t_end, pushes}`` → the scenario written to the save path;
+- ``POST /api/bake``: ``{version, q}`` → the shape of modal state ``q`` becomes the rest
+  shape, modes solved again (answered like a re-solve, with ``baked: true``);
+- ``POST /api/undo``, ``POST /api/redo``: ``{version}`` → back to the basis before, or
+  forward again (:mod:`.history`), answered ``{version}``.
 
 The server binds to 127.0.0.1 unless told otherwise; it never reads or writes a file named
 by a message (the save path is fixed when it starts). Every request passes the
@@ -34,8 +38,8 @@ from starlette.routing import Route
 from ..errors import InputError
 from .export import _b64
 from .guard import ASGIApp, Guard, guarded
-from .messages import (MAX_BODY, CorrectionMessage, ResolveMessage, SaveMessage,
-                       describe_error)
+from .messages import (MAX_BODY, BakeMessage, CorrectionMessage, HistoryMessage,
+                       ResolveMessage, SaveMessage, describe_error)
 from .page import sculpt_page
 from .session import Busy, Session
 
@@ -112,6 +116,24 @@ def create_app(session: Session, guard: Guard) -> ASGIApp:
         data = await run_in_threadpool(session.payload)
         return JSONResponse({**data, "carry": session.transfer_payload()})
 
+    async def bake(request: Request) -> Response:
+        message = await _message(request, BakeMessage)
+        if isinstance(message, JSONResponse):
+            return message
+        await run_in_threadpool(session.bake, message)
+        data = await run_in_threadpool(session.payload)
+        return JSONResponse({**data, "carry": session.transfer_payload(), "baked": True})
+
+    def history(step: str) -> Handler:
+        async def switch(request: Request) -> Response:
+            message = await _message(request, HistoryMessage)
+            if isinstance(message, JSONResponse):
+                return message
+            assert isinstance(message, HistoryMessage)
+            await run_in_threadpool(getattr(session, step), message.version)
+            return JSONResponse({"version": session.version})
+        return switch
+
     async def correction(request: Request) -> Response:
         message = await _message(request, CorrectionMessage)
         if isinstance(message, JSONResponse):
@@ -142,7 +164,10 @@ def create_app(session: Session, guard: Guard) -> ASGIApp:
               Route("/api/status", _guarded(status)),
               Route("/api/resolve", _guarded(resolve), methods=["POST"]),
               Route("/api/correction", _guarded(correction), methods=["POST"]),
-              Route("/api/save", _guarded(save), methods=["POST"])]
+              Route("/api/save", _guarded(save), methods=["POST"]),
+              Route("/api/bake", _guarded(bake), methods=["POST"]),
+              Route("/api/undo", _guarded(history("undo")), methods=["POST"]),
+              Route("/api/redo", _guarded(history("redo")), methods=["POST"])]
     return guarded(Starlette(routes=routes), guard)
 
 

@@ -27,7 +27,8 @@ from .carry import transfer
 from .correction import StaticCorrection, offline_data, static_correction
 from .export import _b64, payload
 from .grabs import chain_tables, grab_chains
-from .messages import PushMessage, ResolveMessage, SaveMessage
+from .history import BasisState, History, baked_net, baked_scenario
+from .messages import BakeMessage, PushMessage, ResolveMessage, SaveMessage
 from .modal import SculptBasis, sculpt_basis
 
 MATERIAL_FIELDS = ("mass", "damping", "rayleigh", "w10", "w01", "w20", "w11", "w02")
@@ -66,6 +67,8 @@ class Session:
         self.modes = modes
         self.save_path = Path(save_path or f"{scenario.name}-sculpt.toml")
         self.version = 0
+        self._versions = 0              # the last version given: each basis has its own
+        self.history = History()
         self.progress: dict[str, Any] = {"busy": False, "stage": "idle", "elapsed": 0.0,
                                          "error": None}
         self._lock = threading.Lock()
@@ -102,8 +105,11 @@ class Session:
             self._stage("carrying the motion over", start)
             self.transfer = (self.version, transfer(old, basis))
         with self._state_lock:          # readers see one basis with its version, never a mix
+            if old is not None:
+                self.history.replaced(self._state())
+            self._versions += 1
             self.scenario, self.basis, self.correction = scenario, basis, correction
-            self.version += 1
+            self.version = self._versions
         self.timing = time.perf_counter() - start
         self._stage("done", start)
 
@@ -138,6 +144,52 @@ class Session:
                 raise
         finally:
             self.progress["busy"] = False
+            self._lock.release()
+
+    def _state(self) -> BasisState:
+        return BasisState(self.scenario, self.basis, self.correction, self.version)
+
+    def bake(self, message: BakeMessage) -> None:
+        """Make the shape of the modal state ``message.q`` the rest shape and re-solve
+        (:mod:`.history`); :attr:`transfer` maps the old modes onto the new ones."""
+        if not self._lock.acquire(blocking=False):
+            raise Busy("a re-solve is already running")
+        try:
+            self.progress.update(busy=True, error=None, stage="baking", elapsed=0.0)
+            with self._state_lock:
+                self._check_version(message.version)
+                basis, scenario = self.basis, self.scenario
+            net = baked_net(basis, np.asarray(message.q, dtype=float))
+            folder = self.save_path.parent
+            baked, _ = baked_scenario(scenario, basis, net, folder,
+                                      f"{self.save_path.stem}-baked-{self._versions + 1}")
+            self._solve(baked)
+        except Exception as exc:
+            self.progress.update(error=str(exc), stage="failed")
+            raise
+        finally:
+            self.progress["busy"] = False
+            self._lock.release()
+
+    def undo(self, version: int) -> None:
+        """Back to the basis before the current one (exactly: kept, not solved again)."""
+        self._switch(version, self.history.back)
+
+    def redo(self, version: int) -> None:
+        """Forward to the basis undone last."""
+        self._switch(version, self.history.forward)
+
+    def _switch(self, version: int, step: Any) -> None:
+        if not self._lock.acquire(blocking=False):
+            raise Busy("a re-solve is already running")
+        try:
+            with self._state_lock:
+                self._check_version(version)
+                state = step(self._state())
+                self.scenario, self.basis, self.correction = (state.scenario, state.basis,
+                                                              state.correction)
+                self.version, self.transfer = state.version, None
+        finally:
             self._lock.release()
 
     # -- what the page receives ------------------------------------------------------------

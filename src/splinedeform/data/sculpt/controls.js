@@ -139,6 +139,7 @@
   async function resolve() {
     if (solving) return;
     solving = true;
+    if (grab) release(null);          // the held push ends now (as when the new modes arrive)
     const material = {}, boundary = {};
     for (const key of WEIGHTS) material[key] = Number(document.getElementById("material-" + key).value);
     for (const edge of EDGES) boundary[edge] = document.getElementById("boundary-" + edge).value;
@@ -152,7 +153,9 @@
     }, 150);
     progressBox.textContent = "re-solving…";
     try {
+      const earlier = pageState();
       const reply = await post("api/resolve", Object.assign({ material, boundary }, freeSet()));
+      remember(earlier);
       load(reply);
       const s = lastSwitch;
       progressBox.textContent = "re-solved in " + reply.solve_seconds + " s (" + K + " modes); " +
@@ -165,6 +168,7 @@
     } finally {
       clearInterval(poll);
       solving = false;
+      showHistory();
     }
   }
   document.getElementById("resolve").addEventListener("click", resolve);
@@ -204,6 +208,7 @@
     tEvent = t;
     modalSum();
     const before = Float64Array.from(disp), oldK = K, oldQ = q, oldV = v, oldVersion = data.version;
+    const oldRest = rest;             // a bake moves the rest shape: jumps are of x = x0 + d
     data = Object.assign({}, d, { colormap: data.colormap });
     unpack(data);
     allocate();
@@ -217,6 +222,7 @@
         for (let j = 0; j < oldK; j++) { const p = P[i * oldK + j]; sq += p * oldQ[3 * j + c]; sv += p * oldV[3 * j + c]; }
         q[3 * i + c] = sq; v[3 * i + c] = sv;
       }
+      if (d.baked) q.fill(0);          // the shape now is the rest shape: only the velocity goes on
     }
     corrections.clear();
     offlineFactor = null;
@@ -228,7 +234,8 @@
     modalSum();
     let jump = 0, scale = 0;
     if (sameGrid) for (let k = 0; k < N * 3; k++) {
-      jump = Math.max(jump, Math.abs(disp[k] - before[k])); scale = Math.max(scale, Math.abs(before[k]));
+      jump = Math.max(jump, Math.abs(rest[k] + disp[k] - oldRest[k] - before[k]));
+      scale = Math.max(scale, Math.abs(before[k]));
     }
     if (carried && scale > 0) carriedMotion = true;
     lastSwitch = { carried, jump, scale, before: Array.from(before), after: Array.from(disp) };
@@ -282,7 +289,9 @@
     pick(x, y) { return pick(x, y); },
     frames() { return frameLog.slice(); },
     latencies() { return latencies.slice(); },
-    setPaused, reset, save, resolve,
+    setPaused, reset, save, resolve, bake, undo, redo,
+    modalState() { return { q: Array.from(q), v: Array.from(v), f: Array.from(f), t, tEvent }; },
+    get history() { return [undoStack.length, redoStack.length]; },
     setSpeed(s) { speed = s; speedBox.value = String(s); },
     // the page's own closed form from rest for given pushes, at ascending times (no drawing):
     // [{index, force, t_on, t_off}], [t...] -> per time the displacement of every sample
