@@ -69,12 +69,14 @@
     if (solving) return;
     solving = true;
     progressBox.textContent = "baking…";
+    const wasPaused = paused;
+    setPaused(true);                  // the shape sent is the shape when the new modes arrive
     try {
       if (grab) release(null);
-      propagate(q, v, f, t - tEvent, q, v);        // the state now
-      tEvent = t;
       const earlier = pageState();
-      const reply = await post("api/bake", { version: data.version, q: Array.from(q) });
+      const now = new Float64Array(K * 3);
+      propagate(q, v, f, t - tEvent, now, null);   // the shape now: x = x0 + Φ q(t)
+      const reply = await post("api/bake", { version: data.version, q: Array.from(now) });
       remember(earlier);
       load(reply);
       progressBox.textContent = "baked in " + reply.solve_seconds + " s: this shape is the rest shape (" + K + " modes)";
@@ -82,6 +84,7 @@
       progressBox.textContent = "";
       showMessage("bake refused: " + err.message);
     } finally {
+      setPaused(wasPaused);
       solving = false;
       showHistory();
     }
