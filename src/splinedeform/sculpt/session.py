@@ -161,9 +161,13 @@ class Session:
                 basis, scenario = self.basis, self.scenario
             net = baked_net(basis, np.asarray(message.q, dtype=float))
             folder = self.save_path.parent
-            baked, _ = baked_scenario(scenario, basis, net, folder,
-                                      f"{self.save_path.stem}-baked-{self._versions + 1}")
-            self._solve(baked)
+            baked, path = baked_scenario(scenario, basis, net, folder,
+                                         f"{self.save_path.stem}-baked-{self._versions + 1}")
+            try:
+                self._solve(baked)
+            except Exception:
+                path.unlink(missing_ok=True)        # refused: no file of a shape never used
+                raise
         except Exception as exc:
             self.progress.update(error=str(exc), stage="failed")
             raise
