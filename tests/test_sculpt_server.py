@@ -265,6 +265,16 @@ def test_command_serves_and_stops_on_ctrl_c(tmp_path):
         assert httpx.post(url + "api/resolve", content=b"{", headers=headers,
                           timeout=30).status_code == 400
         assert httpx.get(url + "api/status", headers=headers, timeout=30).status_code == 200
+        # the running server, as a browser page of another site would reach it
+        rebound = {**headers, "Host": "attacker.example:" + url.rstrip("/").rsplit(":", 1)[1]}
+        assert httpx.get(url + "api/basis", headers=rebound, timeout=30).status_code == 400
+        foreign = {TOKEN_HEADER: token, "Origin": "http://attacker.example",
+                   "Content-Type": "text/plain"}
+        save = json.dumps({"version": 1, "t_end": 1.0,
+                           "pushes": [{"index": 3, "force": [0, 0, 1], "t_on": 0}]})
+        assert httpx.post(url + "api/save", content=save, headers=foreign,
+                          timeout=30).status_code == 403
+        assert not list(tmp_path.glob("*-sculpt.toml"))                 # nothing written
     finally:
         proc.send_signal(signal.SIGINT)
         try:
