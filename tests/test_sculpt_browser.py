@@ -177,36 +177,51 @@ def test_page_closed_form_equals_the_python_twin(page, server):
     assert np.max(np.abs(ours - expect)) <= 1e-5 * scale
 
 
+# the session token the page was served with (what its own script sends)
+TOKEN = "document.querySelector('meta[name=\"splinedeform-token\"]').content"
+
+
 def test_malformed_message_is_refused_and_the_page_lives(page):
     status = page.evaluate("""async () => {
-        const r = await fetch('api/resolve', {method: 'POST', body: '{"material": [1, 2'});
+        const r = await fetch('api/resolve', {method: 'POST', body: '{"material": [1, 2',
+                                              headers: {'X-Sculpt-Token': TOKEN}});
         return [r.status, (await r.json()).error];
-    }""")
+    }""".replace("TOKEN", TOKEN))
     assert status[0] == 400 and "JSON" in status[1]
     hostile = page.evaluate("""async () => {
-        const r = await fetch('api/save', {method: 'POST', body: JSON.stringify(
+        const r = await fetch('api/save', {method: 'POST', headers: {'X-Sculpt-Token': TOKEN},
+                                           body: JSON.stringify(
             {version: 1, t_end: 1, pushes: [{index: -5, force: [0, 0, 'x'], t_on: 0}]})});
         return [r.status, (await r.json()).error];
-    }""")
+    }""".replace("TOKEN", TOKEN))
     assert hostile[0] == 422 and "pushes" in hostile[1]
     t0 = page.evaluate("sculptState.time")
     page.wait_for_function(f"sculptState.time > {t0 + 0.2}", timeout=30000)   # still running
-    assert page.evaluate("fetch('api/status').then((r) => r.status)") == 200
+    assert page.evaluate("fetch('api/status').then((r) => r.status)") == 403      # no token
+    assert page.evaluate("fetch('api/status', {headers: {'X-Sculpt-Token': TOKEN}})"
+                         ".then((r) => r.status)".replace("TOKEN", TOKEN)) == 200
 
 
 def test_save_writes_a_scenario_of_the_pushes(page, server):
     from splinedeform.scenario import load_scenario
+    from splinedeform.sculpt.grabs import grab_chains
+    from splinedeform.sculpt.messages import PushMessage
 
     _, folder = server
-    count = len(page.evaluate("sculptState.pushes"))
+    pushes = [{k: p[k] for k in ("index", "force", "t_on", "t_off")}
+              for p in page.evaluate("sculptState.pushes")]
+    count = len(pushes)
     assert count > 0
     reply = page.evaluate("sculptState.save()")
     saved = Path(reply["path"])
     if not saved.is_absolute():
         saved = folder / saved
     scenario = load_scenario(saved)
-    assert len(scenario.loads) == count == reply["loads"]
-    assert all(load.profile == "step" and load.kind == "point" for load in scenario.loads)
+    assert count == reply["steps"] and len(scenario.loads) == reply["loads"]
+    # one piecewise load per grab and axis the force moved along, not one per frame
+    grabs = grab_chains([PushMessage(**p) for p in pushes])
+    assert len(grabs) < count and 0 < len(scenario.loads) <= 3 * len(grabs)
+    assert all(load.profile == "piecewise" and load.kind == "point" for load in scenario.loads)
     assert scenario.solve.kind == "dynamic"
 
 
@@ -234,6 +249,19 @@ def test_resolve_from_the_page_shows_progress_and_resets(page):
     page.click("#resolve")                  # rigid motions: refused, message shown, page alive
     page.wait_for_function("sculptState.errors.length > 0", timeout=60000)
     assert "rigid" in page.evaluate("sculptState.errors.slice(-1)[0]")
+    assert page.evaluate("sculptState.version") == 3
+    # refused: the form shows the boundary in use again, not the refused one
+    assert page.evaluate("['u0', 'u1', 'v0', 'v1'].map((e) => "
+                         "document.getElementById('boundary-' + e).value)") == ["clamped"] * 4
+    # no stiffness at all: refused in the page's words (its field), not at a line of the file
+    for key in ("w10", "w01", "w20", "w11", "w02"):
+        page.fill(f"#material-{key}", "0")
+    page.click("#resolve")
+    page.wait_for_function("sculptState.errors.length > 1", timeout=60000)
+    refusal = page.evaluate("sculptState.errors.slice(-1)[0]")
+    assert refusal.startswith("re-solve refused: Material: all stiffness weights are zero")
+    assert "sheet.toml" not in refusal and "line" not in refusal
+    assert page.evaluate("document.getElementById('material-w10').value") == "2"
     assert page.evaluate("sculptState.version") == 3
 
 

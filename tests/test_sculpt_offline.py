@@ -4,6 +4,7 @@ normal, not zero. Skipped with the reason when Chromium or Playwright is missing
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -105,5 +106,23 @@ def test_normals_at_a_pole_are_the_limit_normal(browser, tmp_path):
     # one row inwards the normals are the grid's own (x_u × x_v), also near +z
     inner = np.array(page.evaluate(f"sculptState.normal({rv - 2})"))
     assert inner[2] > 0.9
+    assert not page.problems
+    page.close()
+
+
+def test_a_periodic_direction_offers_no_edge_condition(browser, tmp_path):
+    """The half sphere is periodic in u: u0 and u1 are no edges, so their only choice is
+    'free' (disabled); v0 and v1 offer every preset."""
+    session = Session(parse_scenario(DOME, source="dome.toml"), resolution=6, modes=10)
+    page = saved_page(browser, session, tmp_path)
+    options = page.evaluate("""['u0', 'u1', 'v0', 'v1'].map((e) => {
+        const s = document.getElementById('boundary-' + e);
+        return [s.disabled, Array.from(s.options).map((o) => o.value), s.value]; })""")
+    assert options[0] == options[1] == [True, ["free"], "free"]
+    assert options[2] == [False, ["free", "pinned", "clamped", "pole"], "clamped"]
+    assert options[3] == [False, ["free", "pinned", "clamped", "pole"], "pole"]
+    # at rest, before any push, the largest displacement is nothing (not the colour floor)
+    page.wait_for_function("document.getElementById('hud').textContent.includes('max |d|')")
+    assert re.search(r"max \|d\| = 0(\s|$)", page.inner_text("#hud")), page.inner_text("#hud")
     assert not page.problems
     page.close()

@@ -22,6 +22,7 @@ with warnings.catch_warnings():   # starlette >= 1.0 suggests httpx2; httpx stil
 
 from splinedeform.scenario import parse_scenario  # noqa: E402
 from splinedeform.sculpt.export import decode  # noqa: E402
+from splinedeform.sculpt.guard import TOKEN_HEADER, Guard  # noqa: E402
 from splinedeform.sculpt.server import create_app  # noqa: E402
 from splinedeform.sculpt.session import Session  # noqa: E402
 
@@ -54,9 +55,16 @@ def session(tmp_path):
                    save_path=tmp_path / "saved.toml")
 
 
+ORIGIN = "http://127.0.0.1:8765"
+TOKEN = "test-token"
+
+
 @pytest.fixture()
 def client(session):
-    return TestClient(create_app(session), raise_server_exceptions=False)
+    """The page's own requests: addressed to the bound address, same origin, with the token."""
+    app = create_app(session, Guard.for_address("127.0.0.1", 8765, TOKEN))
+    return TestClient(app, base_url=ORIGIN, raise_server_exceptions=False,
+                      headers={"Origin": ORIGIN, TOKEN_HEADER: TOKEN})
 
 
 GOOD_RESOLVE = {"material": {"mass": 1.0, "damping": 0.5, "rayleigh": 0.0, "w10": 2.0,
@@ -141,6 +149,8 @@ HOSTILE = [
     ("/api/resolve", json.dumps({**GOOD_RESOLVE, "material": {"w10": "NaN"}}).encode(), 422),
     ("/api/resolve", json.dumps({**GOOD_RESOLVE, "material": {"w10": 1e308}}).encode(), 422),
     ("/api/resolve", json.dumps({**GOOD_RESOLVE, "material": {"mass": 0}}).encode(), 422),
+    ("/api/resolve", json.dumps({**GOOD_RESOLVE, "material": {"mass": True}}).encode(), 422),
+    ("/api/correction", json.dumps({"version": 1, "index": True}).encode(), 422),
     ("/api/resolve", json.dumps({**GOOD_RESOLVE,
                                  "boundary": {"u0": "../../etc/passwd"}}).encode(), 422),
     ("/api/correction", json.dumps({"version": 1, "index": 10**9}).encode(), 400),
@@ -246,9 +256,25 @@ def test_command_serves_and_stops_on_ctrl_c(tmp_path):
     try:
         assert "http://127.0.0.1:" in line, proc.stderr.read() if proc.poll() is not None else line
         url = line.split()[2]
-        assert httpx.get(url + "api/status", timeout=30).json()["version"] == 1
-        assert httpx.post(url + "api/resolve", content=b"{", timeout=30).status_code == 400
-        assert httpx.get(url + "api/status", timeout=30).status_code == 200
+        page = httpx.get(url, timeout=30).text
+        token = page.split('name="splinedeform-token" content="', 1)[1].split('"', 1)[0]
+        headers = {TOKEN_HEADER: token, "Origin": url.rstrip("/")}
+        assert httpx.get(url + "api/status", timeout=30).status_code == 403     # no token
+        assert httpx.get(url + "api/status", headers=headers,
+                         timeout=30).json()["version"] == 1
+        assert httpx.post(url + "api/resolve", content=b"{", headers=headers,
+                          timeout=30).status_code == 400
+        assert httpx.get(url + "api/status", headers=headers, timeout=30).status_code == 200
+        # the running server, as a browser page of another site would reach it
+        rebound = {**headers, "Host": "attacker.example:" + url.rstrip("/").rsplit(":", 1)[1]}
+        assert httpx.get(url + "api/basis", headers=rebound, timeout=30).status_code == 400
+        foreign = {TOKEN_HEADER: token, "Origin": "http://attacker.example",
+                   "Content-Type": "text/plain"}
+        save = json.dumps({"version": 1, "t_end": 1.0,
+                           "pushes": [{"index": 3, "force": [0, 0, 1], "t_on": 0}]})
+        assert httpx.post(url + "api/save", content=save, headers=foreign,
+                          timeout=30).status_code == 403
+        assert not list(tmp_path.glob("*-sculpt.toml"))                 # nothing written
     finally:
         proc.send_signal(signal.SIGINT)
         try:

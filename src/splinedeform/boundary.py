@@ -2,7 +2,8 @@
 
 Per edge a preset: ``free``, ``pinned`` (``d = 0`` on the edge), ``clamped`` (``d = 0``
 and ``∂_n d = 0``) or ``pole`` (a degenerate edge, such as the pole of a sphere, whose
-control points coincide: they move as one point, so the surface does not tear there). In one direction the end conditions are linear constraints
+control points coincide: they move as one point, so the surface does not tear there; an
+edge whose control points do not coincide is refused, see :func:`check_poles`). In one direction the end conditions are linear constraints
 ``C c = 0`` on the coefficients ``c`` of the 1-D basis, ``C`` made of rows ``b(x_e)`` and
 ``b'(x_e)`` at the ends. For open knots these are ``c_0 = 0`` (and ``c_1 = 0``); for
 Höllig's uniform knots they couple the ``n`` outer coefficients. Each end's constraints are
@@ -27,6 +28,40 @@ from .errors import InputError
 
 PRESETS = ("free", "pinned", "clamped", "pole")
 EDGES = ("u0", "u1", "v0", "v1")
+POLE_TOLERANCE = 1e-8
+"""A pole edge's control points lie within this fraction of the net's size (the diagonal of
+its bounding box) of its first one: round-off of a file, not a shape."""
+
+
+def edge_points(control_points: NDArray[np.float64], edge: str) -> NDArray[np.float64]:
+    """The control points on ``edge`` of a net ``(n_u, n_v, 3)``, in order along it."""
+    return {"u0": control_points[0], "u1": control_points[-1],
+            "v0": control_points[:, 0], "v1": control_points[:, -1]}[edge]
+
+
+def check_poles(edges: Mapping[str, str], control_points: NDArray[np.float64]) -> None:
+    """Refuse a ``pole`` edge that is not collapsed.
+
+    A pole edge moves as one point, so its control points must coincide:
+    ``max_k |P_k - P_0| <= POLE_TOLERANCE · |max P - min P|`` over the edge's points
+    ``P_k``, the right side being the diagonal of the net's bounding box. Otherwise the
+    whole edge would move rigidly as one point; the error names the edge and the length of
+    its control polygon ``Σ_k |P_{k+1} - P_k|``.
+    """
+    P = np.asarray(control_points, dtype=float)
+    size = float(np.linalg.norm(P.max(axis=(0, 1)) - P.min(axis=(0, 1))))
+    for edge in (e for e in EDGES if edges.get(e) == "pole"):
+        row = edge_points(P, edge)
+        spread = float(np.max(np.linalg.norm(row - row[0], axis=-1)))
+        if spread > POLE_TOLERANCE * size:
+            length = float(np.sum(np.linalg.norm(np.diff(row, axis=0), axis=-1)))
+            error = InputError(
+                f"boundary.{edge} = 'pole' needs a collapsed edge (all its control points at "
+                f"one point), but the control polygon of edge {edge} is {length:.6g} long "
+                f"({length / size:.3g} of the net's size {size:.6g}): the whole edge would "
+                "move as one point; use 'free', 'pinned' or 'clamped' there")
+            error.key = f"boundary.{edge}"  # type: ignore[attr-defined]
+            raise error
 
 
 def edge_conditions(boundary: str | Mapping[str, str]) -> dict[str, str]:
@@ -137,7 +172,8 @@ class Constraints:
 
 def build_constraints(basis_u: BSplineBasis, basis_v: BSplineBasis,
                       boundary: str | Mapping[str, str] = "free",
-                      fixed: NDArray[np.bool_] | None = None) -> Constraints:
+                      fixed: NDArray[np.bool_] | None = None,
+                      control_points: NDArray[np.float64] | None = None) -> Constraints:
     """Assemble ``T`` from edge presets and an optional mask of fixed control points.
 
     Parameters
@@ -148,6 +184,8 @@ def build_constraints(basis_u: BSplineBasis, basis_v: BSplineBasis,
     fixed : bool array ``(n_u, n_v)``, optional
         ``True`` marks control points that do not move. A control point already
         determined by an edge condition follows that condition.
+    control_points : array ``(n_u, n_v, 3)``, optional
+        The net; given, every ``pole`` edge must be collapsed (:func:`check_poles`).
     """
     edges = edge_conditions(boundary)
     T_u, keep_u = constraint_map(basis_u, edges["u0"], edges["u1"])
@@ -157,7 +195,8 @@ def build_constraints(basis_u: BSplineBasis, basis_v: BSplineBasis,
     mask = None if fixed is None else _check_mask(fixed, basis_u, basis_v)
     poles = [e for e, preset in edges.items() if preset == "pole"]
     if poles:
-        return _with_poles(basis_u, basis_v, edges, poles, T_u, T_v, keep_u, keep_v, mask)
+        return _with_poles(basis_u, basis_v, edges, poles, T_u, T_v, keep_u, keep_v, mask,
+                           control_points)
     if mask is None:
         T = sp.kron(T_u, T_v, format="csr")
         return Constraints(T, T_u, T_v, free_index, edges, False)
@@ -215,8 +254,10 @@ def _clamped(basis: BSplineBasis, end: int) -> bool:
 def _with_poles(basis_u: BSplineBasis, basis_v: BSplineBasis, edges: dict[str, str],
                 poles: list[str], T_u: sp.csr_matrix, T_v: sp.csr_matrix,
                 keep_u: NDArray[np.int64], keep_v: NDArray[np.int64],
-                mask: NDArray[np.bool_] | None) -> Constraints:
-    """Merge the coordinates of each pole edge into one: ``T ← T S`` (tensor form is lost)."""
+                mask: NDArray[np.bool_] | None,
+                control_points: NDArray[np.float64] | None) -> Constraints:
+    """Merge the coordinates of each pole edge into one: ``T ← T S`` (tensor form is lost);
+    the edges must be collapsed (:func:`check_poles`) when the net is given."""
     n_v = basis_v.size
     T = sp.kron(T_u, T_v, format="csr")
     points = (keep_u[:, None] * n_v + keep_v[None, :]).ravel()     # control point per column
@@ -225,6 +266,8 @@ def _with_poles(basis_u: BSplineBasis, basis_v: BSplineBasis, edges: dict[str, s
         on_edge = np.flatnonzero(np.isin(points, _pole_rows(edge, basis_u, basis_v)))
         if on_edge.size:
             group[on_edge] = group[on_edge].min()
+    if control_points is not None:                 # the knots are right: now the shape
+        check_poles(edges, control_points)
     if mask is not None:
         # a pole moves unless all of its points are fixed
         moving = np.bincount(group, weights=~mask.ravel()[points], minlength=points.size)

@@ -115,7 +115,7 @@ class Model:
         self.physics = physics
         self.constraints: Constraints = build_constraints(
             surface.basis_u, surface.basis_v, boundary,
-            None if fixed is None else np.asarray(fixed))
+            None if fixed is None else np.asarray(fixed), surface.control_points)
         if self.constraints.n_free == 0:
             error = InputError(
                 f"no free coordinate: the boundary {self.constraints.edges} fixes every one of "

@@ -6,6 +6,7 @@ import html
 import json
 import math
 import os
+import re
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -16,6 +17,52 @@ from ..errors import InputError
 from .atomic import _require_folder, write_text
 
 REPORT_TABLE_ROWS = 41
+SAFE_SCHEMES = frozenset({"http", "https", "mailto"})
+"""URL schemes a link of report.md may keep; any other (``javascript:``, ``data:``, …) is defused."""
+
+# a link destination: after "](" (inline link or image) or "]:" (reference definition),
+# optionally opened by "<" (escaped to "&lt;" by then), up to the next space or ")"
+_DESTINATION = re.compile(r"(\]\s*)(\(|:)(\s*(?:&lt;)?)([^\s)]*)")
+_SCHEME = re.compile(r"([a-z][a-z0-9+.\-]*):")
+# a scheme anywhere in the text (a bare "javascript:alert(1)" that some renderer might link)
+_ANY_SCHEME = re.compile(r"(?<![a-z0-9+.\-])([a-z][a-z0-9+.\-]*)(\\?):", re.IGNORECASE)
+_ALWAYS_DEFUSED = frozenset({"javascript", "vbscript", "data", "file", "livescript"})
+
+
+def _scheme(destination: str) -> str | None:
+    """The scheme a browser would read in a link destination, lower case (None: relative).
+
+    As a renderer and a browser read it: HTML entities decoded, backslash escapes dropped,
+    and ASCII controls and spaces removed (a browser's URL parser strips them).
+    """
+    text = html.unescape(destination).replace("\\", "")
+    text = "".join(c for c in text if c > " " and c != "\x7f").lower()
+    match = _SCHEME.match(text)
+    return match.group(1) if match else None
+
+
+def defuse_links(text: str) -> str:
+    """``text`` (already HTML-escaped) with every link whose scheme is not in
+    :data:`SAFE_SCHEMES` turned into plain text.
+
+    ``[a](javascript:x)`` becomes ``[a]\\(javascript&#58;x)``: the escaped parenthesis
+    (``]\\:`` for a reference definition) leaves no link, and the colon of a dangerous
+    scheme is written as a character reference wherever it appears, so no renderer reads
+    the scheme. Relative links and ``http``, ``https``, ``mailto`` are kept as they are.
+    Autolinks ``<javascript:x>`` and raw HTML cannot occur: ``<`` is already ``&lt;``.
+    """
+    def destination(match: re.Match[str]) -> str:
+        scheme = _scheme(match.group(4))
+        if scheme is None or scheme in SAFE_SCHEMES:
+            return match.group(0)
+        return match.group(1) + "\\" + "".join(match.group(2, 3, 4))
+
+    def bare(match: re.Match[str]) -> str:
+        if match.group(1).lower() not in _ALWAYS_DEFUSED:
+            return match.group(0)
+        return match.group(1) + "&#58;"
+
+    return _ANY_SCHEME.sub(bare, _DESTINATION.sub(destination, text))
 
 
 def plain(value: Any) -> Any:
@@ -55,8 +102,9 @@ def format_value(value: Any) -> str:
     if isinstance(value, dict):
         return ", ".join(f"{k}={format_value(v)}" for k, v in value.items())
     # text from a scenario (its title, a net's name) is shown, never interpreted: HTML
-    # escaped, on one line (any whitespace, also U+2028, is one space), pipes escaped
-    return html.escape(" ".join(str(value).split())).replace("|", "\\|")
+    # escaped, on one line (any whitespace, also U+2028, is one space), pipes escaped,
+    # links of any scheme but http, https and mailto defused
+    return defuse_links(html.escape(" ".join(str(value).split()))).replace("|", "\\|")
 
 
 def _is_scalar(value: Any) -> bool:
@@ -123,9 +171,10 @@ def section_markdown(section: Any) -> list[str]:
 def report_markdown(report: Mapping[str, Any], title: str = "splinedeform report") -> str:
     """report.md: a heading and a table (see :func:`section_markdown`) per top-level key."""
     doc = plain(report)
-    lines = [f"# {html.escape(' '.join(str(title).split()))}", ""]
+    lines = [f"# {format_value(str(title))}", ""]
     for name, section in doc.items():
-        lines += [f"## {name.replace('_', ' ').capitalize()}", "", *section_markdown(section), ""]
+        heading = format_value(name.replace("_", " ").capitalize())
+        lines += [f"## {heading}", "", *section_markdown(section), ""]
     return "\n".join(lines)
 
 

@@ -57,7 +57,7 @@ def start(scenario: Any, host: str, port: int, browser: bool, resolution: int,
     if browser:
         webbrowser.open(url)
     try:
-        serve(session, sock, quiet)
+        serve(session, sock, quiet, names=(host,))
     except KeyboardInterrupt:
         pass
     finally:

@@ -1,6 +1,7 @@
 """Messages from the sculpting page to the server, validated with pydantic.
 
-Every field is bounded and finite and no extra key is accepted, so a malformed or hostile
+Every field is bounded and finite, of its own JSON type (strict: ``true`` is no number,
+``"1"`` no weight, ``1.0`` no index) and no extra key is accepted, so a malformed or hostile
 message is refused with a message naming the field before anything is computed. What the
 physics allows beyond that (a boundary preset the surface cannot take, weights leaving a
 deformation without energy) is refused by the scenario validator and the model.
@@ -10,17 +11,21 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, Strict, ValidationError
 
 MAX_PUSHES = 20000
 """Most force segments one save may hold (a drag changes the force once per frame)."""
 MAX_BODY = 4 * 2**20
 """Largest request body in bytes (20000 pushes in JSON take about 2 MiB)."""
 
-Weight = Annotated[float, Field(ge=0.0, le=1e8)]
+Real = Annotated[float, Strict()]
+"""A JSON number (an integer is one too), never a boolean or a string."""
+Count = Annotated[int, Strict()]
+"""A JSON integer, never a boolean, a string or a number with a fraction."""
+Weight = Annotated[Real, Field(ge=0.0, le=1e8)]
 Edge = Literal["free", "pinned", "clamped", "pole"]
-Component = Annotated[float, Field(ge=-1e12, le=1e12)]
-Time = Annotated[float, Field(ge=0.0, le=1e9)]
+Component = Annotated[Real, Field(ge=-1e12, le=1e12)]
+Time = Annotated[Real, Field(ge=0.0, le=1e9)]
 
 
 class _Message(BaseModel):
@@ -30,7 +35,7 @@ class _Message(BaseModel):
 class MaterialMessage(_Message):
     """Material weights and damping: ``[material]`` of a scenario (``mass > 0``)."""
 
-    mass: Annotated[float, Field(gt=0.0, le=1e8)] = 1.0
+    mass: Annotated[Real, Field(gt=0.0, le=1e8)] = 1.0
     damping: Weight = 0.0
     rayleigh: Weight = 0.0
     w10: Weight = 0.0
@@ -49,7 +54,7 @@ class BoundaryMessage(_Message):
     v1: Edge = "free"
 
 
-Parameter = Annotated[float, Field(ge=-1e6, le=1e6)]
+Parameter = Annotated[Real, Field(ge=-1e6, le=1e6)]
 
 
 class FreeRegionMessage(_Message):
@@ -61,7 +66,7 @@ class FreeRegionMessage(_Message):
 
 MAX_NET_POINTS = 160000
 """Most control points a painted free set may list (a 400 x 400 net)."""
-NetIndex = Annotated[int, Field(ge=0, le=100000)]
+NetIndex = Annotated[Count, Field(ge=0, le=100000)]
 
 
 class ResolveMessage(_Message):
@@ -79,14 +84,14 @@ class ResolveMessage(_Message):
 class CorrectionMessage(_Message):
     """The static correction column of one sample point of basis ``version``."""
 
-    version: Annotated[int, Field(ge=0)]
-    index: Annotated[int, Field(ge=0)]
+    version: Annotated[Count, Field(ge=0)]
+    index: Annotated[Count, Field(ge=0)]
 
 
 class PushMessage(_Message):
     """A force ``force`` held at sample ``index`` for ``t_on <= t < t_off`` (None: still held)."""
 
-    index: Annotated[int, Field(ge=0)]
+    index: Annotated[Count, Field(ge=0)]
     force: tuple[Component, Component, Component]
     t_on: Time
     t_off: Time | None = None
@@ -95,18 +100,46 @@ class PushMessage(_Message):
 class SaveMessage(_Message):
     """The session as a scenario: the pushes on basis ``version`` up to time ``t_end``."""
 
-    version: Annotated[int, Field(ge=0)]
-    t_end: Annotated[float, Field(gt=0.0, le=1e9)]
+    version: Annotated[Count, Field(ge=0)]
+    t_end: Annotated[Real, Field(gt=0.0, le=1e9)]
     pushes: Annotated[list[PushMessage], Field(max_length=MAX_PUSHES)]
 
 
+_JSON_TYPES = ((bool, "true/false"), (str, "a string"), (int, "an integer"),
+               (float, "a number"), (type(None), "null"), (dict, "an object"),
+               (list, "an array"), (tuple, "an array"))
+
+
+def _json_type(value: object) -> str:
+    return next((name for kind, name in _JSON_TYPES if isinstance(value, kind)),
+                type(value).__name__)
+
+
 def describe_error(exc: ValidationError) -> str:
-    """One line per problem, ``key.path: what is wrong`` (the input itself is not echoed)."""
+    """One line per problem, ``key.path: what is wrong (got <JSON type>)``; the input itself
+    is not echoed, only its type."""
     lines = []
     for err in exc.errors()[:10]:
         where = ".".join(str(p) for p in err["loc"]) or "message"
-        lines.append(f"{where}: {err['msg']}")
+        got = "" if err["type"] in ("missing", "extra_forbidden") else \
+            f" (got {_json_type(err.get('input'))})"
+        lines.append(f"{where}: {err['msg']}{got}")
     more = exc.error_count() - len(lines)
     if more > 0:
         lines.append(f"... and {more} more")
     return "; ".join(lines)
+
+
+class BakeMessage(_Message):
+    """Make the shape of modal state ``q`` (``3 k`` numbers, mode-major ``[q_1x, q_1y, q_1z,
+    q_2x, …]``) on basis ``version`` the rest shape."""
+
+    version: Annotated[Count, Field(ge=0)]
+    q: Annotated[list[Annotated[Real, Field(ge=-1e12, le=1e12)]],
+                 Field(min_length=3, max_length=3 * MAX_NET_POINTS)]
+
+
+class HistoryMessage(_Message):
+    """Undo or redo from basis ``version`` (the one the page shows)."""
+
+    version: Annotated[Count, Field(ge=0)]

@@ -20,11 +20,15 @@ from ..viz.viewer import _vendor_text
 
 
 #: the parts of the page's script, in the order they are put together
-PARTS = ("state", "draw", "grab", "paint", "controls")
+PARTS = ("state", "draw", "grab", "paint", "controls", "history")
 
 
-def sculpt_page(data: Mapping[str, Any]) -> str:
-    """The self-contained page for the modal data ``data`` (see :meth:`.session.Session.payload`)."""
+def sculpt_page(data: Mapping[str, Any], token: str = "") -> str:
+    """The self-contained page for the modal data ``data`` (see :meth:`.session.Session.payload`).
+
+    ``token`` is the session token the page's script sends with every API call
+    (:mod:`.guard`); a page written for offline use needs none.
+    """
     folder = resources.files("splinedeform").joinpath("data")
     template = folder.joinpath("sculpt_template.html").read_text(encoding="utf-8")
     app = "".join(folder.joinpath("sculpt", f"{part}.js").read_text(encoding="utf-8")
@@ -35,6 +39,7 @@ def sculpt_page(data: Mapping[str, Any]) -> str:
     if "</script" in three.lower():
         raise RuntimeError("the vendored three.js contains '</script' and cannot be inlined")
     fills = {"__SPLINEDEFORM_TITLE__": html.escape(str(data.get("title", "sculpt"))),
+             "__SPLINEDEFORM_TOKEN__": html.escape(token, quote=True),
              "/*__SPLINEDEFORM_THREE__*/": three,
              "/*__SPLINEDEFORM_APP__*/": app,
              "__SPLINEDEFORM_DATA__": script_json({**data, "colormap": colormap_table(64)})}

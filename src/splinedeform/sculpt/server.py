@@ -10,10 +10,16 @@ page shows it):
   answered with the new data and ``carry``, the map of the old modal state onto the new
   modes (:mod:`.carry`);
 - ``POST /api/correction``: ``{version, index}`` → the static correction column of a sample;
-- ``POST /api/save``: ``{version, t_end, pushes}`` → the scenario written to the save path.
+- ``POST /api/save``: ``{version, t_end, pushes}`` → the scenario written to the save path;
+- ``POST /api/bake``: ``{version, q}`` → the shape of modal state ``q`` becomes the rest
+  shape, modes solved again (answered like a re-solve, with ``baked: true``);
+- ``POST /api/undo``, ``POST /api/redo``: ``{version}`` → back to the basis before, or
+  forward again (:mod:`.history`), answered ``{version}``.
 
 The server binds to 127.0.0.1 unless told otherwise; it never reads or writes a file named
-by a message (the save path is fixed when it starts).
+by a message (the save path is fixed when it starts). Every request passes the
+:class:`~.guard.Guard` first: addressed to the bound address (``Host``), from the server's
+own origin (``Origin``), and, for ``/api/``, with the session token the served page carries.
 """
 
 from __future__ import annotations
@@ -25,14 +31,15 @@ from collections.abc import Awaitable, Callable
 from pydantic import BaseModel, ValidationError
 from starlette.applications import Starlette
 from starlette.concurrency import run_in_threadpool
-from starlette.requests import Request
+from starlette.requests import ClientDisconnect, Request
 from starlette.responses import HTMLResponse, JSONResponse, Response
 from starlette.routing import Route
 
 from ..errors import InputError
 from .export import _b64
-from .messages import (MAX_BODY, CorrectionMessage, ResolveMessage, SaveMessage,
-                       describe_error)
+from .guard import ASGIApp, Guard, guarded
+from .messages import (MAX_BODY, BakeMessage, CorrectionMessage, HistoryMessage,
+                       ResolveMessage, SaveMessage, describe_error)
 from .page import sculpt_page
 from .session import Busy, Session
 
@@ -75,20 +82,24 @@ def _guarded(handler: Handler) -> Handler:
             return _error(str(exc), 409)
         except InputError as exc:
             return _error(str(exc))
+        except ClientDisconnect:      # the page went away mid-upload: no error of ours
+            print(f"sculpt: {request.url.path}: the page disconnected before its message "
+                  "arrived; nothing done", file=sys.stderr)
+            return _error("disconnected before the message arrived", 400)
         except Exception as exc:  # noqa: BLE001  (never let one message stop the server)
             print(f"sculpt: internal error: {type(exc).__name__}: {exc}", file=sys.stderr)
             return _error(f"internal error: {type(exc).__name__}: {exc}", 500)
     return guarded
 
 
-def create_app(session: Session) -> Starlette:
-    """The starlette application serving ``session``."""
+def create_app(session: Session, guard: Guard) -> ASGIApp:
+    """The starlette application serving ``session``, behind ``guard``."""
 
     async def page(request: Request) -> Response:
         # the page as served keeps working when saved: it carries what the static
         # correction needs (the API answers do not: a page online asks the server)
         data = await run_in_threadpool(session.page_payload)
-        html = await run_in_threadpool(sculpt_page, data)
+        html = await run_in_threadpool(sculpt_page, data, guard.token)
         return HTMLResponse(html, headers={"Cache-Control": "no-store"})
 
     async def basis(request: Request) -> Response:
@@ -104,6 +115,24 @@ def create_app(session: Session) -> Starlette:
         await run_in_threadpool(session.resolve, message)
         data = await run_in_threadpool(session.payload)
         return JSONResponse({**data, "carry": session.transfer_payload()})
+
+    async def bake(request: Request) -> Response:
+        message = await _message(request, BakeMessage)
+        if isinstance(message, JSONResponse):
+            return message
+        await run_in_threadpool(session.bake, message)
+        data = await run_in_threadpool(session.payload)
+        return JSONResponse({**data, "carry": session.transfer_payload(), "baked": True})
+
+    def history(step: str) -> Handler:
+        async def switch(request: Request) -> Response:
+            message = await _message(request, HistoryMessage)
+            if isinstance(message, JSONResponse):
+                return message
+            assert isinstance(message, HistoryMessage)
+            await run_in_threadpool(getattr(session, step), message.version)
+            return JSONResponse({"version": session.version})
+        return switch
 
     async def correction(request: Request) -> Response:
         message = await _message(request, CorrectionMessage)
@@ -122,9 +151,11 @@ def create_app(session: Session) -> Starlette:
         assert isinstance(message, SaveMessage)
         if not message.pushes:
             raise InputError("nothing to save yet: push the surface first")
-        path, _ = await run_in_threadpool(session.save, message)
-        print(f"sculpt: saved {len(message.pushes)} force steps to {path}", file=sys.stderr)
-        return JSONResponse({"path": str(path), "loads": len(message.pushes)})
+        path, text = await run_in_threadpool(session.save, message)
+        loads = text.splitlines().count("[[load]]")       # table headers: lines of their own
+        print(f"sculpt: saved {len(message.pushes)} force steps as {loads} loads to {path}",
+              file=sys.stderr)
+        return JSONResponse({"path": str(path), "loads": loads, "steps": len(message.pushes)})
 
     async def no_icon(request: Request) -> Response:
         return Response(status_code=204)
@@ -133,8 +164,11 @@ def create_app(session: Session) -> Starlette:
               Route("/api/status", _guarded(status)),
               Route("/api/resolve", _guarded(resolve), methods=["POST"]),
               Route("/api/correction", _guarded(correction), methods=["POST"]),
-              Route("/api/save", _guarded(save), methods=["POST"])]
-    return Starlette(routes=routes)
+              Route("/api/save", _guarded(save), methods=["POST"]),
+              Route("/api/bake", _guarded(bake), methods=["POST"]),
+              Route("/api/undo", _guarded(history("undo")), methods=["POST"]),
+              Route("/api/redo", _guarded(history("redo")), methods=["POST"])]
+    return guarded(Starlette(routes=routes), guard)
 
 
 def bind(host: str, port: int) -> socket.socket:
@@ -155,11 +189,18 @@ def bind(host: str, port: int) -> socket.socket:
     return sock
 
 
-def serve(session: Session, sock: socket.socket, quiet: bool = False) -> None:
-    """Serve until Ctrl-C (uvicorn handles SIGINT/SIGTERM and shuts down cleanly)."""
+def serve(session: Session, sock: socket.socket, quiet: bool = False,
+          names: tuple[str, ...] = ()) -> None:
+    """Serve until Ctrl-C (uvicorn handles SIGINT/SIGTERM and shuts down cleanly).
+
+    Requests must address the socket's address and port (or ``names``, e.g. the
+    ``--host`` name it was bound by) and carry the token of the page served.
+    """
     import uvicorn
 
-    config = uvicorn.Config(create_app(session), log_level="warning" if not quiet else "error",
+    host, port = sock.getsockname()[:2]
+    guard = Guard.for_address(host, port, also=names)
+    config = uvicorn.Config(create_app(session, guard), log_level="warning" if not quiet else "error",
                             access_log=False, lifespan="off")
     uvicorn.Server(config).run(sockets=[sock])
 

@@ -4,11 +4,15 @@ The session keeps the scenario it was started from; a new material or boundary i
 as overrides of that scenario (validated by the scenario reader, so a value the physics
 refuses is named like a key of a file) and the model is rebuilt from it. "Save" writes
 the same scenario with the pushes as ``[[load]]`` point forces with step profiles, so
-``splinedeform run`` replays the session.
+``splinedeform run`` replays the session; a surface read from a file (``file``, ``cad``) is
+named relative to the saved scenario, copied beside it when it lies outside its folder.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import re
+import shutil
 import threading
 import time
 from pathlib import Path
@@ -16,13 +20,15 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, ScenarioError
 from ..scenario import build, free_region_mask, scenario_to_toml, with_overrides
 from ..scenario.spec import Scenario
 from .carry import transfer
 from .correction import StaticCorrection, offline_data, static_correction
 from .export import _b64, payload
-from .messages import PushMessage, ResolveMessage, SaveMessage
+from .grabs import chain_tables, grab_chains
+from .history import BasisState, History, baked_net, baked_scenario
+from .messages import BakeMessage, PushMessage, ResolveMessage, SaveMessage
 from .modal import SculptBasis, sculpt_basis
 
 MATERIAL_FIELDS = ("mass", "damping", "rayleigh", "w10", "w01", "w20", "w11", "w02")
@@ -61,6 +67,8 @@ class Session:
         self.modes = modes
         self.save_path = Path(save_path or f"{scenario.name}-sculpt.toml")
         self.version = 0
+        self._versions = 0              # the last version given: each basis has its own
+        self.history = History()
         self.progress: dict[str, Any] = {"busy": False, "stage": "idle", "elapsed": 0.0,
                                          "error": None}
         self._lock = threading.Lock()
@@ -97,8 +105,11 @@ class Session:
             self._stage("carrying the motion over", start)
             self.transfer = (self.version, transfer(old, basis))
         with self._state_lock:          # readers see one basis with its version, never a mix
+            if old is not None:
+                self.history.replaced(self._state())
+            self._versions += 1
             self.scenario, self.basis, self.correction = scenario, basis, correction
-            self.version += 1
+            self.version = self._versions
         self.timing = time.perf_counter() - start
         self._stage("done", start)
 
@@ -124,11 +135,65 @@ class Session:
             overrides["boundary.free_points"] = None if points is None else [list(p) for p in points]
             try:
                 self._solve(with_overrides(self.scenario, overrides, origin="sculpt page"))
+            except ScenarioError as exc:    # the page's settings, not a line of the file
+                message = in_page_words(str(exc), self.scenario.source)
+                self.progress.update(error=message, stage="failed")
+                raise InputError(message) from None
             except Exception as exc:
                 self.progress.update(error=str(exc), stage="failed")
                 raise
         finally:
             self.progress["busy"] = False
+            self._lock.release()
+
+    def _state(self) -> BasisState:
+        return BasisState(self.scenario, self.basis, self.correction, self.version)
+
+    def bake(self, message: BakeMessage) -> None:
+        """Make the shape of the modal state ``message.q`` the rest shape and re-solve
+        (:mod:`.history`); :attr:`transfer` maps the old modes onto the new ones."""
+        if not self._lock.acquire(blocking=False):
+            raise Busy("a re-solve is already running")
+        try:
+            self.progress.update(busy=True, error=None, stage="baking", elapsed=0.0)
+            with self._state_lock:
+                self._check_version(message.version)
+                basis, scenario = self.basis, self.scenario
+            net = baked_net(basis, np.asarray(message.q, dtype=float))
+            folder = self.save_path.parent
+            baked, path = baked_scenario(scenario, basis, net, folder,
+                                         f"{self.save_path.stem}-baked-{self._versions + 1}")
+            try:
+                self._solve(baked)
+            except Exception:
+                path.unlink(missing_ok=True)        # refused: no file of a shape never used
+                raise
+        except Exception as exc:
+            self.progress.update(error=str(exc), stage="failed")
+            raise
+        finally:
+            self.progress["busy"] = False
+            self._lock.release()
+
+    def undo(self, version: int) -> None:
+        """Back to the basis before the current one (exactly: kept, not solved again)."""
+        self._switch(version, self.history.back)
+
+    def redo(self, version: int) -> None:
+        """Forward to the basis undone last."""
+        self._switch(version, self.history.forward)
+
+    def _switch(self, version: int, step: Any) -> None:
+        if not self._lock.acquire(blocking=False):
+            raise Busy("a re-solve is already running")
+        try:
+            with self._state_lock:
+                self._check_version(version)
+                state = step(self._state())
+                self.scenario, self.basis, self.correction = (state.scenario, state.basis,
+                                                              state.correction)
+                self.version, self.transfer = state.version, None
+        finally:
             self._lock.release()
 
     # -- what the page receives ------------------------------------------------------------
@@ -204,14 +269,19 @@ class Session:
 
     # -- save --------------------------------------------------------------------------------
     def to_scenario(self, message: SaveMessage) -> Scenario:
-        """The session as a scenario: pushes as step point loads, probes at grabbed points."""
+        """The session as a scenario: each grab one piecewise point load (:mod:`.grabs`),
+        probes at the grabbed points."""
         self._check_version(message.version)
-        loads, probes = [], []
         for n, push in enumerate(message.pushes, start=1):
-            loads.append(self._load_table(push, n))
-            at = loads[-1]["at"]
+            self._check_push(push, n)
+        loads, probes = [], []
+        for chain in grab_chains(message.pushes):
+            at = self._sample_point(chain[0].index)
+            loads += chain_tables(chain, at)
             if at not in probes and len(probes) < MAX_PROBES:
                 probes.append(at)
+        if not loads:
+            raise InputError("nothing to save: every push of the session has zero force")
         overrides: dict[str, Any] = {
             "load": loads,
             "title": f"sculpted: {self.scenario.title or self.scenario.name}",
@@ -224,19 +294,15 @@ class Session:
             overrides["output"]["probes"] = probes
         return with_overrides(self.scenario, overrides, origin="sculpt save")
 
-    def _load_table(self, push: PushMessage, n: int) -> dict[str, Any]:
+    def _check_push(self, push: PushMessage, n: int) -> None:
         self._check_index(push.index, f"pushes[{n}].index")
         if push.t_off is not None and not push.t_off > push.t_on:
             raise InputError(f"pushes[{n}]: t_off = {push.t_off} must be after t_on = {push.t_on}")
+
+    def _sample_point(self, index: int) -> list[float]:
+        """``[u, v]`` of sample ``index`` (row-major over the sample grid)."""
         rv = self.basis.samples_v.size
-        u = float(self.basis.samples_u[push.index // rv])
-        v = float(self.basis.samples_v[push.index % rv])
-        table: dict[str, Any] = {"kind": "point", "at": [u, v],
-                                 "force": [float(f) for f in push.force],
-                                 "profile": "step", "t_on": float(push.t_on)}
-        if push.t_off is not None:
-            table["t_off"] = float(push.t_off)
-        return table
+        return [float(self.basis.samples_u[index // rv]), float(self.basis.samples_v[index % rv])]
 
     def save(self, message: SaveMessage) -> tuple[Path, str]:
         """Write the session scenario to :attr:`save_path` (atomically); return it and its text."""
@@ -244,13 +310,70 @@ class Session:
 
         scenario = self.to_scenario(message)
         model = self.basis.model
-        header = [f"# Saved by splinedeform sculpt: {len(message.pushes)} force steps on "
+        header = [f"# Saved by splinedeform sculpt: {len(message.pushes)} force steps in "
+                  f"{len(scenario.loads)} piecewise loads on "
                   f"{model.surface.shape[0]}x{model.surface.shape[1]} control points.",
                   "# splinedeform run replays it with every mode"
                   + ("." if self.correction.complete else
                      f" (the page kept {self.basis.lam.size} of {model.n_free} and added the "
                      "static part of the others)."), ""]
-        text = "\n".join(header) + scenario_to_toml(scenario)
+        text = "\n".join(header) + scenario_to_toml(self._portable(scenario))
         path = write_text(self.save_path, text)
         return path, text
+
+    def _portable(self, scenario: Scenario) -> Scenario:
+        """``scenario`` with its surface file (if any) named relative to the save file's
+        folder, which ``splinedeform run`` reads without ``--allow-outside-paths``: the
+        file as it is when it lies in that folder or below, else a copy beside the save."""
+        from ..export import write_with
+
+        source = scenario.surface.path
+        if source is None:
+            return scenario
+        source = Path(source).resolve()
+        folder = self.save_path.parent.resolve()
+        if not source.is_relative_to(folder):
+            target = folder / source.name
+            if target.exists() and not _same_file(target, source):
+                target = folder / f"{self.save_path.stem}-{source.name}"
+            if not (target.exists() and _same_file(target, source)):
+                write_with(target, lambda tmp: shutil.copyfile(source, tmp))
+            source = target
+        relative = Path(source.relative_to(folder).as_posix())
+        return dataclasses.replace(scenario,
+                                   surface=dataclasses.replace(scenario.surface, path=relative))
+
+
+PAGE_FIELDS = {"material": "Material", "boundary": "Boundary",
+               "boundary.free_region": "Free set: the free region box",
+               "boundary.free_points": "Free set: the painted control points"}
+"""What the page calls a key of the scenario (material weights and edges: ``Material
+w10``, ``Boundary u0``)."""
+
+
+def page_field(key: str) -> str:
+    """The page's name of a scenario key path (``material.w10`` → ``Material w10``)."""
+    for prefix in sorted(PAGE_FIELDS, key=len, reverse=True):
+        if key == prefix or key.startswith(prefix + ".") or key.startswith(prefix + "["):
+            rest = key[len(prefix):].lstrip(".")
+            return PAGE_FIELDS[prefix] + (f" {rest}" if rest else "")
+    return key
+
+
+def in_page_words(message: str, source: str) -> str:
+    """A scenario error about the page's settings, worded for the page: each
+    ``file:line: key: text`` (or ``file (sculpt page): key: text``) becomes
+    ``<page field>: text``; the file and its lines are not the page's."""
+    where = re.compile(rf"^(\s*){re.escape(source)}(?::\d+| \([^)]*\))?: ([\w.\[\]]+): ")
+    head = re.compile(rf"^{re.escape(source)}: (\d+) problems in the scenario$")
+    lines = []
+    for line in message.splitlines():
+        line = head.sub(r"\1 problems with the page's settings:", line)
+        lines.append(where.sub(lambda m: m.group(1) + page_field(m.group(2)) + ": ", line))
+    return "\n".join(lines)
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether two files hold the same bytes."""
+    return a.stat().st_size == b.stat().st_size and a.read_bytes() == b.read_bytes()
 

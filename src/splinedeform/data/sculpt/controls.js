@@ -44,7 +44,7 @@
     hudBox.textContent = "t = " + t.toFixed(2) + (paused ? " (paused)" : "") +
       "   " + (mean > 0 ? (1000 / mean).toFixed(0) : "-") + " fps, " + work.toFixed(1) + " ms per frame" +
       "\n" + K + (data.complete ? " modes (all)" : " of " + data.n_free + " modes" +
-      (online || data.offline ? " + static correction" : "")) + ", " + ru + "×" + rv + " samples, max |d| = " + vmax.toPrecision(3) +
+      (online || data.offline ? " + static correction" : "")) + ", " + ru + "×" + rv + " samples, max |d| = " + (dmax > 0 ? dmax.toPrecision(3) : "0") +
       (grab ? "\ngrabbed sample " + grab.index : "");
   }
 
@@ -88,7 +88,10 @@
       label.querySelector(".name").textContent = edge;
       const select = label.querySelector("select");
       select.id = "boundary-" + edge;
-      for (const preset of ["free", "pinned", "clamped", "pole"]) {
+      // a periodic direction has no edges: nothing to choose there
+      const periodic = data.periodic && data.periodic[edge[0] === "u" ? 0 : 1];
+      if (periodic) { select.disabled = true; select.title = "periodic in " + edge[0] + ": no edge"; }
+      for (const preset of periodic ? ["free"] : ["free", "pinned", "clamped", "pole"]) {
         const option = document.createElement("option");
         option.value = option.textContent = preset;
         select.appendChild(option);
@@ -124,7 +127,7 @@
 
   async function post(path, body) {
     if (!online) throw new Error("this page is not served by splinedeform sculpt (offline copy)");
-    const response = await fetch(path, { method: "POST", headers: { "Content-Type": "application/json" },
+    const response = await fetch(path, { method: "POST", headers: Object.assign({ "Content-Type": "application/json" }, apiHeaders),
                                          body: JSON.stringify(body) });
     let reply;
     try { reply = await response.json(); } catch (err) { reply = { error: "no JSON answer (" + response.status + ")" }; }
@@ -136,20 +139,23 @@
   async function resolve() {
     if (solving) return;
     solving = true;
+    if (grab) release(null);          // the held push ends now (as when the new modes arrive)
     const material = {}, boundary = {};
     for (const key of WEIGHTS) material[key] = Number(document.getElementById("material-" + key).value);
     for (const edge of EDGES) boundary[edge] = document.getElementById("boundary-" + edge).value;
     const started = performance.now();
     const poll = setInterval(async () => {
       try {
-        const s = await (await fetch("api/status")).json();
+        const s = await (await fetch("api/status", { headers: apiHeaders })).json();
         if (!solving) return;              // answered after the re-solve: its result stays
         progressBox.textContent = "re-solving: " + s.stage + " (" + ((performance.now() - started) / 1000).toFixed(1) + " s)";
       } catch (err) { /* the answer of the re-solve reports errors */ }
     }, 150);
     progressBox.textContent = "re-solving…";
     try {
+      const earlier = pageState();
       const reply = await post("api/resolve", Object.assign({ material, boundary }, freeSet()));
+      remember(earlier);
       load(reply);
       const s = lastSwitch;
       progressBox.textContent = "re-solved in " + reply.solve_seconds + " s (" + K + " modes); " +
@@ -157,20 +163,30 @@
          "motion carried over (largest jump " + (100 * s.jump / s.scale).toPrecision(2) + " % of |d|)");
     } catch (err) {
       progressBox.textContent = "";
+      restoreAccepted();
       showMessage("re-solve refused: " + err.message);
     } finally {
       clearInterval(poll);
       solving = false;
+      showHistory();
     }
   }
   document.getElementById("resolve").addEventListener("click", resolve);
+  // a refused re-solve changes nothing: the forms and the free set show the basis in use again
+  function restoreAccepted() {
+    freeMask = decode(data.free_mask, Uint8Array).slice();
+    freeSource = data.free_region ? "box" : "points";
+    freeEdited = false;
+    buildForms();
+    paintNet();
+  }
 
   async function save() {
     const list = pushes.map((p) => ({ index: p.index, force: p.force, t_on: p.t_on, t_off: p.t_off }));
     const note = carriedMotion ? " (from the last re-solve on; the motion carried over it is not in the file: a scenario starts at rest)" : "";
     try {
       const reply = await post("api/save", { version: data.version, t_end: Math.max(t, 1e-3), pushes: list });
-      document.getElementById("saved").textContent = "saved " + reply.loads + " force steps to " + reply.path + note;
+      document.getElementById("saved").textContent = "saved " + reply.steps + " force steps as " + reply.loads + " loads (one per grab and direction) to " + reply.path + note;
       showMessage("saved " + reply.path, true);
       return reply;
     } catch (err) {
@@ -192,6 +208,7 @@
     tEvent = t;
     modalSum();
     const before = Float64Array.from(disp), oldK = K, oldQ = q, oldV = v, oldVersion = data.version;
+    const oldRest = rest;             // a bake moves the rest shape: jumps are of x = x0 + d
     data = Object.assign({}, d, { colormap: data.colormap });
     unpack(data);
     allocate();
@@ -205,6 +222,7 @@
         for (let j = 0; j < oldK; j++) { const p = P[i * oldK + j]; sq += p * oldQ[3 * j + c]; sv += p * oldV[3 * j + c]; }
         q[3 * i + c] = sq; v[3 * i + c] = sv;
       }
+      if (d.baked) q.fill(0);          // the shape now is the rest shape: only the velocity goes on
     }
     corrections.clear();
     offlineFactor = null;
@@ -216,7 +234,8 @@
     modalSum();
     let jump = 0, scale = 0;
     if (sameGrid) for (let k = 0; k < N * 3; k++) {
-      jump = Math.max(jump, Math.abs(disp[k] - before[k])); scale = Math.max(scale, Math.abs(before[k]));
+      jump = Math.max(jump, Math.abs(rest[k] + disp[k] - oldRest[k] - before[k]));
+      scale = Math.max(scale, Math.abs(before[k]));
     }
     if (carried && scale > 0) carriedMotion = true;
     lastSwitch = { carried, jump, scale, before: Array.from(before), after: Array.from(disp) };
@@ -270,7 +289,9 @@
     pick(x, y) { return pick(x, y); },
     frames() { return frameLog.slice(); },
     latencies() { return latencies.slice(); },
-    setPaused, reset, save, resolve,
+    setPaused, reset, save, resolve, bake, undo, redo,
+    modalState() { return { q: Array.from(q), v: Array.from(v), f: Array.from(f), t, tEvent }; },
+    get history() { return [undoStack.length, redoStack.length]; },
     setSpeed(s) { speed = s; speedBox.value = String(s); },
     // the page's own closed form from rest for given pushes, at ascending times (no drawing):
     // [{index, force, t_on, t_off}], [t...] -> per time the displacement of every sample

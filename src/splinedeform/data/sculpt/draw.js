@@ -102,7 +102,7 @@
   }
 
   // -- per frame: x = x0 + Φ_s q(t) (+ r_a ⊗ P held) ---------------------------------------------
-  let vmax = 0, dirty = true;
+  let vmax = 0, dmax = 0, dirty = true;   // colour scale (never 0), largest |d| drawn
   // out[3n + c] = Σ_i A[n K + i] q_c,i for the rows n of a (rows × K) float32 matrix A
   // (Φ_s or the net's), float64 sums in the order i = 0 … K-1; two rows at a time, so that
   // each modal coordinate is loaded once for both (the loop is bound by its loads)
@@ -231,6 +231,7 @@
       if (m > top) top = m;
     }
     vmax = Math.max(top, vmax * 0.995, 1e-6 * radius);
+    dmax = top;
     gridNormals(pos, normals);
     poleNormals(pos, normals);
     const cam = camera.position, lx = lightDir.x, ly = lightDir.y, lz = lightDir.z;

@@ -2,6 +2,10 @@
 // The parts are concatenated in order inside one function scope (see sculpt/page.py).
   let data = JSON.parse(document.getElementById("splinedeform-data").textContent);
   const online = location.protocol === "http:" || location.protocol === "https:";
+  // the session token of the server that served this page: sent with every API call
+  // (the server refuses calls without it; see splinedeform/sculpt/guard.py)
+  const tokenTag = document.querySelector('meta[name="splinedeform-token"]');
+  const apiHeaders = { "X-Sculpt-Token": tokenTag ? tokenTag.content : "" };
   const messageBox = document.getElementById("message");
   const errors = [];
   let messageTimer = null;

@@ -1,0 +1,95 @@
+// sculpt page, part history: "bake" (the current shape becomes the rest shape) and undo/redo of every change of basis.
+// The parts are concatenated in order inside one function scope (see sculpt/page.py).
+  // Each re-solve or bake keeps the page's whole state before it (the modal data, (q, q', f),
+  // the clock, the pushes, the free set); undo puts it back exactly after the server has
+  // switched back to that basis (splinedeform/sculpt/history.py), redo likewise.
+  const MAX_UNDO = 20;                 // as the server keeps
+  let undoStack = [], redoStack = [];
+  const undoButton = document.getElementById("undo"), redoButton = document.getElementById("redo");
+  function pageState() {
+    return { data, q: Float64Array.from(q), v: Float64Array.from(v), f: Float64Array.from(f),
+             t, tEvent, pushes: pushes.map((p) => Object.assign({}, p, { force: p.force.slice() })),
+             freeMask: freeMask.slice(), freeSource, freeEdited, carriedMotion,
+             corrections: new Map(corrections) };
+  }
+  function showHistory() {
+    undoButton.disabled = !online || undoStack.length === 0;
+    redoButton.disabled = !online || redoStack.length === 0;
+  }
+  function remember(state) {            // a new basis replaced the one of `state`
+    undoStack.push(state);
+    if (undoStack.length > MAX_UNDO) undoStack.shift();
+    redoStack = [];
+    showHistory();
+  }
+  function restore(state) {
+    if (grab) release(null);
+    const sameGrid = state.data.grid[0] === ru && state.data.grid[1] === rv;
+    data = state.data;
+    unpack(data);
+    allocate();
+    q.set(state.q); v.set(state.v); f.set(state.f);
+    t = state.t; tEvent = state.tEvent;
+    pushes = state.pushes.map((p) => Object.assign({}, p, { force: p.force.slice() }));
+    freeMask = state.freeMask.slice(); freeSource = state.freeSource; freeEdited = state.freeEdited;
+    carriedMotion = state.carriedMotion;
+    corrections.clear();
+    state.corrections.forEach((c, k) => { if (c) corrections.set(k, c); });
+    offlineFactor = null; grab = null; controls.enabled = true; lastSwitch = null;
+    if (!sameGrid || !geometry) buildGeometry();
+    buildForms();
+    paintNet();
+    modalSum();
+    dirty = true;
+  }
+  async function switchBasis(path, from, to) {
+    if (solving || from.length === 0) return;
+    solving = true;
+    try {
+      const target = from[from.length - 1];
+      const reply = await post(path, { version: data.version });
+      if (reply.version !== target.data.version) {
+        throw new Error("the server's history differs from the page's (basis " + reply.version +
+                        " instead of " + target.data.version + "); reload the page");
+      }
+      from.pop();
+      to.push(pageState());
+      restore(target);
+      progressBox.textContent = (path === "api/undo" ? "undone" : "redone") + ": basis " + data.version;
+    } catch (err) {
+      showMessage((path === "api/undo" ? "undo" : "redo") + " refused: " + err.message);
+    } finally {
+      solving = false;
+      showHistory();
+    }
+  }
+  function undo() { return switchBasis("api/undo", undoStack, redoStack); }
+  function redo() { return switchBasis("api/redo", redoStack, undoStack); }
+  async function bake() {
+    if (solving) return;
+    solving = true;
+    progressBox.textContent = "baking…";
+    const wasPaused = paused;
+    setPaused(true);                  // the shape sent is the shape when the new modes arrive
+    try {
+      if (grab) release(null);
+      const earlier = pageState();
+      const now = new Float64Array(K * 3);
+      propagate(q, v, f, t - tEvent, now, null);   // the shape now: x = x0 + Φ q(t)
+      const reply = await post("api/bake", { version: data.version, q: Array.from(now) });
+      remember(earlier);
+      load(reply);
+      progressBox.textContent = "baked in " + reply.solve_seconds + " s: this shape is the rest shape (" + K + " modes)";
+    } catch (err) {
+      progressBox.textContent = "";
+      showMessage("bake refused: " + err.message);
+    } finally {
+      setPaused(wasPaused);
+      solving = false;
+      showHistory();
+    }
+  }
+  document.getElementById("bake").addEventListener("click", () => { bake(); });
+  undoButton.addEventListener("click", () => { undo(); });
+  redoButton.addEventListener("click", () => { redo(); });
+  showHistory();
