@@ -1,11 +1,13 @@
 """Scenarios whose [surface] is a NURBS surface of a CAD file (shape = "cad")."""
 
+import warnings
+
 import numpy as np
 import pytest
 
 import splinedeform as sd
 from splinedeform.cad import NurbsPatch, refine, surface_from_patch, write_3dm
-from splinedeform.errors import ScenarioError
+from splinedeform.errors import InputWarning, ScenarioError
 from splinedeform.scenario import build, load_scenario
 
 r3 = pytest.importorskip("rhino3dm", reason="the 'cad' extra (rhino3dm) is not installed")
@@ -97,13 +99,21 @@ def test_degree_zero_surface_is_refused():
         _patch_from_rhino(SimpleNamespace(OrderU=1, OrderV=3), "flat.3dm face 0")
 
 
-def test_brep_face_is_read_untrimmed_with_a_warning(tmp_path):
+def test_brep_face_is_read_whole_and_only_its_open_seam_is_warned_about(tmp_path):
     model = r3.File3dm()
     sphere = r3.Brep.CreateFromSphere(r3.Sphere(r3.Point3d(0, 0, 0), 2.0))
     model.Objects.AddBrep(sphere)
     model.Write(str(tmp_path / "ball.3dm"), 7)
-    with pytest.warns(UserWarning, match="ball.3dm: face 0 is a Brep face"):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         surf = build(load_scenario(scenario(tmp_path, 'path = "ball.3dm"'))).surface
+    # the sphere's face is not trimmed; its u seam (first = last column) is not joined, its
+    # v ends are poles (one point each), not a seam
+    assert [str(w.message) for w in caught] == [
+        f"{tmp_path / 'ball.3dm'} face 0 is closed in u (its first and last control points "
+        "in u coincide) but the seam is not joined: its two sides are separate unknowns and "
+        "move apart under load"]
+    assert all(issubclass(w.category, InputWarning) for w in caught)
     # a revolved surface: weights a_i b_j, one rational basis per direction
     assert isinstance(surf.basis_u, sd.RationalBasis) and isinstance(surf.basis_v, sd.RationalBasis)
     u, v = np.meshgrid(*surf.sample_parameters(20), indexing="ij")
@@ -164,7 +174,7 @@ def test_poles_of_a_cad_sphere_move_as_one_point(tmp_path):
     model = r3.File3dm()
     model.Objects.AddBrep(r3.Brep.CreateFromSphere(r3.Sphere(r3.Point3d(0, 0, 0), 1.0)))
     model.Write(str(tmp_path / "ball.3dm"), 7)
-    with pytest.warns(UserWarning, match="Brep face"):
+    with pytest.warns(InputWarning, match="NURBS patch is closed in u"):
         from splinedeform.cad import read_3dm
         surf = surface_from_patch(read_3dm(tmp_path / "ball.3dm"))
     m = sd.Model(surf, sd.Material(w10=1.0, w01=1.0), boundary={"v0": "pole", "v1": "pole"})

@@ -21,13 +21,20 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .basis import BSplineBasis
-from .errors import InputError
+from .cad_child import read_in_child
+from .cad_units import check_units, rhino_name, units_from_rhino
+from .errors import InputError, InputWarning
 from .export.atomic import atomic_path
 from .knots import KnotVectorBasis, RationalBasis
 from .surface import Basis, Surface
 
 #: relative tolerance for weights to count as a product ``a_i b_j`` (or as all equal)
 WEIGHT_TOL = 1e-12
+#: points per side, and distance (relative to the net's size), of the trimming test
+TRIM_SAMPLES = 257
+TRIM_TOL = 1e-4
+#: distance (relative to the net's size) under which a seam's two rows of points coincide
+SEAM_TOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -39,8 +46,11 @@ class NurbsPatch:
     knots_v: NDArray[np.float64]
     points: NDArray[np.float64]
     weights: NDArray[np.float64]
+    #: length unit of ``points`` (a key of :data:`splinedeform.cad_units.UNITS`), None: unknown
+    units: str | None = None
 
     def __post_init__(self) -> None:
+        check_units(self.units, "NURBS patch units")
         bu = KnotVectorBasis(self.degrees[0], self.knots_u)
         bv = KnotVectorBasis(self.degrees[1], self.knots_v)
         shape = (bu.size, bv.size)
@@ -83,7 +93,7 @@ def refine(patch: NurbsPatch, splits: int) -> NurbsPatch:
     hom = np.concatenate([patch.points * w[..., None], w[..., None]], axis=-1)
     hom = np.einsum("ai,ijc,bj->abc", Su, hom, Sv)
     return NurbsPatch(patch.degrees, fu.knots, fv.knots, hom[..., :3] / hom[..., 3:],
-                      hom[..., 3])
+                      hom[..., 3], patch.units)
 
 
 def surface_from_patch(patch: NurbsPatch, name: str = "cad surface",
@@ -100,10 +110,31 @@ def surface_from_patch(patch: NurbsPatch, name: str = "cad surface",
     bu = KnotVectorBasis(patch.degrees[0], patch.knots_u)
     bv = KnotVectorBasis(patch.degrees[1], patch.knots_v)
     bu, bv = bu.shifted(bu.domain[0]), bv.shifted(bv.domain[0])
+    warn_open_seams(patch, source)
     a, b = weight_factors(np.asarray(patch.weights, dtype=float), source)
     basis_u: Basis = bu if np.ptp(a) <= WEIGHT_TOL * a.max() else RationalBasis(bu, a)
     basis_v: Basis = bv if np.ptp(b) <= WEIGHT_TOL * b.max() else RationalBasis(bv, b)
     return Surface(np.asarray(patch.points, dtype=float), basis_u, basis_v, name=name)
+
+
+def warn_open_seams(patch: NurbsPatch, source: str = "NURBS patch") -> None:
+    """Warn (once per direction) where the surface is closed but its seam is not joined.
+
+    The surface is closed in ``u`` when its first and last rows of control points
+    coincide, ``P_0j = P_{N-1,j}`` within :data:`SEAM_TOL` of the net's size (a row that
+    is one point, a pole, does not count). Read from a file, the two rows are separate
+    unknowns: nothing keeps the seam closed, and its two sides move apart under load.
+    """
+    P = np.asarray(patch.points, dtype=float)
+    size = max(float(np.ptp(P.reshape(-1, 3), axis=0).max()), 1e-300)
+    for axis, name in ((0, "u"), (1, "v")):
+        first, last = np.take(P, 0, axis=axis), np.take(P, -1, axis=axis)
+        if (np.linalg.norm(first - last, axis=-1).max() <= SEAM_TOL * size
+                and np.ptp(first, axis=0).max() > SEAM_TOL * size):
+            warnings.warn(f"{source} is closed in {name} (its first and last control points "
+                          f"in {name} coincide) but the seam is not joined: its two sides "
+                          "are separate unknowns and move apart under load", InputWarning,
+                          stacklevel=3)
 
 
 def weight_factors(w: NDArray[np.float64], source: str = "NURBS patch"
@@ -171,16 +202,21 @@ def _rhino3dm():
 
 
 def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch],
-              names: list[str] | None = None) -> Path:
+              names: list[str] | None = None, units: str | None = None) -> Path:
     """Write ``patches`` as NURBS surfaces to a ``.3dm`` file (atomically); return its path.
 
-    ``names`` label the objects (openNURBS object names), one per patch.
+    ``names`` label the objects (openNURBS object names), one per patch. ``units`` (a key
+    of :data:`splinedeform.cad_units.UNITS`; default: the first patch's) is the file's
+    ``ModelUnitSystem``; ``None`` when not known (openNURBS ``UnitSystem.None``).
     """
     r3 = _rhino3dm()
     path = Path(path)
     if names is not None and len(names) != len(patches):
         raise InputError(f"{len(names)} object names for {len(patches)} surfaces")
+    if units is None and patches:
+        units = patches[0].units
     model = r3.File3dm()
+    model.Settings.ModelUnitSystem = getattr(r3.UnitSystem, rhino_name(units))
     for index, patch in enumerate(patches):
         (nu, nv), w = patch.degrees, np.asarray(patch.weights)
         cu, cv = w.shape
@@ -221,13 +257,16 @@ def frame_patches(surface: Surface, times: NDArray[np.float64], nets: NDArray[np
 
 
 def write_frames_3dm(path: str | os.PathLike, surface: Surface, times: NDArray[np.float64],
-                     nets: NDArray[np.float64], label: str = "t") -> Path:
+                     nets: NDArray[np.float64], label: str = "t",
+                     units: str | None = None) -> Path:
     """The initial surface and every frame as named NURBS surfaces in one ``.3dm`` file
-    (object ``k + 1`` is frame ``k``; see :func:`frame_patches`). Written atomically."""
-    return write_3dm(path, *frame_patches(surface, times, nets, label))
+    (object ``k + 1`` is frame ``k``; see :func:`frame_patches`), in ``units`` (see
+    :func:`write_3dm`). Written atomically."""
+    return write_3dm(path, *frame_patches(surface, times, nets, label), units=units)
 
 
-def _patch_from_rhino(srf, source: str) -> NurbsPatch:
+def _patch_from_rhino(srf, source: str) -> dict:
+    """Degrees, full knot vectors, points and weights of a rhino3dm NURBS surface."""
     nu, nv = srf.OrderU - 1, srf.OrderV - 1
     if nu < 1 or nv < 1:
         raise InputError(f"{source}: surface of degree ({nu}, {nv}); degree 0 is not supported")
@@ -236,8 +275,13 @@ def _patch_from_rhino(srf, source: str) -> NurbsPatch:
     cu, cv = srf.Points.CountU, srf.Points.CountV
     hom = np.array([[list(_xyzw(srf.Points[i, j])) for j in range(cv)] for i in range(cu)])
     w = hom[..., 3]
-    return NurbsPatch((nu, nv), np.r_[ku[0], ku, ku[-1]], np.r_[kv[0], kv, kv[-1]],
-                      hom[..., :3] / w[..., None], w)
+    if np.any(w <= 0):
+        i, j = np.argwhere(w <= 0)[0]
+        raise InputError(f"{source}: weight w[{i}, {j}] = {w[i, j]:g}; NURBS weights must "
+                         "be > 0")
+    return {"degrees": (nu, nv), "knots_u": np.r_[ku[0], ku, ku[-1]],
+            "knots_v": np.r_[kv[0], kv, kv[-1]], "points": hom[..., :3] / w[..., None],
+            "weights": w}
 
 
 def _xyzw(p) -> tuple[float, float, float, float]:
@@ -245,33 +289,96 @@ def _xyzw(p) -> tuple[float, float, float, float]:
 
 
 def read_3dm(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
-    """Surface number ``face`` of a ``.3dm`` file (surfaces and Brep faces, in file order).
+    """Surface number ``face`` of a ``.3dm`` file (surfaces and Brep faces, in file order),
+    in the file's ``ModelUnitSystem`` (:attr:`NurbsPatch.units`; None if not one of ours).
 
-    A Brep face is read as its underlying (untrimmed) surface, with a warning.
+    Read in a child process (:func:`splinedeform.cad_child.read_in_child`): a file that
+    crashes openNURBS is an ``InputError`` naming the file. A Brep face is read as its
+    underlying surface; a face that is really trimmed (its outer loop is not the
+    surface's own boundary, or it has inner loops) is warned about, once.
     """
-    r3 = _rhino3dm()
+    _rhino3dm()
     path = Path(path)
     if not path.is_file():
         raise InputError(f"{path}: no such file")
+    if isinstance(face, bool) or not isinstance(face, int) or face < 0:
+        raise InputError(f"{path}: face {face!r} out of range; faces are numbered from 0")
+    data = read_in_child(read_3dm_arrays, path, face, library="openNURBS (rhino3dm)")
+    return NurbsPatch(tuple(data["degrees"]), data["knots_u"], data["knots_v"],
+                      data["points"], data["weights"], units=data["units"])
+
+
+def read_3dm_arrays(path: Path, face: int) -> dict:
+    """What :func:`read_3dm` reads, as plain arrays (run in the child process)."""
+    r3 = _rhino3dm()
     model = r3.File3dm.Read(str(path))
     if model is None:
         raise InputError(f"{path}: not a .3dm (openNURBS) file")
-    found = []
+    found, geometry_of = [], []
     for obj in model.Objects:
         geometry = obj.Geometry
         if isinstance(geometry, r3.Brep):
             found += [(f, True) for f in geometry.Faces]
+            geometry_of += [geometry] * len(geometry.Faces)
         elif isinstance(geometry, r3.Surface):
             found.append((geometry, False))
+            geometry_of.append(geometry)
     if not found:
         raise InputError(f"{path}: the file holds no surface")
-    if not isinstance(face, int) or not 0 <= face < len(found):
+    if not 0 <= face < len(found):
         raise InputError(f"{path}: face {face!r} out of range; the file holds "
                          f"{len(found)} surface(s), numbered 0..{len(found) - 1}")
     surface, in_brep = found[face]
+    source = f"{path} face {face}"
     if in_brep:
-        warnings.warn(f"{path}: face {face} is a Brep face; its underlying surface is used "
-                      "and any trimming is dropped", stacklevel=2)
+        if _is_trimmed(geometry_of[face], surface):
+            warnings.warn(f"{source} is a trimmed Brep face; its whole underlying surface "
+                          "is used", InputWarning, stacklevel=2)
         surface = surface.UnderlyingSurface()
-    return _patch_from_rhino(surface.ToNurbsSurface(), f"{path} face {face}")
+    data = _patch_from_rhino(surface.ToNurbsSurface(), source)
+    data["units"] = units_from_rhino(str(model.Settings.ModelUnitSystem).split(".")[-1])
+    return data
 
+
+def _is_trimmed(brep: object, brep_face: object) -> bool:
+    """Whether a Brep face is trimmed: it has inner loops, its parameter box is smaller
+    than its surface's domain, or an edge of its outer loop leaves the box's four sides.
+
+    The sides are sampled at :data:`TRIM_SAMPLES` points each and the edges at 9; an edge
+    point counts as on a side within ``TRIM_TOL`` of the box's diagonal (point to chord:
+    the chords of a curved side are off it by far less).
+    """
+    surface = brep_face.UnderlyingSurface()
+    box = [brep_face.Domain(k) for k in (0, 1)]
+    whole = [surface.Domain(k) for k in (0, 1)]
+    span = max(abs(d.T1 - d.T0) for d in whole)
+    if len(brep_face.Loops) > 1 or any(
+            abs(a.T0 - b.T0) > 1e-9 * span or abs(a.T1 - b.T1) > 1e-9 * span
+            for a, b in zip(box, whole)):
+        return True
+    s = np.linspace(0.0, 1.0, TRIM_SAMPLES)
+    (u0, u1), (v0, v1) = [(d.T0, d.T1) for d in box]
+    us, vs = u0 + (u1 - u0) * s, v0 + (v1 - v0) * s
+    sides = [[(u, v0) for u in us], [(u1, v) for v in vs], [(u, v1) for u in us[::-1]],
+             [(u0, v) for v in vs[::-1]]]
+    chords = np.array([[_xyz(surface.PointAt(u, v)) for u, v in side] for side in sides])
+    edge_points = []
+    for trim in brep_face.OuterLoop.Trims:
+        if trim.EdgeIndex >= 0:          # a singular trim (a pole) has no edge
+            edge = brep.Edges[trim.EdgeIndex]
+            d = edge.Domain
+            edge_points += [_xyz(edge.PointAt(d.T0 + (d.T1 - d.T0) * k / 8)) for k in range(9)]
+    if not edge_points:
+        return False
+    a, b = chords[:, :-1].reshape(-1, 3), chords[:, 1:].reshape(-1, 3)
+    x = np.array(edge_points)[:, None, :]
+    ab = b - a
+    tau = np.clip(np.einsum("psk,sk->ps", x - a, ab) / np.maximum((ab * ab).sum(-1), 1e-300),
+                  0.0, 1.0)
+    gap = np.linalg.norm(x - a - tau[..., None] * ab, axis=-1).min(axis=1)
+    diagonal = np.ptp(chords.reshape(-1, 3), axis=0).max()
+    return bool(gap.max() > TRIM_TOL * max(diagonal, np.abs(chords).max(), 1e-300))
+
+
+def _xyz(p) -> tuple[float, float, float]:
+    return p.X, p.Y, p.Z
