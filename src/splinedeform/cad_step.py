@@ -125,8 +125,8 @@ def write_step(path: str | os.PathLike, patches: list[NurbsPatch],
         if suffix in STEP_SUFFIXES:
             from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
 
+            writer = STEPControl_Writer()    # (which sets the unit to its default)
             Interface_Static.SetCVal_s("write.step.unit", name)  # converted from millimetres
-            writer = STEPControl_Writer()
             ok = writer.Transfer(compound, STEPControl_AsIs) == IFSelect_RetDone and \
                 writer.Write(str(tmp)) == IFSelect_RetDone
         else:
