@@ -28,9 +28,18 @@ from typing import Any, Callable
 
 from .errors import InputError, InputWarning
 
-#: the child: the caller's import path first (as ``multiprocessing`` does), then serve
-_CHILD = ("import pickle, sys; sys.path[:0] = pickle.load(sys.stdin.buffer); "
-          "from splinedeform.cad_child import serve; serve()")
+#: the child: the caller's import path first (as ``multiprocessing`` does); the package
+#: as a bare namespace (its ``__init__``, which imports the whole library, is not run:
+#: the readers' modules import only numpy, the CAD library and each other); then serve
+_CHILD = """
+import importlib.util, pickle, sys, types
+sys.path[:0] = pickle.load(sys.stdin.buffer)
+package = types.ModuleType("splinedeform")
+package.__path__ = list(importlib.util.find_spec("splinedeform").submodule_search_locations)
+sys.modules["splinedeform"] = package
+from splinedeform.cad_child import serve
+serve()
+"""
 
 
 class _Child:

@@ -22,7 +22,7 @@ import numpy as np
 
 from .cad import NurbsPatch, frame_patches
 from .cad_child import read_in_child
-from .cad_step_read import IGES_SUFFIXES, STEP_SUFFIXES, read_arrays
+from .cad_step_read import IGES_SUFFIXES, MISSING, STEP_SUFFIXES, ocp, read_arrays
 from .cad_units import millimetres, occt_name
 from .errors import InputError
 from .export.atomic import atomic_path
@@ -32,22 +32,6 @@ __all__ = ["IGES_SUFFIXES", "STEP_SUFFIXES", "bspline_surface", "read_step", "wr
 
 #: OpenCASCADE tolerance for the natural edges of a written face (model units)
 EDGE_TOLERANCE = 1e-9
-
-_MISSING = ("STEP and IGES files need the 'cad-step' extra (OpenCASCADE): "
-            "pip install 'splinedeform[cad-step]'")
-
-
-def ocp() -> Any:
-    """OCP, with OpenCASCADE's messages below failures silenced (it prints statistics)."""
-    try:
-        import OCP
-        from OCP.Message import Message, Message_Gravity
-    except ImportError as exc:  # pragma: no cover - depends on the installation
-        raise InputError(_MISSING) from exc
-    for printer in Message.DefaultMessenger_s().Printers():
-        printer.SetTraceLevel(Message_Gravity.Message_Fail)
-    return OCP
-
 
 def _collections() -> tuple[Any, Any, Any, Any]:
     """``(Array1 of double, Array1 of int, Array2 of double, Array2 of gp_Pnt)``.
@@ -160,7 +144,7 @@ def read_step(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
     """
     path = Path(path)
     if importlib.util.find_spec("OCP") is None:  # pragma: no cover - depends on the install
-        raise InputError(_MISSING)
+        raise InputError(MISSING)
     if not path.is_file():
         raise InputError(f"{path}: no such file")
     if isinstance(face, bool) or not isinstance(face, int) or face < 0:

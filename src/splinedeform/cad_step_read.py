@@ -7,7 +7,8 @@ shape (``TopExp_Explorer`` order), converts its surface to a B-spline surface
 direction (``SetUNotPeriodic``: clamped knots, same surface) and returns plain arrays:
 degrees, the flat knot sequences (``N + n + 1`` knots), poles ``P_ij`` in the file's
 length unit (OpenCASCADE reads every file in millimetres; the poles are divided by the
-unit's length in millimetres), weights ``w_ij`` and the unit.
+unit's length in millimetres), weights ``w_ij`` and the unit. This module imports only
+numpy and OCP, so the child starts quickly.
 
 IGES stores weights as written, but OpenCASCADE replaces a non-positive one by 1 (every
 weight then reads 1: a rational surface silently made polynomial), so the weights of
@@ -33,10 +34,24 @@ IGES_SUFFIXES = (".igs", ".iges")
 PERIOD_TOL = 1e-9
 
 
+MISSING = ("STEP and IGES files need the 'cad-step' extra (OpenCASCADE): "
+           "pip install 'splinedeform[cad-step]'")
+
+
+def ocp() -> Any:
+    """OCP, with OpenCASCADE's messages below failures silenced (it prints statistics)."""
+    try:
+        import OCP
+        from OCP.Message import Message, Message_Gravity
+    except ImportError as exc:  # pragma: no cover - depends on the installation
+        raise InputError(MISSING) from exc
+    for printer in Message.DefaultMessenger_s().Printers():
+        printer.SetTraceLevel(Message_Gravity.Message_Fail)
+    return OCP
+
+
 def read_arrays(path: Path, face: int) -> dict[str, Any]:
     """Face ``face`` of a STEP or IGES file as plain arrays (see the module docstring)."""
-    from .cad_step import ocp
-
     ocp()
     from OCP.BRep import BRep_Tool
     from OCP.BRepTools import BRepTools
