@@ -20,6 +20,7 @@ import pickle
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 import traceback
 import warnings
@@ -47,24 +48,32 @@ class _Child:
 
     def __init__(self) -> None:
         self.process: subprocess.Popen[bytes] | None = None
+        self.owner = 0                      # the process that started it (not a fork of it)
+        self.errors: Any = None             # the child's stderr, a temporary file
         self.lock = threading.Lock()
 
     def request(self, message: tuple[Any, ...]) -> tuple[str, Any, list[str]]:
-        """Send ``message``; the child's answer, or EOFError (with its exit code) if it died."""
-        if self.process is None or self.process.poll() is not None:
+        """Send ``message``; the child's answer, or EOFError(exit code, last line of its
+        stderr) if it died."""
+        if self.process is None or self.process.poll() is not None or \
+                self.owner != os.getpid():
+            self.errors = tempfile.TemporaryFile()
             self.process = subprocess.Popen(
                 [sys.executable, "-c", _CHILD], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                stderr=subprocess.DEVNULL)
+                stderr=self.errors)
+            self.owner = os.getpid()
             pickle.dump(list(sys.path), self.process.stdin)
         assert self.process.stdin is not None and self.process.stdout is not None
         try:
             pickle.dump(message, self.process.stdin)
             self.process.stdin.flush()
             return pickle.load(self.process.stdout)
-        except (EOFError, BrokenPipeError, pickle.UnpicklingError):
+        except (EOFError, OSError, pickle.UnpicklingError):
             code = self.process.wait()
             self.process = None
-            raise EOFError(code) from None
+            self.errors.seek(0)
+            lines = self.errors.read().decode("utf-8", "replace").strip().splitlines()
+            raise EOFError(code, lines[-1] if lines else "") from None
 
     def close(self) -> None:
         if self.process is not None and self.process.poll() is None:
@@ -95,8 +104,13 @@ def read_in_child(reader: Callable[..., dict[str, Any]], path: Path, *args: Any,
             outcome, payload, messages = _child.request(
                 (reader.__module__, reader.__qualname__, os.getcwd(), path, args))
         except EOFError as exc:
+            code, last = exc.args
+            if code is not None and code > 0:      # Python failed in the child, not the file
+                raise InputError(f"{path}: the reader process for {library} failed "
+                                 f"({_exit_description(code)}: {last or 'no message'})"
+                                 ) from None
             raise InputError(f"{path}: {library} crashed reading this file "
-                             f"({_exit_description(exc.args[0])}); the file is probably "
+                             f"({_exit_description(code)}); the file is probably "
                              "malformed (damaged or written by a faulty exporter)") from None
     for message in messages:
         warnings.warn(message, InputWarning, stacklevel=3)
