@@ -92,7 +92,7 @@ def test_degree_zero_surface_is_refused():
     # so the reader's check is fed a stand-in with rhino3dm's attribute names
     from types import SimpleNamespace
 
-    from splinedeform.cad import _patch_from_rhino
+    from splinedeform.cad_3dm_read import _patch_from_rhino
     from splinedeform.errors import InputError
 
     with pytest.raises(InputError, match=r"flat.3dm face 0: surface of degree \(0, 2\)"):

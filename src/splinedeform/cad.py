@@ -6,8 +6,10 @@ vectors (``N + n + 1`` knots each, our convention and splipy's/geomdl's), contro
 
 .. math:: S(u, v) = \\frac{\\sum_{ij} w_{ij} N_i(u) N_j(v) P_{ij}}{\\sum_{ij} w_{ij} N_i(u) N_j(v)}.
 
-openNURBS stores ``N + n - 1`` knots (the first and last are implied) and homogeneous
-control points ``(w x, w y, w z, w)``. Needs the ``cad`` extra.
+and its coordinates are in :attr:`NurbsPatch.units`. openNURBS stores ``N + n - 1`` knots
+(the first and last are implied) and homogeneous control points ``(w x, w y, w z, w)``;
+files are read in a child process (:mod:`splinedeform.cad_3dm_read`,
+:mod:`splinedeform.cad_child`). Needs the ``cad`` extra.
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .basis import BSplineBasis
-from .cad_3dm_read import _patch_from_rhino, _rhino3dm, read_3dm_arrays  # noqa: F401
+from .cad_3dm_read import _rhino3dm, read_3dm_arrays
 from .cad_child import read_in_child
 from .cad_units import check_units, rhino_name
 from .errors import InputError, InputWarning
