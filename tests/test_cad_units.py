@@ -50,6 +50,9 @@ def test_step_in_metres_round_trips_in_metres(tmp_path):
     assert back.units == "m" and np.abs(back.points - roof().points).max() <= 1e-11
     result = run(_case(tmp_path, "roof.step", "step"), tmp_path / "out")
     assert result.built.units == "m"
+    from splinedeform.scenario import describe
+
+    assert ("length unit", "m") in describe(result.scenario, result.built)
     report = json.loads((tmp_path / "out" / "report.json").read_text())
     assert report["surface"]["units"] == "m"
     # OpenCASCADE reads the output as metres: in its millimetres, 1000 x our initial net

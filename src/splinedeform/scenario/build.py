@@ -277,6 +277,7 @@ def describe(scenario: Scenario, built: Built | None = None) -> list[tuple[str, 
         rows += [("control net", f"{n_u} x {n_v} ({n_u * n_v} points)"),
                  (getattr(built.model, "unknowns_label", "free control points"),
                   str(built.model.n_free))]
+        rows += [("length unit", built.units)] if built.units is not None else []
     rows += [("loads", ", ".join(f"{ld.kind} ({ld.profile})" for ld in s.loads) or "none"),
              ("solve", s.solve.kind + (f" with {s.solve.method} to t = {s.solve.t_end:g}"
                                        if s.solve.kind == "dynamic" else "")),
