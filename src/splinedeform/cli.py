@@ -12,6 +12,7 @@ from __future__ import annotations
 import importlib.util
 import platform
 import sys
+import warnings
 from contextlib import contextmanager
 from importlib import metadata, resources
 from pathlib import Path
@@ -39,6 +40,8 @@ OPTIONAL = {
     "playwright": ("playwright", "viewer test in a headless browser"),
     "starlette": ("starlette", "sculpt server (extra: sculpt)"),
     "uvicorn": ("uvicorn", "sculpt server (extra: sculpt)"),
+    "rhino3dm": ("rhino3dm", "openNURBS .3dm files (extra: cad)"),
+    "OCP": ("cadquery-ocp-novtk", "STEP and IGES files, OpenCASCADE (extra: cad-step)"),
 }
 
 
@@ -117,7 +120,18 @@ INFO_WIDTH = 100
 
 @contextmanager
 def _reported_errors(debug: bool) -> Iterator[None]:
-    """Turn errors into a message on stderr and an exit code (a traceback only with --debug)."""
+    """Turn errors into a message on stderr and an exit code (a traceback only with --debug);
+    warnings are one line each on stderr, ``warning: <message>`` (with their source line
+    only with --debug)."""
+    with warnings.catch_warnings():
+        if not debug:
+            warnings.showwarning = _print_warning
+        with _errors_reported(debug):
+            yield
+
+
+@contextmanager
+def _errors_reported(debug: bool) -> Iterator[None]:
     try:
         yield
     except (typer.Exit, typer.Abort, KeyboardInterrupt):
@@ -133,6 +147,13 @@ def _reported_errors(debug: bool) -> Iterator[None]:
         _print_error(f"internal error: {type(exc).__name__}: {exc}\n"
                      "(run again with --debug for the traceback)")
         raise typer.Exit(EXIT_INTERNAL_ERROR) from None
+
+
+def _print_warning(message: Warning | str, category: type[Warning], filename: str,
+                   lineno: int, file: Any = None, line: str | None = None) -> None:
+    _, err = _consoles()
+    err.print(f"[bold yellow]warning:[/] {_escape(str(message))}", highlight=False,
+              soft_wrap=True)
 
 
 def _print_error(message: str) -> None:
@@ -267,7 +288,7 @@ def _optional_rows() -> list[tuple[str, str]]:
         try:
             importlib.import_module(module)
         except ImportError:
-            rows.append((dist, f"missing  ({use})"))
+            rows.append((dist, f"not installed  ({use})"))
             continue
         except Exception as exc:  # noqa: BLE001  (installed but broken, e.g. a missing library)
             rows.append((dist, f"installed but fails to import: {type(exc).__name__}: {exc}  "

@@ -127,14 +127,15 @@ def _write_files(result: RunResult, folder: Path, stages: Stages) -> None:
             label = {"dynamic": "time", "static": "load factor",
                      "modes": "phase"}[scenario.solve.kind]
             result.outputs.append(("NURBS surfaces .3dm", write_frames_3dm(
-                folder / f"{name}.3dm", surface, times, nets, label)))
+                folder / f"{name}.3dm", surface, times, nets, label,
+                units=result.built.units)))
     for ext, suffix in STEP_FILES.items():
         if ext in formats:
             from .cad_step import write_frames_step
 
             with stages.stage(f"CAD surfaces {suffix}"):
                 result.outputs.append((f"NURBS surfaces {suffix}", write_frames_step(
-                    folder / f"{name}{suffix}", surface, times, nets)))
+                    folder / f"{name}{suffix}", surface, times, nets, result.built.units)))
     if "images" in formats:
         _write_images(result, folder, stages)
     for ext in ("gif", "mp4"):
@@ -241,6 +242,7 @@ def make_report(result: RunResult) -> dict[str, Any]:
                     "degree": [surface.basis_u.degree, surface.basis_v.degree],
                     "knots": [surface.basis_u.kind, surface.basis_v.kind],
                     "domain": [list(d) for d in surface.domain],
+                    "units": result.built.units or "none",
                     "fit_error": surface.fit_error,
                     _unknowns(result.built.model): result.n_free},
         "solver": {"kind": s.solve.kind,

@@ -20,6 +20,7 @@ class Built:
     model: Any              # splinedeform.Model
     load: Any               # splinedeform.loads.Load or None
     fixed: Any = None       # bool mask (n_u, n_v) of the free region, or None
+    units: str | None = None  # length unit of a CAD surface (splinedeform.cad_units), or None
 
 
 @contextmanager
@@ -44,11 +45,22 @@ def _located(scenario: Scenario, path: str) -> Iterator[None]:
 
 def build_surface(scenario: Scenario) -> Any:
     """The initial surface: a built-in shape, a stored control net or a fitted point grid."""
+    return surface_and_units(scenario)[0]
+
+
+def surface_and_units(scenario: Scenario) -> tuple[Any, str | None]:
+    """The initial surface (see :func:`build_surface`) and its length unit: a CAD file's
+    (or ``surface.units``), None for other surfaces."""
+    spec = scenario.surface
+    if spec.shape == "cad":
+        return _surface_from_cad(scenario)
+    return _surface_of_shape(scenario), None
+
+
+def _surface_of_shape(scenario: Scenario) -> Any:
     spec = scenario.surface
     if spec.shape == "file":
         return _surface_from_file(scenario)
-    if spec.shape == "cad":
-        return _surface_from_cad(scenario)
     from .. import shapes
 
     with _located(scenario, "surface"), _periodic_at_knots(scenario):
@@ -76,8 +88,9 @@ def _fit_options(spec: SurfaceSpec) -> dict[str, Any]:
     return options
 
 
-def _surface_from_cad(scenario: Scenario) -> Any:
-    """Surface ``face`` of a CAD file, as a deformable NURBS surface (trimming dropped)."""
+def _surface_from_cad(scenario: Scenario) -> tuple[Any, str | None]:
+    """Surface ``face`` of a CAD file, as a deformable NURBS surface (trimming dropped),
+    and its unit: ``surface.units`` if given, else the file's."""
     from ..cad import read_cad, surface_from_patch
 
     path = scenario.surface.path
@@ -85,8 +98,9 @@ def _surface_from_cad(scenario: Scenario) -> Any:
     face = scenario.surface.parameters["face"]
     with _located(scenario, "surface.path"):
         patch = read_cad(path, face)
-        return surface_from_patch(patch, name=f"{path.stem} face {face}",
-                                  source=f"{path} face {face}")
+        surface = surface_from_patch(patch, name=f"{path.stem} face {face}",
+                                     source=f"{path} face {face}")
+    return surface, scenario.surface.parameters.get("units") or patch.units
 
 
 def _surface_from_file(scenario: Scenario) -> Any:
@@ -227,19 +241,20 @@ def build(scenario: Scenario) -> Built:
     from ..material import Material
     from ..model import Model
 
-    surface = build_surface(scenario)
+    surface, units = surface_and_units(scenario)
     _check_parameters(scenario, surface)
     fixed = free_region_mask(scenario, surface)
     if scenario.material.physics == "shell":
         return Built(surface=surface, model=_shell_model(scenario, surface, fixed),
-                     load=build_load(scenario), fixed=fixed)
+                     load=build_load(scenario), fixed=fixed, units=units)
     with _located(scenario, "material"):
         material = Material(**scenario.material.weights())
     with _located(scenario, "boundary"):
         model = Model(surface, material, boundary=scenario.boundary.edges(), fixed=fixed,
                       mass_matrix=scenario.material.mass_matrix,
                       physics=scenario.material.physics)
-    return Built(surface=surface, model=model, load=build_load(scenario), fixed=fixed)
+    return Built(surface=surface, model=model, load=build_load(scenario), fixed=fixed,
+                 units=units)
 
 
 def _shell_model(scenario: Scenario, surface: Any, fixed: Any) -> Any:
@@ -262,6 +277,7 @@ def describe(scenario: Scenario, built: Built | None = None) -> list[tuple[str, 
         rows += [("control net", f"{n_u} x {n_v} ({n_u * n_v} points)"),
                  (getattr(built.model, "unknowns_label", "free control points"),
                   str(built.model.n_free))]
+        rows += [("length unit", built.units)] if built.units is not None else []
     rows += [("loads", ", ".join(f"{ld.kind} ({ld.profile})" for ld in s.loads) or "none"),
              ("solve", s.solve.kind + (f" with {s.solve.method} to t = {s.solve.t_end:g}"
                                        if s.solve.kind == "dynamic" else "")),

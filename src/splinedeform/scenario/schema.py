@@ -35,6 +35,7 @@ from pydantic import BaseModel, ConfigDict, Field, Strict
 
 from ..basis import KNOT_KINDS
 from ..boundary import PRESETS
+from ..cad_units import UNITS
 from ..loads import OMEGA_MAX
 from ..model import METHODS, STEP_METHODS
 from ..shapes import FIT_METHODS
@@ -42,6 +43,8 @@ from ..shapes import FIT_METHODS
 PROFILES = ("constant", "step", "piecewise", "harmonic")
 IVP_METHODS = ("rk45", "dop853", "radau", "bdf")
 MASS_MATRICES = ("consistent", "lumped")
+#: length units of CAD files
+CAD_UNITS = tuple(UNITS)
 PHYSICS = ("parametric", "intrinsic", "shell")
 #: edge kinds of the Kirchhoff–Love shell only (``physics = "shell"``)
 SHELL_EDGES = ("diaphragm", "symmetry")
@@ -163,6 +166,12 @@ class FromCad(_Table):
     face: Annotated[int, Strict(), Field(ge=0)] = Field(0, description=(
             "which surface of the file, counting plain surfaces and Brep faces in file "
             "order from 0; a trimmed face is taken untrimmed, with a warning"))
+    units: Optional[Literal[CAD_UNITS]] = Field(  # type: ignore[valid-type]
+        None, description=(
+            "length unit of the file's coordinates, overriding the unit the file declares "
+            "(the numbers are kept, only their unit changes); the run computes in it, "
+            "reports it and writes `3dm`, `step`, `iges` outputs in it"),
+        json_schema_extra={"doc_default": "the file's"})
 
 
 #: every ``surface.shape``; a new shape is one model here
