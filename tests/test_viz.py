@@ -241,6 +241,54 @@ def test_gif_has_one_distinct_frame_per_time(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["motion.gif"]
 
 
+def test_gif_colour_bar_is_the_colour_map_ramp_exactly(tmp_path):
+    """Every pixel down the middle of the bar is one of the ramp's colours, unchanged by the
+    palette, and the bar climbs the ramp level by level (no bands of one colour)."""
+    from splinedeform.viz.gif import RAMP_LEVELS, ramp_colors
+
+    s = plane(3)
+    times, nets = motion(s, 3)
+    path = viz.write_animation(tmp_path / "motion.gif", s, s.control_points, times, nets,
+                               resolution=10)
+    frame = iio.imread(path, index=1)[..., :3].astype(int)
+    # the bar's axes span x in [0.86, 0.885] and y in [0.15, 0.85] of the 640 x 480 frame
+    column = frame[480 - int(0.85 * 480) + 3:480 - int(0.15 * 480) - 3, int(0.8725 * 640)]
+    ramp = ramp_colors(viz.COLORMAP).astype(int)
+    match = np.all(column[:, None, :] == ramp[None], axis=-1)
+    assert match.any(axis=1).all()              # exact: every bar pixel is a ramp colour
+    level = match.argmax(axis=1)[::-1]          # bottom (0) to top (RAMP_LEVELS - 1)
+    assert np.all(np.diff(level) >= 0)
+    # 330 rows for 128 levels: all but a few levels at the two ends appear
+    assert len(np.unique(level)) >= RAMP_LEVELS - 4
+
+
+def test_gif_palette_maps_to_the_nearest_entry():
+    """The lookup table agrees with a brute-force nearest search over the palette."""
+    from splinedeform.viz.gif import PaletteMap
+
+    rng = np.random.default_rng(3)
+    palette = rng.integers(0, 256, (256, 3)).astype(np.uint8)
+    image = rng.integers(0, 256, (40, 50, 3)).astype(np.uint8)
+    image[0, :5] = palette[[7, 8, 9, 200, 255]]        # palette colours map to themselves
+    index = PaletteMap(palette)(image)
+    distance = ((image[..., None, :].astype(int) - palette.astype(int)) ** 2).sum(-1)
+    chosen = np.take_along_axis(distance, index[..., None].astype(int), -1)[..., 0]
+    np.testing.assert_array_equal(chosen, distance.min(-1))   # integers: exact
+    assert index[0, :5].tolist() == [7, 8, 9, 200, 255]
+
+
+def test_gif_frame_delay_follows_fps(tmp_path):
+    s = plane(3)
+    times, nets = motion(s, 2)
+    path = viz.write_animation(tmp_path / "m.gif", s, s.control_points, times, nets,
+                               resolution=6, fps=25.0)
+    from PIL import Image
+
+    with Image.open(path) as gif:
+        assert gif.n_frames == 2 and gif.info["duration"] == 40   # 1000 / 25 ms
+        assert gif.info["loop"] == 0
+
+
 def test_mp4_when_an_encoder_is_available(tmp_path):
     if not viz.mp4_available():
         pytest.skip("imageio-ffmpeg (the `video` extra) is not installed")

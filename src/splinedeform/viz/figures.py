@@ -17,6 +17,8 @@ from .colour import COLORMAP, displacement_colors, shade
 DPI = 100
 PANEL_INCHES = 4.0          # each surface panel is 400 × 400 px
 COLORBAR_INCHES = 1.5     # colour bar and its label, clear of the last panel's z ticks
+#: the view of every 3-D picture: (elevation, azimuth) in degrees (``output.camera``)
+CAMERA = (28.0, -60.0)
 #: base colour of a panel without displacement (the rest shape), shaded like the others
 REST_RGBA = np.array([0.78, 0.80, 0.84, 1.0])
 
@@ -82,12 +84,13 @@ def _face_colors(magnitude: NDArray[np.float64], faces: NDArray[np.int64], vmax:
     return displacement_colors(magnitude[faces].mean(axis=1), vmax)
 
 
-def _axes3d(fig: Any, rect: Sequence[float] | tuple[int, int, int]) -> Any:
+def _axes3d(fig: Any, rect: Sequence[float] | tuple[int, int, int],
+            camera: tuple[float, float] = CAMERA) -> Any:
     import mpl_toolkits.mplot3d  # noqa: F401  (registers the 3-D projection)
 
     ax = fig.add_axes(rect, projection="3d") if len(rect) == 4 else \
         fig.add_subplot(*rect, projection="3d")
-    ax.view_init(elev=28, azim=-60)
+    ax.view_init(elev=float(camera[0]), azim=float(camera[1]))
     ax.tick_params(labelsize=7, pad=0)
     return ax
 
@@ -98,14 +101,19 @@ def _axis_labels(ax: Any) -> None:
         setter(name, fontsize=9, labelpad=-4)
 
 
-def _colorbar(fig: Any, rect: Sequence[float], vmax: float, label: str = "|displacement|"
-              ) -> None:
+def _colorbar(fig: Any, rect: Sequence[float], vmax: float, label: str = "|displacement|",
+              levels: int | None = None, colormap: str = COLORMAP, vmin: float = 0.0) -> Any:
+    """A vertical colour bar of ``colormap`` over ``[vmin, vmax]``; ``levels`` draws it
+    with the map resampled at that many colours (as a GIF palette holds them)."""
     import matplotlib
     from matplotlib.cm import ScalarMappable
     from matplotlib.colors import Normalize
 
-    mappable = ScalarMappable(Normalize(0.0, vmax if vmax > 0 else 1.0),
-                              matplotlib.colormaps[COLORMAP])
+    cmap = matplotlib.colormaps[colormap]
+    top = vmax if vmax > vmin else vmin + 1.0
+    mappable = ScalarMappable(Normalize(vmin, top),
+                              cmap.resampled(levels) if levels is not None else cmap)
     bar = fig.colorbar(mappable, cax=fig.add_axes(rect))
     bar.set_label(label)
+    return bar
 

@@ -24,9 +24,9 @@ from .figures import (COLORBAR_INCHES, DPI, PANEL_INCHES, REST_RGBA, _axes3d, _a
 
 
 def _displaced_meshes(surface: Surface, rest_net: ArrayLike, nets: Sequence[ArrayLike],
-                      resolution: int) -> tuple[NDArray[np.float64], NDArray[np.float64],
-                                                NDArray[np.int64]]:
-    """Vertices ``(F, N, 3)``, displacement magnitudes ``(F, N)`` and faces.
+                      resolution: int, warp: float = 1.0
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+    """Drawn vertices ``x_rest + w d`` ``(F, N, 3)``, true ``|d|`` ``(F, N)`` and faces.
 
     Welded (:func:`~splinedeform.export.weld`): seams and poles are one vertex and the
     zero-area triangles of a pole, whose normal is undefined, are not drawn.
@@ -37,7 +37,7 @@ def _displaced_meshes(surface: Surface, rest_net: ArrayLike, nets: Sequence[Arra
     X0, _ = tessellate_frames(surface, rest, resolution)
     keep, faces = weld(np.concatenate([X0[None], X]), faces)
     X, X0 = X[:, keep], X0[keep]
-    return X, np.linalg.norm(X - X0, axis=-1), faces
+    return X0 + warp * (X - X0), np.linalg.norm(X - X0, axis=-1), faces
 
 
 def _pyvista() -> Any:
