@@ -198,6 +198,19 @@ def dense_probes(result: RunResult, samples: int = DENSE_PROBE_SAMPLES
     return t, out
 
 
+def picture_warp(result: RunResult) -> float:
+    """The warp factor of the pictures and the animation: ``output.warp``, or for "auto"
+    :func:`splinedeform.viz.warp.auto_warp` of the largest displacement and the largest
+    side of the control net's bounding box."""
+    from .viz.warp import auto_warp
+
+    warp = result.scenario.output.warp
+    if warp != "auto":
+        return float(warp)
+    rest = np.asarray(result.rest_net, dtype=float).reshape(-1, 3)
+    return auto_warp(float(result.max_displacement), float(np.ptp(rest, axis=0).max()))
+
+
 def _write_images(result: RunResult, folder: Path, stages: Stages) -> None:
     """surfaces.png (rest shape and the frame of largest displacement), probes.png, modes.png."""
     from . import viz
@@ -210,7 +223,8 @@ def _write_images(result: RunResult, folder: Path, stages: Stages) -> None:
         result.outputs.append(("picture", viz.render_surfaces(
             folder / "surfaces.png", surface, rest, [result.nets[0], result.nets[peak]],
             [f"initial ({label} = {result.times[0]:g})",
-             f"largest displacement ({label} = {result.times[peak]:.4g})"])))
+             f"largest displacement ({label} = {result.times[peak]:.4g})"],
+            warp=picture_warp(result), camera=result.scenario.output.camera)))
         if kind == "dynamic":
             dense = dense_probes(result)
             result.outputs.append(("probe plot", viz.plot_probes(
@@ -229,7 +243,9 @@ def _write_animation(result: RunResult, path: Path, stages: Stages) -> None:
         result.outputs.append((stage, write_animation(
             path, result.built.surface, result.rest_net, result.times, result.nets,
             resolution=result.scenario.output.resolution,
-            progress=lambda done, total: stages.tick(stage, done, total + 1))))
+            progress=lambda done, total: stages.tick(stage, done, total + 1),
+            fps=result.scenario.output.fps, warp=picture_warp(result),
+            camera=result.scenario.output.camera)))
 
 
 def make_report(result: RunResult) -> dict[str, Any]:

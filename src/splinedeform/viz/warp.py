@@ -3,7 +3,8 @@
 A picture draws ``x_rest + w (x - x_rest)``: with ``w = 1`` the true shape, with ``w > 1``
 the displacement exaggerated ``w`` times (colours keep the true ``|x - x_rest|``). The
 automatic factor makes the largest displacement :data:`WARP_TARGET` of the surface's size,
-rounded down to 1, 2 or 5 × 10ᵏ, and never shrinks a displacement (``w >= 1``).
+rounded down to 1, 2 or 5 × 10ᵏ (so it is drawn as 8 % to 20 % of the size), and never
+shrinks a displacement (``w >= 1``).
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import math
 from ..errors import InputError
 
 #: "auto": the largest displacement is drawn as this fraction of the surface's size
-WARP_TARGET = 0.1
+WARP_TARGET = 0.2
 
 
 def auto_warp(largest_displacement: float, size: float) -> float:
