@@ -330,6 +330,17 @@ def test_viewer_data_holds_float32_frames_and_nets():
               for n in nets)
     assert data["vmax"] == pytest.approx(top, rel=1e-12)
     assert data["times"] == times.tolist() and data["netShape"] == [6, 6]
+    assert data["startFrame"] == 2            # sin(πt/2) rises to the last frame
+
+
+def test_viewer_starts_at_the_peak_not_the_last_frame():
+    s = plane(3)
+    times = np.linspace(0.0, 1.0, 7)
+    lift = np.zeros_like(s.control_points)
+    lift[..., 2] = 0.3 * bump(s)
+    nets = s.control_points[None] + np.sin(np.pi * times)[:, None, None, None] * lift
+    # sin(πt) on 7 frames peaks at t = 1/2, frame 3, and is back to rest at the end
+    assert viz.viewer_data(s, s.control_points, times, nets, resolution=5)["startFrame"] == 3
 
 
 def test_vertex_checksum_weights():
