@@ -220,8 +220,20 @@ def test_plot_modes_size_and_checks(tmp_path):
     shapes = np.stack([bump(s), bump(s) * (s.control_points[..., 0] - 0.5)])
     path = viz.plot_modes(tmp_path / "modes.png", s, [3.2, 7.9], shapes, resolution=16)
     image = read_png(path)
-    assert image.shape == (400, 800, 3)
+    # two 320 px panels and a 110 px bar column, white margins trimmed
+    assert image.shape[0] <= 320 and image.shape[1] <= 750
     assert distinct_colours(image) > 100
+    ink = np.any(image < 250, axis=-1)
+    rows, cols = np.flatnonzero(ink.any(axis=1)), np.flatnonzero(ink.any(axis=0))
+    margin = viz.figures.MARGIN_PIXELS
+    assert rows[0] <= margin and cols[0] <= margin                   # no wide white border
+    assert rows[-1] >= image.shape[0] - 1 - margin and cols[-1] >= image.shape[1] - 1 - margin
+    # the colour bar, right of the panels, spans the diverging map: deep red (coolwarm(1)
+    # is (180, 4, 38)) at the top, deep blue ((59, 76, 192) at 0) at the bottom
+    bar = image[:, -image.shape[1] // 6:]
+    red = np.nonzero(bar[..., 0] - bar[..., 2] > 120)[0]
+    blue = np.nonzero(bar[..., 2] - bar[..., 0] > 120)[0]
+    assert red.size > 100 and blue.size > 100 and red.mean() < blue.mean()
     with pytest.raises(InputError, match="shapes"):
         viz.plot_modes(tmp_path / "m.png", s, [1.0], shapes)
 

@@ -232,7 +232,8 @@ def _write_images(result: RunResult, folder: Path, stages: Stages) -> None:
                 *(dense if dense is not None else (None, None)))))
         if result.omegas is not None:
             result.outputs.append(("mode shapes", viz.plot_modes(
-                folder / "modes.png", surface, result.omegas, result.mode_shapes)))
+                folder / "modes.png", surface, result.omegas, result.mode_shapes,
+                camera=result.scenario.output.camera)))
 
 
 def _write_animation(result: RunResult, path: Path, stages: Stages) -> None:

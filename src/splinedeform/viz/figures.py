@@ -33,12 +33,31 @@ def _figure(width: float, height: float) -> Any:
     return fig
 
 
-def _save_png(fig: Any, path: str | os.PathLike[str]) -> Path:
+#: white kept around the drawing when a picture's margins are trimmed
+MARGIN_PIXELS = 10
+
+
+def _save_png(fig: Any, path: str | os.PathLike[str], trim: bool = False) -> Path:
+    """Write ``fig`` as PNG; with ``trim`` the white border is cut to :data:`MARGIN_PIXELS`."""
     target = Path(path)
     if target.suffix.lower() != ".png":
         raise InputError(f"pictures are written as PNG; the file name must end in .png, "
                          f"got {target.name!r}")
-    return write_with(target, lambda tmp: fig.savefig(tmp, format="png", dpi=DPI))
+    if not trim:
+        return write_with(target, lambda tmp: fig.savefig(tmp, format="png", dpi=DPI))
+    from PIL import Image
+
+    fig.canvas.draw()
+    rgb = np.asarray(fig.canvas.buffer_rgba())[..., :3]
+    ink = np.any(rgb < 250, axis=-1)
+    rows, cols = np.flatnonzero(ink.any(axis=1)), np.flatnonzero(ink.any(axis=0))
+    if rows.size:
+        top, bottom = max(rows[0] - MARGIN_PIXELS, 0), min(rows[-1] + MARGIN_PIXELS + 1, len(rgb))
+        left, right = max(cols[0] - MARGIN_PIXELS, 0), min(cols[-1] + MARGIN_PIXELS + 1,
+                                                           rgb.shape[1])
+        rgb = rgb[top:bottom, left:right]
+    image = Image.fromarray(np.ascontiguousarray(rgb))
+    return write_with(target, lambda tmp: image.save(tmp, format="png"))
 
 
 def _bounds(points: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
