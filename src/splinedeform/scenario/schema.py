@@ -361,7 +361,8 @@ class Output(_Table):
         "auto", description=(
             "pictures and animation draw `x_rest + warp · d` (colours keep the true `|d|`); "
             '"auto": `0.2 · size / max |d|` rounded down to 1, 2 or 5 × 10^k (at least 1; '
-            "size: the largest side of the control net's box), stated in the caption"))
+            "size: the largest side of the control net's box; 1 for a modes solve), stated in "
+            "the caption"))
     camera: tuple[Angle, Angle] = Field(
         (28.0, -60.0), title="[elevation, azimuth]", description=(
             "view of the pictures and the animation, in degrees"))

@@ -51,12 +51,12 @@ class _FrameDrawer:
 
     def __init__(self, surface: Surface, rest_net: ArrayLike, times: ArrayLike, nets: ArrayLike,
                  resolution: int, warp: float, camera: tuple[float, float],
-                 bar_levels: int | None = None) -> None:
+                 bar_levels: int | None = None, label: str = "t") -> None:
         self.t, P = check_frames(surface, times, nets)
         self.X, self.mag, self.faces = _displaced_meshes(surface, rest_net, list(P), resolution,
                                                          warp)
         self.vmax = float(self.mag.max())
-        self.caption = warp_caption(warp)
+        self.caption, self.label = warp_caption(warp), str(label)
         width, height = ANIMATION_PIXELS
         self.fig = _figure(width / DPI, height / DPI)
         self.ax = _axes3d(self.fig, [0.0, 0.02, 0.84, 0.9], camera)
@@ -78,7 +78,8 @@ class _FrameDrawer:
         self._collection = _collection(self.X[f], self.faces,
                                        _face_colors(self.mag[f], self.faces, self.vmax))
         self.ax.add_collection3d(self._collection)
-        title = f"t = {self.t[f]:.4g}" + (f"   ({self.caption})" if self.caption else "")
+        title = f"{self.label} = {self.t[f]:.4g}" + (f"  ·  {self.caption}" if self.caption
+                                                      else "")
         self.ax.set_title(title, fontsize=11)
         self.fig.canvas.draw()
         return np.asarray(self.fig.canvas.buffer_rgba())[..., :3].copy()
@@ -86,13 +87,15 @@ class _FrameDrawer:
 
 def animation_frames(surface: Surface, rest_net: ArrayLike, times: ArrayLike, nets: ArrayLike,
                      resolution: int = 32, progress: Progress = None, warp: float = 1.0,
-                     camera: tuple[float, float] = CAMERA) -> list[NDArray[np.uint8]]:
+                     camera: tuple[float, float] = CAMERA, label: str = "t"
+                     ) -> list[NDArray[np.uint8]]:
     """RGB images ``(480, 640, 3)`` of every frame, with fixed axes and colour scale.
 
     ``warp`` scales the drawn displacement (``x_rest + w d``; colours keep ``|d|``),
-    ``camera`` is the view ``(elevation, azimuth)`` in degrees.
+    ``camera`` is the view ``(elevation, azimuth)`` in degrees; each frame is titled
+    ``"{label} = {time}"``.
     """
-    draw = _FrameDrawer(surface, rest_net, times, nets, resolution, warp, camera)
+    draw = _FrameDrawer(surface, rest_net, times, nets, resolution, warp, camera, None, label)
     images = []
     for f in range(len(draw)):
         images.append(draw(f))
@@ -104,11 +107,11 @@ def animation_frames(surface: Surface, rest_net: ArrayLike, times: ArrayLike, ne
 def write_animation(path: str | os.PathLike[str], surface: Surface, rest_net: ArrayLike,
                     times: ArrayLike, nets: ArrayLike, resolution: int = 32,
                     progress: Progress = None, fps: float = 15.0, warp: float = 1.0,
-                    camera: tuple[float, float] = CAMERA) -> Path:
+                    camera: tuple[float, float] = CAMERA, label: str = "t") -> Path:
     """Animate the motion as a looping GIF (pillow) or an MP4 (imageio-ffmpeg).
 
-    One 640 × 480 image per frame (see :func:`animation_frames` for ``warp`` and
-    ``camera``), ``fps`` frames per second (a GIF rounds the delay to hundredths of a
+    One 640 × 480 image per frame (see :func:`animation_frames` for ``warp``, ``camera``
+    and ``label``), ``fps`` frames per second (a GIF rounds the delay to hundredths of a
     second). ``progress(done, total)`` is called after each frame is drawn and encoded.
     The GIF's palette holds the colour bar's :data:`~splinedeform.viz.gif.RAMP_LEVELS`
     colours exactly (see :mod:`splinedeform.viz.gif`).
@@ -126,7 +129,7 @@ def write_animation(path: str | os.PathLike[str], surface: Surface, rest_net: Ar
                          "(pip install 'splinedeform[video]') or write a .gif")
     check_frames(surface, times, nets)
     draw = _FrameDrawer(surface, rest_net, times, nets, resolution, float(warp), camera,
-                        RAMP_LEVELS if suffix == ".gif" else None)
+                        RAMP_LEVELS if suffix == ".gif" else None, label)
 
     def frames() -> Iterator[NDArray[np.uint8]]:
         for f in range(len(draw)):
