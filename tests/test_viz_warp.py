@@ -21,15 +21,17 @@ from tiny_scenario import BASE
 
 
 @pytest.mark.parametrize("largest, size, expected", [
-    (0.002, 1.0, 100.0),     # 0.2 / 0.002 = 100 exactly: kept
-    (0.004, 1.0, 50.0),      # 0.2 / 0.004 = 50 exactly: kept
-    (0.0041, 1.0, 20.0),     # 48.8 -> 20
-    (0.003, 2.0, 100.0),     # 133 -> 100
+    (0.002, 1.0, 100.0),     # 0.2 / 0.002 = 100 exactly
+    (0.004, 1.0, 50.0),      # 50 exactly
+    (0.0041, 1.0, 50.0),     # 48.8: nearer 50 than 20 in ratio
+    (0.003, 2.0, 100.0),     # 133: 100 (ratio 1.33) rather than 200 (1.5)
+    (0.0006, 1.0, 500.0),    # 333: 500 (ratio 1.5) rather than 200 (1.67)
     (0.5, 1.0, 1.0),         # already large: never shrunk
-    (0.15, 1.0, 1.0),        # 1.33 -> 1
+    (0.05, 1.0, 1.0),        # 5 % of the size is visible as it is
+    (0.0499, 2.0, 10.0),     # 2.5 %: 8.02 -> 10
     (0.0, 1.0, 1.0),         # no motion
 ])
-def test_auto_warp_rounds_down_to_one_two_five(largest, size, expected):
+def test_auto_warp_takes_the_nearest_of_one_two_five(largest, size, expected):
     assert auto_warp(largest, size) == expected        # nice numbers: exact
     assert warp_caption(1.0) == ""
     assert "× 50" in warp_caption(50.0)
@@ -86,7 +88,9 @@ def test_a_run_draws_with_the_automatic_warp_camera_and_fps(monkeypatch, tmp_pat
     size = float(np.ptp(result.rest_net.reshape(-1, 3), axis=0).max())
     raw = 0.2 * size / result.max_displacement
     nice = [m * 10.0 ** k for k in range(-3, 8) for m in (1, 2, 5)]
-    expected = max([1.0] + [n for n in nice if n <= raw])
+    expected = max(1.0, min(nice, key=lambda n: abs(np.log(n / raw))))
+    if result.max_displacement >= 0.05 * size:
+        expected = 1.0
     assert picture_warp(result) == expected
     for name in ("picture", "animation"):
         assert drawn[name]["warp"] == expected and drawn[name]["camera"] == (45.0, 10.0)

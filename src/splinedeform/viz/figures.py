@@ -14,6 +14,11 @@ from ..errors import InputError
 from ..export import write_with
 from .colour import COLORMAP, displacement_colors, shade
 
+#: version of what the pictures show: raise it with any change that alters them (view,
+#: colours, layout, warp); docs/gallery/regenerate.py records it in the gallery's
+#: manifest and tests/test_gallery.py asks for the gallery to be regenerated when it differs
+RENDERER_VERSION = 2
+
 DPI = 100
 PANEL_INCHES = 4.0          # each surface panel is 400 × 400 px
 COLORBAR_INCHES = 1.5     # colour bar and its label, clear of the last panel's z ticks

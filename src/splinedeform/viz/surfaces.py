@@ -79,14 +79,14 @@ def _render_pyvista(path: Path, X: NDArray[np.float64], mag: NDArray[np.float64]
 
 def surfaces_figure(X: NDArray[np.float64], mag: NDArray[np.float64],
                     faces: NDArray[np.int64], titles: Sequence[str], vmax: float,
-                    camera: tuple[float, float] = CAMERA, caption: str = "") -> Any:
+                    camera: tuple[float, float] = CAMERA, warp: float = 1.0) -> Any:
     """The matplotlib Figure of :func:`render_surfaces` (one 3-D axes per panel).
 
     Each surface is one collection of triangles, drawn far to near in the order of the
     depth of their projected centroids (painter's order), shaded by
     :func:`~splinedeform.viz.colour.shade`. A panel without displacement (the rest shape)
     is drawn in a neutral grey, so its shading shows the shape rather than a flat navy.
-    ``caption`` (e.g. the warp factor) is written under the panels.
+    A warp factor ``warp`` other than 1 is written under the colour bar.
     """
     n = X.shape[0]
     width = PANEL_INCHES * n + COLORBAR_INCHES
@@ -101,15 +101,16 @@ def surfaces_figure(X: NDArray[np.float64], mag: NDArray[np.float64],
         _axis_labels(ax)
         ax.set_title(titles[i], fontsize=10)
     _colorbar(fig, [(n * PANEL_INCHES + 0.45) / width, 0.12, 0.18 / width, 0.72], vmax)
-    if caption:
-        fig.text(0.01, 0.012, caption, fontsize=9, ha="left", va="bottom")
+    if warp != 1:
+        fig.text((n * PANEL_INCHES + 0.54) / width, 0.015, f"displacement\ndrawn × {warp:g}",
+                 fontsize=8, ha="center", va="bottom")
     return fig
 
 
 def _render_matplotlib(path: Path, X: NDArray[np.float64], mag: NDArray[np.float64],
                        faces: NDArray[np.int64], titles: Sequence[str], vmax: float,
-                       camera: tuple[float, float], caption: str) -> Path:
-    return _save_png(surfaces_figure(X, mag, faces, titles, vmax, camera, caption), path)
+                       camera: tuple[float, float], warp: float) -> Path:
+    return _save_png(surfaces_figure(X, mag, faces, titles, vmax, camera, warp), path)
 
 
 def render_surfaces(path: str | os.PathLike[str], surface: Surface, rest_net: ArrayLike,
@@ -120,8 +121,8 @@ def render_surfaces(path: str | os.PathLike[str], surface: Surface, rest_net: Ar
     All panels share the colour scale ``[0, max |d|]`` and the same equal-aspect box, so
     sizes and colours compare across panels; a panel with no displacement is grey. With
     matplotlib the picture is ``(400 n + 150) × 400`` pixels for ``n`` panels. Each panel
-    draws ``x_rest + w d`` with the warp factor ``w`` (stated under the panels when it is
-    not 1; colours keep the true ``|d|``), seen from ``camera = (elevation, azimuth)``
+    draws ``x_rest + w d`` with the warp factor ``w`` (stated under the colour bar when it
+    is not 1; colours keep the true ``|d|``), seen from ``camera = (elevation, azimuth)``
     in degrees (matplotlib; PyVista keeps its isometric view).
     """
     target = Path(path)
@@ -143,5 +144,5 @@ def render_surfaces(path: str | os.PathLike[str], surface: Surface, rest_net: Ar
             return _render_pyvista(target, X, mag, faces, titles, vmax, caption)
         except Exception:   # noqa: BLE001  (no off-screen context: draw with matplotlib)
             pass
-    return _render_matplotlib(target, X, mag, faces, titles, vmax, camera, caption)
+    return _render_matplotlib(target, X, mag, faces, titles, vmax, camera, float(warp))
 
