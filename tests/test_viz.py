@@ -253,6 +253,22 @@ def test_gif_has_one_distinct_frame_per_time(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["motion.gif"]
 
 
+def test_gif_progress_counts_frames_already_encoded(tmp_path):
+    """Each progress call finds the (temporary) GIF longer: frames are encoded as they are
+    drawn, not all at the end after the last count."""
+    s = plane(3)
+    times, nets = motion(s, 4)
+    sizes = []
+
+    def progress(done, total):
+        sizes.append(sum(p.stat().st_size for p in tmp_path.iterdir()))
+
+    viz.write_animation(tmp_path / "motion.gif", s, s.control_points, times, nets,
+                        resolution=8, progress=progress)
+    assert len(sizes) == 4 and sizes[0] > 768            # header and 256-colour table
+    assert all(b > a for a, b in zip(sizes, sizes[1:]))
+
+
 def test_gif_colour_bar_is_the_colour_map_ramp_exactly(tmp_path):
     """Every pixel down the middle of the bar is one of the ramp's colours, unchanged by the
     palette, and the bar climbs the ramp level by level (no bands of one colour)."""

@@ -29,6 +29,8 @@ RAMP_LEVELS = 128
 #: evenly spaced greys from black to white
 GREY_LEVELS = 16
 PALETTE_SIZE = 256
+#: at most this many sample pixels (every third, then evenly thinned) enter the median cut
+FITTED_PIXELS = 60_000
 
 
 def ramp_colors(colormap: str, levels: int = RAMP_LEVELS) -> NDArray[np.uint8]:
@@ -40,16 +42,17 @@ def ramp_colors(colormap: str, levels: int = RAMP_LEVELS) -> NDArray[np.uint8]:
 
 
 def global_palette(samples: NDArray[np.uint8], ramp: NDArray[np.uint8]) -> NDArray[np.uint8]:
-    """The 256 × RGB palette: ``ramp``, :data:`GREY_LEVELS` greys, then the median cut of
-    the non-grey pixels of ``samples (S, H, W, 3)`` (spread ``max - min`` over the channels
-    above 12) into the entries left."""
+    """The 256 × RGB palette: ``ramp``, :data:`GREY_LEVELS` greys, then the median cut (one
+    k-means pass) of the non-grey pixels of ``samples (S, H, W, 3)`` (spread ``max - min``
+    over the channels above 12; at most :data:`FITTED_PIXELS` of them) into the entries
+    left."""
     from PIL import Image
 
     greys = np.repeat(np.round(np.linspace(0, 255, GREY_LEVELS)).astype(np.uint8)[:, None], 3, 1)
     left = PALETTE_SIZE - len(ramp) - GREY_LEVELS
-    pixels = samples.reshape(-1, 3)
+    pixels = samples.reshape(-1, 3)[::3]
     colourful = pixels[np.ptp(pixels.astype(np.int16), axis=1) > 12]
-    colourful = colourful[::max(1, len(colourful) // 200_000)]
+    colourful = colourful[::-(-len(colourful) // FITTED_PIXELS) or 1]
     fitted = np.zeros((0, 3), dtype=np.uint8)
     if len(colourful) and left > 0:
         quantised = Image.fromarray(np.ascontiguousarray(colourful[None])).quantize(
@@ -129,6 +132,7 @@ class GifWriter:
         for chunk in GifImagePlugin.getdata(frame, offset=box[:2], duration=self.duration):
             data.write(chunk)
         self.stream.write(data.getvalue())
+        self.stream.flush()
 
     def close(self) -> None:
         self.stream.write(b";")
