@@ -107,3 +107,24 @@ def test_a_run_draws_with_the_automatic_warp_camera_and_fps(monkeypatch, tmp_pat
 def test_bad_output_view_keys_are_located(line, where):
     with pytest.raises(ScenarioError, match=where):
         scenario(f"formats = []\n{line}")
+
+
+def test_the_warp_factor_is_stated_in_the_picture_and_the_animation():
+    from splinedeform.viz.animation import _FrameDrawer
+    from splinedeform.viz.surfaces import surfaces_figure
+
+    b = BSplineBasis(2, 2, 1.0, "open")
+    gu, gv = np.meshgrid(b.greville(), b.greville(), indexing="ij")
+    s = Surface(np.stack([gu, gv, 0 * gu], -1), b, b)
+    moved = s.control_points.copy()
+    moved[1:-1, 1:-1, 2] = 0.004
+    X, mag, faces = _displaced_meshes(s, s.control_points, [s.control_points, moved], 4, 50.0)
+    texts = lambda fig: " ".join(t.get_text() for t in fig.texts)   # noqa: E731
+    assert "× 50" in texts(surfaces_figure(X, mag, faces, ["a", "b"], float(mag.max()),
+                                           warp=50.0))
+    assert "×" not in texts(surfaces_figure(X, mag, faces, ["a", "b"], float(mag.max())))
+    draw = _FrameDrawer(s, s.control_points, [0.0, 1.0], [s.control_points, moved], 4, 50.0,
+                        (20.0, 30.0), label="load factor")
+    draw(1)
+    assert draw.ax.get_title() == "load factor = 1  ·  displacement drawn × 50 (output.warp)"
+    assert (draw.ax.elev, draw.ax.azim) == (20.0, 30.0)

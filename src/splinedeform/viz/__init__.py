@@ -4,7 +4,9 @@
 * :mod:`.figures` — matplotlib helpers (Agg canvas, no pyplot state);
 * :mod:`.surfaces` — ``surfaces.png`` (PyVista if it can render off screen, else matplotlib);
 * :mod:`.plots` — ``probes.png`` and ``modes.png``;
-* :mod:`.animation` — GIF / MP4;
+* :mod:`.animation` — GIF / MP4, drawn and encoded frame by frame;
+* :mod:`.gif` — the GIF's one palette (the colour bar's ramp held exactly) and its writer;
+* :mod:`.warp` — the warp factor of the pictures (``output.warp``);
 * :mod:`.viewer` — ``viewer.html``.
 """
 
