@@ -39,7 +39,8 @@ def test_the_picture_is_current(name):
     assert entry["renderer"] == RENDERER_VERSION, \
         f"{name} was drawn by renderer {entry['renderer']}, now {RENDERER_VERSION}: " \
         f"{HOW.format(stem)}"
-    assert sha256(GALLERY / name) == entry["sha256"], f"{name} was changed by hand: {HOW.format(stem)}"
+    assert sha256(GALLERY / name) == entry["sha256"], \
+        f"{name} was changed by hand: {HOW.format(stem)}"
 
 
 def test_the_gallery_page_shows_every_picture():

@@ -360,9 +360,9 @@ class Output(_Table):
                                                               allow_inf_nan=False)]] = Field(
         "auto", description=(
             "pictures and animation draw `x_rest + warp · d` (colours keep the true `|d|`); "
-            '"auto": below `max |d| = 0.05 · size`, `0.2 · size / max |d|` rounded to the nearest 1, 2 or 5 × 10^k, else 1 ('
-            "size: the largest side of the control net's box; 1 for a modes solve), stated in "
-            "the caption"))
+            '"auto": below `max |d| = 0.05 · size`, `0.2 · size / max |d|` rounded to the '
+            "nearest 1, 2 or 5 × 10^k, else 1 (size: the largest side of the control net's "
+            "box; 1 for a modes solve), stated in the caption"))
     camera: tuple[Angle, Angle] = Field(
         (28.0, -60.0), title="[elevation, azimuth]", description=(
             "view of the pictures and the animation, in degrees"))

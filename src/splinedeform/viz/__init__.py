@@ -18,7 +18,8 @@ from .surfaces import render_surfaces
 from .viewer import content_security_policy, script_json, vertex_checksum, viewer_data, viewer_html, write_viewer
 
 __all__ = ["ANIMATION_PIXELS", "COLORBAR_INCHES", "COLORMAP", "DPI", "LIGHT", "MODE_COLORMAP",
-           "PANEL_INCHES", "RENDERER_VERSION", "animation_frames", "colormap_table", "content_security_policy", "displacement_colors",
+           "PANEL_INCHES", "RENDERER_VERSION", "animation_frames", "colormap_table",
+           "content_security_policy", "displacement_colors",
            "mode_geometry", "mp4_available", "plot_modes", "plot_probes", "render_surfaces",
            "script_json", "shade", "vertex_checksum", "viewer_data", "viewer_html",
            "write_animation", "write_viewer"]

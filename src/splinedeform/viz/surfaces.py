@@ -19,8 +19,8 @@ from ..errors import InputError
 from ..export import check_net, tessellate_frames, weld, write_with
 from ..surface import Surface
 from .colour import COLORMAP
-from .figures import (CAMERA, COLORBAR_INCHES, DPI, PANEL_INCHES, REST_RGBA, _axes3d, _axis_labels, _box,
-                      _collection, _colorbar, _face_colors, _figure, _save_png)
+from .figures import (CAMERA, COLORBAR_INCHES, DPI, PANEL_INCHES, REST_RGBA, _axes3d, _axis_labels,
+                      _box, _collection, _colorbar, _face_colors, _figure, _save_png)
 from .warp import warp_caption
 
 
