@@ -269,6 +269,27 @@ def test_gif_progress_counts_frames_already_encoded(tmp_path):
     assert all(b > a for a, b in zip(sizes, sizes[1:]))
 
 
+def test_a_frame_drawn_over_the_kept_background_is_the_full_drawing():
+    """Only the surface and the title are drawn per frame; a full redraw of the figure
+    with the same surface gives the same picture (8 levels of 255 and 0.5 % of the
+    pixels: antialiasing along the silhouette, composited once more over the background)."""
+    from splinedeform.viz.animation import _FrameDrawer
+    from splinedeform.viz.figures import _collection, _face_colors
+
+    s = plane(3)
+    times, nets = motion(s, 3)
+    draw = _FrameDrawer(s, s.control_points, times, nets, 10, 1.0, (28.0, -60.0))
+    draw(0)
+    image = draw(2)
+    surface = _collection(draw.X[2], draw.faces, _face_colors(draw.mag[2], draw.faces,
+                                                              draw.vmax))
+    draw.ax.add_collection3d(surface)
+    draw.fig.canvas.draw()
+    full = np.asarray(draw.fig.canvas.buffer_rgba())[..., :3].astype(int)
+    assert np.mean(np.any(np.abs(full - image) > 8, axis=-1)) < 0.005
+    assert np.mean(np.any(image != draw(0), axis=-1)) > 0.01     # frames do differ
+
+
 def test_gif_colour_bar_is_the_colour_map_ramp_exactly(tmp_path):
     """Every pixel down the middle of the bar is one of the ramp's colours, unchanged by the
     palette, and the bar climbs the ramp level by level (no bands of one colour)."""
