@@ -1,8 +1,8 @@
 """Animations of the motion: a looping GIF (pillow, :mod:`.gif`) or an MP4 (imageio-ffmpeg).
 
 Frames are drawn one at a time on one matplotlib figure (fixed axes, colour scale and
-view) and written as they are drawn, so memory holds one frame, not the whole film, and
-the progress counts frames written.
+view) and written as they are drawn, so memory holds a few frames (the GIF's palette
+samples), not the whole film, and the progress counts frames written.
 """
 
 from __future__ import annotations
@@ -10,7 +10,6 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
