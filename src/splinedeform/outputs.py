@@ -36,6 +36,9 @@ def _mesh_net(result: RunResult) -> Any:
     return result.nets[-1]
 
 
+#: what the frames of each solve kind are called in the pictures
+FRAME_LABELS = {"dynamic": "t", "static": "load factor", "modes": "phase"}
+
 #: STEP / IGES output formats and their file suffixes (the 'cad-step' extra)
 STEP_FILES = {"step": ".step", "iges": ".igs"}
 
@@ -61,7 +64,36 @@ def planned_outputs(result: RunResult) -> list[str]:
     names += [f"{name}.{ext}" for ext in ("gif", "mp4") if ext in formats]
     names += ["viewer.html"] if "viewer" in formats else []
     names += ["report.json", "report.md"] if "report" in formats else []
+    return names + mode_file_names(result)
+
+
+def mode_file_names(result: RunResult) -> list[str]:
+    """The per-mode files of a modes solve: ``<name>_modes.vtu`` (vtu), the frames of each
+    mode ``<name>_mode<k>_nets.json/.npz`` (json, npz) and the animation of each mode of
+    ``output.animate_modes`` but the first, ``<name>_mode<k>.gif/.mp4`` (gif, mp4)."""
+    s = result.scenario
+    if s.solve.kind != "modes" or result.mode_nets is None:
+        return []
+    formats, name = s.output.formats, s.name
+    names = [f"{name}_modes.vtu"] if "vtu" in formats else []
+    names += [f"{name}_mode{k}_nets.{ext}" for k in range(1, len(result.mode_nets) + 1)
+              for ext in ("json", "npz") if ext in formats]
+    names += [f"{name}_mode{k}.{ext}" for k in animated_modes(result) if k != 1
+              for ext in ("gif", "mp4") if ext in formats]
     return names
+
+
+def animated_modes(result: RunResult) -> tuple[int, ...]:
+    """``output.animate_modes`` (mode numbers from 1), mode 1 when not given."""
+    return tuple(result.scenario.output.animate_modes or (1,))
+
+
+def mode_frames(result: RunResult, k: int) -> Any:
+    """Control nets of mode ``k`` (from 1) over one period: ``P_rest + sin(2π φ) D_k`` at the
+    phases ``φ`` of the frames (the frames of a modes solve are those of mode 1)."""
+    phase = np.asarray(result.times, dtype=float)
+    return result.rest_net + np.sin(2.0 * np.pi * phase)[:, None, None, None] \
+        * result.mode_nets[k - 1]
 
 
 def write_outputs(result: RunResult, folder: Path, stages: Stages) -> None:
@@ -148,6 +180,8 @@ def _write_files(result: RunResult, folder: Path, stages: Stages) -> None:
             result.outputs.append(("viewer", write_viewer(
                 folder / "viewer.html", surface, rest, times, nets, resolution=res,
                 title=scenario.title or scenario.name)))
+    if mode_file_names(result):
+        _write_mode_files(result, folder, stages)
     if "report" in formats:
         with stages.stage("report"):
             result.report = make_report(result)
@@ -199,6 +233,22 @@ def dense_probes(result: RunResult, samples: int = DENSE_PROBE_SAMPLES
     return t, out
 
 
+def picture_warp(result: RunResult) -> float:
+    """The warp factor of the pictures and the animation: ``output.warp``, or for "auto"
+    :func:`splinedeform.viz.warp.auto_warp` of the largest displacement and the largest
+    side of the control net's bounding box (1 for a modes solve, whose amplitude is
+    chosen for drawing)."""
+    from .viz.warp import auto_warp
+
+    warp = result.scenario.output.warp
+    if warp != "auto":
+        return float(warp)
+    if result.scenario.solve.kind == "modes":       # drawn at 10 % of the size already
+        return 1.0
+    rest = np.asarray(result.rest_net, dtype=float).reshape(-1, 3)
+    return auto_warp(float(result.max_displacement), float(np.ptp(rest, axis=0).max()))
+
+
 def _write_images(result: RunResult, folder: Path, stages: Stages) -> None:
     """surfaces.png (rest shape and the frame of largest displacement), probes.png, modes.png."""
     from . import viz
@@ -206,12 +256,13 @@ def _write_images(result: RunResult, folder: Path, stages: Stages) -> None:
     surface, rest = result.built.surface, result.rest_net
     kind = result.scenario.solve.kind
     with stages.stage("images"):
-        label = {"dynamic": "t", "static": "load factor", "modes": "phase"}[kind]
+        label = FRAME_LABELS[kind]
         peak = peak_frame(result)
         result.outputs.append(("picture", viz.render_surfaces(
             folder / "surfaces.png", surface, rest, [result.nets[0], result.nets[peak]],
             [f"initial ({label} = {result.times[0]:g})",
-             f"largest displacement ({label} = {result.times[peak]:.4g})"])))
+             f"largest displacement ({label} = {result.times[peak]:.4g})"],
+            warp=picture_warp(result), camera=result.scenario.output.camera)))
         if kind == "dynamic":
             dense = dense_probes(result)
             result.outputs.append(("probe plot", viz.plot_probes(
@@ -219,18 +270,51 @@ def _write_images(result: RunResult, folder: Path, stages: Stages) -> None:
                 *(dense if dense is not None else (None, None)))))
         if result.omegas is not None:
             result.outputs.append(("mode shapes", viz.plot_modes(
-                folder / "modes.png", surface, result.omegas, result.mode_shapes)))
+                folder / "modes.png", surface, result.omegas, result.mode_shapes,
+                camera=result.scenario.output.camera)))
 
 
-def _write_animation(result: RunResult, path: Path, stages: Stages) -> None:
+def _write_animation(result: RunResult, path: Path, stages: Stages, nets: Any = None,
+                     what: str = "animation", label: str | None = None) -> None:
     from .viz import write_animation
 
-    stage = f"animation {path.suffix}"
+    stage = f"{what} {path.suffix}"
     with stages.stage(stage):
         result.outputs.append((stage, write_animation(
-            path, result.built.surface, result.rest_net, result.times, result.nets,
+            path, result.built.surface, result.rest_net, result.times,
+            result.nets if nets is None else nets,
             resolution=result.scenario.output.resolution,
-            progress=lambda done, total: stages.tick(stage, done, total + 1))))
+            progress=lambda done, total: stages.tick(stage, done, total + 1),
+            fps=result.scenario.output.fps, warp=picture_warp(result),
+            camera=result.scenario.output.camera,
+            label=label or FRAME_LABELS[result.scenario.solve.kind])))
+
+
+def _write_mode_files(result: RunResult, folder: Path, stages: Stages) -> None:
+    """The files of :func:`mode_file_names`: mode fields, per-mode nets and animations."""
+    from . import export
+
+    s = result.scenario
+    formats, name, res = s.output.formats, s.name, s.output.resolution
+    surface = result.built.surface
+    if "vtu" in formats:
+        with stages.stage("mode fields .vtu"):
+            result.outputs.append(("mode fields .vtu", export.write_mode_fields(
+                folder / f"{name}_modes.vtu", surface, result.mode_nets, resolution=res)))
+    wanted = [ext for ext in export.CONTROL_NET_FORMATS if ext in formats]
+    if wanted:
+        with stages.stage("mode nets"):
+            for k in range(1, len(result.mode_nets) + 1):
+                for path in export.write_control_nets(folder, f"{name}_mode{k}_nets", surface,
+                                                      result.times, mode_frames(result, k),
+                                                      formats=wanted):
+                    result.outputs.append((f"mode {k} nets {path.suffix}", path))
+    for k in animated_modes(result):
+        for ext in ("gif", "mp4"):
+            if k != 1 and ext in formats:
+                _write_animation(result, folder / f"{name}_mode{k}.{ext}", stages,
+                                 mode_frames(result, k), f"mode {k}",
+                                 f"mode {k} (ω = {float(result.omegas[k - 1]):.5g}), phase")
 
 
 def make_report(result: RunResult) -> dict[str, Any]:

@@ -38,6 +38,9 @@ class RunResult:
     nets: Any
     omegas: Any = None
     mode_shapes: Any = None
+    #: each computed mode as a displacement of the control net ``(k, n_u, n_v, 3)``, scaled
+    #: as the frames of a modes solve draw it (:func:`mode_displacements`)
+    mode_nets: Any = None
     probes: dict[str, Any] = field(default_factory=dict)
     probe_points: dict[str, tuple[float, float]] = field(default_factory=dict)
     energy: dict[str, Any] | None = None
@@ -151,12 +154,13 @@ def _solve(scenario: Scenario, built: Built, stages: _Stages) -> RunResult:
     if solve.modes > 0 and solve.kind != "static":
         with stages.stage("modes"), _located(scenario, "solve.modes"):
             omegas, shapes = model.modes(min(solve.modes, model.n_free))
+    mode_nets = None if shapes is None else mode_displacements(built.surface, shapes)
     with stages.stage("frames"), _located(scenario, "solve"):
-        nets = _frames(scenario, built, solution, times, shapes)
+        nets = _frames(scenario, built, solution, times, mode_nets)
     if shapes is not None and shapes.ndim == 4:     # the shell's modes move x, y, z
         shapes = np.einsum("kabc,abc->kab", shapes, _net_normals(built.surface))
     result = RunResult(scenario=scenario, built=built, solution=solution, times=times,
-                       nets=nets, omegas=omegas, mode_shapes=shapes)
+                       nets=nets, omegas=omegas, mode_shapes=shapes, mode_nets=mode_nets)
     with np.errstate(over="ignore", invalid="ignore"):
         _measure(result)
     _require_finite(result)
@@ -224,7 +228,23 @@ def _method_options(solve: SolveSpec, times: Any, mesh_time: float | None) -> di
     return options
 
 
-def _frames(scenario: Scenario, built: Built, solution: Any, times: Any, shapes: Any) -> Any:
+def mode_displacements(surface: Any, shapes: Any) -> Any:
+    """The modes as control-net displacements ``D_k (k, n_u, n_v, 3)``, each scaled so that
+    its largest control-point displacement is 0.1 × the largest side of the net's box.
+
+    A scalar mode ``φ_k (n_u, n_v)`` moves along the net's normals (``φ_k n``); a shell
+    mode ``(n_u, n_v, 3)`` is a displacement net already.
+    """
+    import numpy as np
+
+    D = shapes if shapes.ndim == 4 else shapes[..., None] * _net_normals(surface)[None]
+    rest = surface.control_points
+    size = float(np.ptp(rest.reshape(-1, 3), axis=0).max()) or 1.0
+    peak = np.linalg.norm(D, axis=-1).max(axis=(1, 2))
+    return D * (0.1 * size / np.where(peak > 0, peak, 1.0))[:, None, None, None]
+
+
+def _frames(scenario: Scenario, built: Built, solution: Any, times: Any, mode_nets: Any) -> Any:
     """Control nets ``(F, n_u, n_v, 3)`` at the frame times (see :class:`RunResult`)."""
     import numpy as np
 
@@ -235,13 +255,8 @@ def _frames(scenario: Scenario, built: Built, solution: Any, times: Any, shapes:
     if kind == "static":
         d = solution.control_points() - rest
         return rest + times[:, None, None, None] * d
-    # a scalar mode moves along the normals; a shell mode is a displacement net already
-    shape = shapes[0] if shapes.ndim == 4 else shapes[0][..., None] * _net_normals(built.surface)
-    size = float(np.ptp(rest.reshape(-1, 3), axis=0).max()) or 1.0
-    peak = float(np.linalg.norm(shape, axis=-1).max()) or 1.0
-    amplitude = 0.1 * size / peak
-    wave = np.sin(2.0 * np.pi * times)
-    return rest + amplitude * wave[:, None, None, None] * shape
+    # the lowest mode over one period of its phase
+    return rest + np.sin(2.0 * np.pi * times)[:, None, None, None] * mode_nets[0]
 
 
 def _net_normals(surface: Any) -> Any:

@@ -67,6 +67,7 @@ Time = Annotated[float, Strict(), Field(ge=0, le=TIME_MAX, allow_inf_nan=False)]
 Integer = Annotated[int, Strict()]
 Text = Annotated[str, Strict()]
 Pair = tuple[Real, Real]
+Angle = Annotated[float, Strict(), Field(ge=-360, le=360, allow_inf_nan=False)]
 #: index of a control point along one direction of the net (from 0)
 NetIndex = Annotated[int, Strict(), Field(ge=0, le=100_000)]
 Cells = Annotated[int, Strict(), Field(ge=1, le=512)]
@@ -364,6 +365,23 @@ class Output(_Table):
         json_schema_extra={"doc_default": 'the domain centre'})
     time: Optional[Time] = Field(None, description="dynamic: the state written as OBJ / STL / PLY",
         json_schema_extra={"doc_default": 'the last frame'})
+    warp: Union[Literal["auto"], Annotated[float, Strict(), Field(gt=0, le=1e6,
+                                                              allow_inf_nan=False)]] = Field(
+        "auto", description=(
+            "pictures and animation draw `x_rest + warp · d` (colours keep the true `|d|`); "
+            '"auto": below `max |d| = 0.05 · size`, `0.2 · size / max |d|` rounded to the '
+            "nearest 1, 2 or 5 × 10^k, else 1 (size: the largest side of the control net's "
+            "box; 1 for a modes solve), stated in the caption"))
+    camera: tuple[Angle, Angle] = Field(
+        (28.0, -60.0), title="[elevation, azimuth]", description=(
+            "view of the pictures and the animation, in degrees"))
+    fps: Annotated[float, Strict(), Field(gt=0, le=50, allow_inf_nan=False)] = Field(
+        15.0, description="frames per second of the animation (a GIF keeps hundredths of a "
+                          "second per frame)")
+    animate_modes: Optional[list[Annotated[int, Strict(), Field(ge=1, le=1000)]]] = Field(
+        None, title="mode numbers", description=(
+            "modes: the modes animated, mode 1 as `<name>.gif`, mode k as "
+            "`<name>_mode<k>.gif`"), json_schema_extra={"doc_default": "[1]"})
 
 
 class ScenarioFile(_Table):

@@ -384,6 +384,14 @@ def _validate_output(raw: Mapping[str, Any], problems: _Problems,
         elif solve.t_end is not None and values["time"] > solve.t_end:
             problems.add("output.time", f"must be <= t_end = {solve.t_end:g}, got "
                                         f"{values['time']:g}")
+    if "animate_modes" in values and solve is not None:
+        if solve.kind != "modes":
+            problems.add("output.animate_modes",
+                         f"does not apply to a {solve.kind} solve (only modes)")
+        for i, k in enumerate(values["animate_modes"], start=1):
+            if k > solve.modes:
+                problems.add(f"output.animate_modes[{i}]",
+                             f"mode {k} is not computed: solve.modes = {solve.modes}")
     for i, (u, v) in enumerate(values.get("probes", ()), start=1):
         if u < 0 or v < 0:
             problems.add(f"output.probes[{i}]", f"parameters must be >= 0, got [{u:g}, {v:g}]")
