@@ -9,10 +9,13 @@ polynomial; in the local parameter ``s = (x - t_μ)/w ∈ [0, 1]`` it has Bézie
 
 The ``β`` lie in ``[0, 1]`` (they come from knot insertion, a convex process) and the
 Bernstein polynomials are non-negative, so the sum is evaluated without cancellation.
-They are found once per basis from the derivatives at the span's left end (the
+They are found once per basis from the derivatives at the span's ends (the
 Cox–de Boor triangle, :mod:`splinedeform.deboor`), by
 ``β_{r,k} = Σ_{j<=k} C(k,j) (n-j)!/n! w^j D^j N_{μ-n+r}(t_μ)``, the inverse of
-``D^j p(0) = n!/(n-j)! Δ^j β_0`` for ``p(s) = Σ_k β_k B_{k,n}(s)``.
+``D^j p(0) = n!/(n-j)! Δ^j β_0`` for ``p(s) = Σ_k β_k B_{k,n}(s)``, for ``k <= n/2``, and
+the mirror formula ``β_{r,n-k} = Σ_{j<=k} C(k,j) (n-j)!/n! (-w)^j D^j N_{μ-n+r}(t_{μ+1})``
+for the others: the end values ``β_{r,0}`` and ``β_{r,n}`` are then the values at the
+knots themselves (exact zeros stay exact).
 
 Derivatives use the same identity: ``D^j N = n!/(n-j)! w^{-j} Σ_k (Δ^j β)_{r,k} B_{k,n-j}(s)``,
 tabulated per order. An evaluation is then a span look-up, the Bernstein values of
@@ -106,12 +109,18 @@ def span_form(left: Array, right: Array, widths: Array, degree: int) -> SpanForm
     degree : int
     """
     n = degree
-    ends = triangle(left, right, n, n)                 # D^j N_{μ-n+r}(t_μ): (j, r, S)
-    local = ends * right[0] ** np.arange(n + 1)[:, None, None]   # d^j/ds^j = w^j D^j
+    width = right[0]                                          # w in the unit of left/right
+    powers = width ** np.arange(n + 1)[:, None, None]         # d^j/ds^j = w^j D^j
+    at_left = triangle(left, right, n, n) * powers            # p^{(j)}(0): (j, r, S)
+    at_right = triangle(left + width, right - width, n, n) * powers   # p^{(j)}(1)
     beta = np.zeros((widths.size, n + 1, n + 1))
     for k in range(n + 1):
-        for j in range(k + 1):
-            beta[:, :, k] += (comb(k, j) * factorial(n - j) / factorial(n)) * local[j].T
+        # the nearer end gives each coefficient exactly where it is a value (k = 0, n)
+        # and with the fewest terms otherwise
+        near, sign, order = (at_left, 1.0, k) if k <= n // 2 else (at_right, -1.0, n - k)
+        for j in range(order + 1):
+            beta[:, :, k] += (comb(order, j) * factorial(n - j) / factorial(n)
+                              * sign ** j) * near[j].T
     coefficients = tuple(
         np.ascontiguousarray(np.diff(beta, n=j, axis=2)
                              * (factorial(n) / factorial(n - j) * widths ** (-j))[:, None, None])
