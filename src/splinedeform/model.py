@@ -34,6 +34,7 @@ from .modal_solve import check_count as _check_count
 from .solution import ModalSolution, Readout, SampledSolution, StaticSolution
 from . import spectrum
 from .solvers import modal_basis, numeric
+from .solvers.factor import factorise
 from .solvers.forcing import ReducedForcing
 from .solvers.system import KroneckerFactors, Reduction
 from .surface import Surface
@@ -218,7 +219,7 @@ class Model:
             raise SingularSystemError(message + f" ({self.rigid_modes} deformation(s) without "
                                       "energy, counted from the weights and the constraints)")
         try:
-            lu = spla.splu(self._K)
+            lu = factorise(self._K)            # once constrained K is SPD: a Cholesky
             d = lu.solve(F)
         except RuntimeError:
             raise SingularSystemError(message) from None
