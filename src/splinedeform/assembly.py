@@ -123,8 +123,9 @@ def kronecker_sums(sums: Sequence[Sequence[tuple[float, sp.spmatrix, sp.spmatrix
             values_b = np.stack([_table(PB, _values_on(B, PB))[0] for _, _, B in terms])
             la, ca = values_a.shape[1:]
             lb, cb = values_b.shape[1:]
-            product = ((values_a * weights[:, None, None]).reshape(len(terms), -1).T
-                       @ values_b.reshape(len(terms), -1))              # (i e, k f)
+            with np.errstate(over="ignore", invalid="ignore"):   # scales are checked later
+                product = ((values_a * weights[:, None, None]).reshape(len(terms), -1).T
+                           @ values_b.reshape(len(terms), -1))          # (i e, k f)
             data = product.reshape(la, ca, lb, cb).transpose(0, 2, 1, 3)[stored]
         else:
             data = np.zeros(indices.size)

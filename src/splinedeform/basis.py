@@ -119,6 +119,7 @@ class BSplineBasis:
     kind: KnotKind = "open"
     knots: NDArray[np.float64] = field(init=False, repr=False, compare=False)
     form: SpanForm = field(init=False, repr=False, compare=False)
+    _span_functions: NDArray[np.int64] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         _check_degree(self.degree)
@@ -139,6 +140,9 @@ class BSplineBasis:
         below, above = self._cell_windows()
         object.__setattr__(self, "form", span_form(-below, above, np.full(self.cells, self.h),
                                                    self.degree))
+        index = np.arange(self.cells)[:, None] + np.arange(self.degree + 1)
+        object.__setattr__(self, "_span_functions", np.mod(index - self.degree, self.cells)
+                           if self.kind == "periodic" else index)
 
     # -- layout -------------------------------------------------------------
     @property
@@ -203,16 +207,19 @@ class BSplineBasis:
     # -- evaluation ---------------------------------------------------------
     def _check_points(self, x: ArrayLike) -> NDArray[np.float64]:
         x = np.asarray(x, dtype=float)
-        if not np.all(np.isfinite(x)):
+        if not x.size:
+            return x
+        lo, hi = x.min(), x.max()                  # NaN and infinities show in these
+        if not (np.isfinite(lo) and np.isfinite(hi)):
             raise InputError("parameters must be finite numbers")
         if self.kind == "periodic":
             return np.mod(x, self.length)
         tol = 1e-12 * self.length
-        if x.size and (x.min() < -tol or x.max() > self.length + tol):
+        if lo < -tol or hi > self.length + tol:
             raise InputError(
                 f"parameter outside the domain [0, {self.length:g}]: "
-                f"got values in [{x.min():g}, {x.max():g}]")
-        return np.clip(x, 0.0, self.length)
+                f"got values in [{lo:g}, {hi:g}]")
+        return np.clip(x, 0.0, self.length) if lo < 0.0 or hi > self.length else x
 
     def span(self, x: ArrayLike) -> NDArray[np.int64]:
         """Index ``i`` of the cell ``[i h, (i+1) h)`` holding each parameter (last cell closed)."""
@@ -248,20 +255,17 @@ class BSplineBasis:
         """
         if not isinstance(max_derivative, (int, np.integer)) or max_derivative < 0:
             raise InputError(f"derivative order must be an integer >= 0, got {max_derivative!r}")
-        x = self._check_points(x)
-        n = self.degree
-        y = x.ravel() / self.h
-        cell = np.clip(np.floor(y).astype(np.int64), 0, self.cells - 1)
-        values = self.form.values(cell, y - cell, max_derivative)
-        index = cell.reshape(x.shape)[..., None] + np.arange(n + 1)
-        if self.kind == "periodic":
-            index = np.mod(index - n, self.cells)
-        return index, values.reshape((max_derivative + 1,) + x.shape + (n + 1,))
+        x = np.asarray(x, dtype=float)
+        cell, s = self.locate(x)
+        values = self.form.values(cell, s, max_derivative)
+        index = self._span_functions[cell].reshape(x.shape + (self.degree + 1,))
+        return index, values.reshape((max_derivative + 1,) + x.shape + (self.degree + 1,))
 
     def locate(self, x: ArrayLike) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
         """Cell ``i`` and local parameter ``s = x/h - i ∈ [0, 1]`` of each parameter (flattened)."""
         y = self._check_points(x).ravel() / self.h
-        cell = np.clip(np.floor(y).astype(np.int64), 0, self.cells - 1)
+        cell = y.astype(np.int64)                  # y >= 0: truncation is the floor
+        np.minimum(cell, self.cells - 1, out=cell)   # x = L belongs to the last cell
         return cell, y - cell
 
     def locate_scalar(self, x: float) -> tuple[int, float]:
@@ -280,8 +284,7 @@ class BSplineBasis:
 
     def span_functions(self) -> NDArray[np.int64]:
         """Indices of the ``n + 1`` functions not vanishing on each cell, shape ``(m, n+1)``."""
-        index = np.arange(self.cells)[:, None] + np.arange(self.degree + 1)
-        return np.mod(index - self.degree, self.cells) if self.kind == "periodic" else index
+        return self._span_functions.copy()
 
     def matrix(self, x: ArrayLike, derivative: int = 0) -> sp.csr_matrix:
         """Sparse collocation matrix ``A_{ij} = D^derivative b_j(x_i)``, shape ``(len(x), size)``."""

@@ -55,10 +55,13 @@ class SpanForm:
         Works through blocks of :data:`splinedeform.deboor.BLOCK` parameters.
         """
         n = self.degree
+        top = min(max_derivative, n)
+        if s.size <= BLOCK and max_derivative == 0:             # the common case, one product
+            return np.einsum("prk,pk->pr", self.coefficients[0][span], bernstein(s, n))[None]
         out = np.zeros((max_derivative + 1, s.size, n + 1))
         for start in range(0, s.size, BLOCK):
             block = slice(start, start + BLOCK)
-            for j in range(min(max_derivative, n) + 1):
+            for j in range(top + 1):
                 # Σ_k β^{(j)}_{r,k} B_{k,n-j}(s): gathered coefficients against Bernstein values
                 np.einsum("prk,pk->pr", self.coefficients[j][span[block]],
                           bernstein(s[block], n - j), out=out[j, block])
@@ -86,14 +89,27 @@ def _binomials(m: int) -> list[float]:
 
 
 _BINOMIALS = [[float(comb(m, k)) for k in range(m + 1)] for m in range(16)]
+_TO_BERNSTEIN: list[Array] = []
 
 
 def bernstein(s: Array, degree: int) -> Array:
-    """Bernstein polynomials ``B_{k,m}(s) = C(m,k) s^k (1-s)^{m-k}``, shape ``(N, m+1)``."""
-    powers_s = np.vander(s, degree + 1, increasing=True)            # s^k
-    powers_s *= np.vander(1.0 - s, degree + 1)                       # (1-s)^{m-k}
-    powers_s *= np.array(_binomials(degree))
-    return powers_s
+    """Bernstein polynomials ``B_{k,m}(s) = C(m,k) s^k (1-s)^{m-k}``, shape ``(N, m+1)``.
+
+    As powers times the integer matrix ``C_{jk} = (-1)^{j-k} C(m,k) C(m-k, j-k)`` (one
+    matrix product): at ``s = 0`` and ``s = 1`` every product is exact, so the values at
+    knots are exact; elsewhere the cancellation costs at most ``2^m`` roundings.
+    """
+    return np.vander(s, degree + 1, increasing=True) @ _power_to_bernstein(degree)
+
+
+def _power_to_bernstein(m: int) -> Array:
+    if m >= len(_TO_BERNSTEIN):
+        return np.array([[(-1) ** (j - k) * comb(m, k) * comb(m - k, j - k) if j >= k else 0
+                          for k in range(m + 1)] for j in range(m + 1)], dtype=float)
+    return _TO_BERNSTEIN[m]
+
+
+_TO_BERNSTEIN.extend(_power_to_bernstein(m) for m in range(16))
 
 
 def span_form(left: Array, right: Array, widths: Array, degree: int) -> SpanForm:
