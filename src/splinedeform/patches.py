@@ -74,10 +74,27 @@ def evaluate_patches(Q: Array, basis_u: Any, basis_v: Any, u: Array, v: Array) -
     return out[:, 0]
 
 
-def evaluate_patch_point(Q: Array, basis_u: Any, basis_v: Any, u: float, v: float) -> Array:
-    """One point ``Σ_kl Q_{ij,kl} B_k(s) B_l(t)`` from plain floats; shape ``(3,)``."""
+def point_patches(surface: Any, du: int, dv: int) -> Array | None:
+    """:func:`patch_net` laid out for one point at a time: ``(cells_u, cells_v, 3, K)``.
+
+    ``K = (n_u+1-du)(n_v+1-dv)`` coefficients of each coordinate side by side, so one
+    point is a single matrix-vector product ``Q_ij w`` with ``w_kl = B_k(s) B_l(t)``.
+    """
+    key = ("point patches", du, dv)
+    if key not in surface._cache:
+        Q = patch_net(surface, du, dv)
+        if Q is not None:
+            Q = np.ascontiguousarray(Q.reshape(Q.shape[:2] + (-1, 3)).transpose(0, 1, 3, 2))
+            Q.setflags(write=False)
+        surface._cache[key] = Q
+    return surface._cache[key]
+
+
+def evaluate_patch_point(Q: Array, degrees: tuple[int, int], basis_u: Any, basis_v: Any,
+                         u: float, v: float) -> Array:
+    """One point ``Σ_kl Q_{ij,kl} B_k(s) B_l(t)`` from plain floats and :func:`point_patches`."""
     i, s = basis_u.locate_scalar(u)
     j, t = basis_v.locate_scalar(v)
-    weights_v = scalar_bernstein(t, Q.shape[3] - 1)
-    weights = [a * b for a in scalar_bernstein(s, Q.shape[2] - 1) for b in weights_v]
-    return weights @ Q[i, j].reshape(-1, 3)
+    weights_v = scalar_bernstein(t, degrees[1])
+    weights = [a * b for a in scalar_bernstein(s, degrees[0]) for b in weights_v]
+    return Q[i, j].dot(np.array(weights))

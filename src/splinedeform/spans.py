@@ -81,7 +81,16 @@ class SpanForm:
 def scalar_bernstein(s: float, degree: int) -> list[float]:
     """:func:`bernstein` of one parameter, as a list of ``m + 1`` floats."""
     t = 1.0 - s
-    return [c * s ** k * t ** (degree - k) for k, c in enumerate(_binomials(degree))]
+    out = _binomials(degree).copy()               # C(m,k) s^k (1-s)^{m-k}: the powers of t
+    power = 1.0                                   # from the right, those of s from the left
+    for k in range(degree, -1, -1):
+        out[k] *= power
+        power *= t
+    power = s
+    for k in range(1, degree + 1):
+        out[k] *= power
+        power *= s
+    return out
 
 
 def _binomials(m: int) -> list[float]:
