@@ -19,6 +19,11 @@ Three knot layouts are supported, all with ``m`` equal cells of width ``h = L/m`
 Function index ``j`` (0-based) of a uniform basis is Höllig's ``k = j - n``.
 On cell ``i`` the non-zero functions are ``j = i, ..., i + n`` (modulo ``m`` when
 periodic), so every evaluation returns ``n + 1`` values per parameter.
+
+Evaluation: each basis keeps the Bernstein coefficients of its non-zero functions on
+every cell (:mod:`splinedeform.spans`, found once from the Cox–de Boor recurrence of the
+knot vector); a parameter's values are then its cell's coefficients against the Bernstein
+polynomials of its local parameter ``s = x/h - i``, for all parameters at once.
 """
 
 from __future__ import annotations

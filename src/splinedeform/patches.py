@@ -12,8 +12,8 @@ with the per-span Bernstein coefficients ``β``, ``γ`` of the two bases
 functions of the spans. The patches ``Q`` are computed once per surface and order (they
 are a property of the immutable control net) and kept while they take at most
 :data:`MAX_PATCH_VALUES` numbers; an evaluation is then one contiguous gather of
-``(n_u+1)(n_v+1)`` points per parameter pair and two small contractions, or for a single
-pair a handful of float operations and two matrix products.
+``(n_u+1)(n_v+1)`` points per parameter pair and one small contraction, or for a single
+pair given as two floats a handful of float operations and one matrix-vector product.
 """
 
 from __future__ import annotations

@@ -25,7 +25,7 @@ of parameters, and plain floats for one.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from math import comb, factorial
 
 import numpy as np
@@ -46,7 +46,6 @@ class SpanForm:
 
     degree: int
     coefficients: tuple[Array, ...]
-    _lists: list = field(default_factory=list, repr=False, compare=False)
 
     def values(self, span: NDArray[np.int64], s: Array, max_derivative: int) -> Array:
         """``D^j N_{first+r}`` at local parameters ``s`` on spans ``span`` (both shape ``(N,)``).
@@ -66,16 +65,6 @@ class SpanForm:
                 np.einsum("prk,pk->pr", self.coefficients[j][span[block]],
                           bernstein(s[block], n - j), out=out[j, block])
         return out
-
-    def scalar_values(self, span: int, s: float, derivative: int) -> list[float]:
-        """:meth:`values` of one parameter and one order, as plain floats (no array overhead)."""
-        n = self.degree
-        if derivative > n:
-            return [0.0] * (n + 1)
-        if not self._lists:
-            self._lists.extend(c.tolist() for c in self.coefficients)
-        basis = scalar_bernstein(s, n - derivative)
-        return [sum(c * b for c, b in zip(row, basis)) for row in self._lists[derivative][span]]
 
 
 def scalar_bernstein(s: float, degree: int) -> list[float]:
