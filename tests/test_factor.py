@@ -73,3 +73,13 @@ def test_static_solve_uses_it_and_matches_a_dense_solve():
     d = model.static(load).d_free
     # as above: cond(K) · eps ≈ 1e-12, 1e-10 with margin
     np.testing.assert_allclose(d, expected, rtol=0, atol=1e-10 * np.abs(expected).max())
+
+
+def test_a_second_load_reuses_the_factorisation():
+    model = sd.Model(sd.shapes.plane(cells=(6, 6)), PLATE, boundary="clamped")
+    first = model.static(sd.Point(0.4, 0.3, (0.0, 0.0, -1.0))).d_free
+    kept = model._stiffness_factor
+    second = model.static(sd.Point(0.4, 0.3, (0.0, 0.0, -2.0))).d_free
+    assert model._stiffness_factor is kept
+    # linear in the load: twice the force, twice the displacement (to rounding)
+    np.testing.assert_allclose(second, 2 * first, rtol=0, atol=1e-13 * np.abs(second).max())

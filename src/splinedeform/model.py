@@ -219,7 +219,9 @@ class Model:
             raise SingularSystemError(message + f" ({self.rigid_modes} deformation(s) without "
                                       "energy, counted from the weights and the constraints)")
         try:
-            lu = factorise(self._K)            # once constrained K is SPD: a Cholesky
+            lu = getattr(self, "_stiffness_factor", None)
+            if lu is None:                     # once constrained K is SPD: a Cholesky,
+                lu = self._stiffness_factor = factorise(self._K)   # kept for further loads
             d = lu.solve(F)
         except RuntimeError:
             raise SingularSystemError(message) from None
