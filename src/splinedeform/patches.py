@@ -35,8 +35,10 @@ MAX_PATCH_VALUES = 8 * 2**20
 
 
 def patch_net(surface: Any, du: int, dv: int) -> Array | None:
-    """Patches ``Q^{du,dv}`` of ``surface``, shape ``(cells_u, cells_v, n_u+1-du, n_v+1-dv, 3)``.
+    """Patches ``Q^{du,dv}`` of ``surface``, shape ``(cells_u, cells_v, 3, K)``.
 
+    ``K = (n_u+1-du)(n_v+1-dv)``: the coefficients ``(k, l)`` of each coordinate side by
+    side, ``k``-major, so that a point is one product ``Q_ij w`` with ``w_kl = B_k(s) B_l(t)``.
     ``None`` where a basis has no polynomial span form (a rational basis), an order
     exceeds a degree (the derivative is zero), or the patches would be too large.
     """
@@ -51,48 +53,37 @@ def patch_net(surface: Any, du: int, dv: int) -> Array | None:
         if Cu.shape[0] * Cv.shape[0] * Cu.shape[2] * Cv.shape[2] * 3 <= MAX_PATCH_VALUES:
             P = surface.control_points
             along_v = np.einsum("jql,ujqc->ujlc", Cv, P[:, bv.span_functions()])
-            Q = np.einsum("irk,irjlc->ijklc", Cu, along_v[bu.span_functions()])
-            Q = np.ascontiguousarray(Q)
+            Q = np.einsum("irk,irjlc->ijckl", Cu, along_v[bu.span_functions()])
+            Q = np.ascontiguousarray(Q).reshape(Q.shape[:3] + (-1,))
             Q.setflags(write=False)
     surface._cache[key] = Q
     return Q
 
 
-def evaluate_patches(Q: Array, basis_u: Any, basis_v: Any, u: Array, v: Array) -> Array:
-    """``Σ_kl Q_{ij,kl} B_k(s) B_l(t)`` at flat parameter arrays ``u``, ``v``; shape ``(N, 3)``."""
+def evaluate_patches(Q: Array, degrees: tuple[int, int], basis_u: Any, basis_v: Any,
+                     u: Array, v: Array) -> Array:
+    """``Σ_kl Q_{ij,kl} B_k(s) B_l(t)`` at flat parameter arrays ``u``, ``v``; shape ``(N, 3)``.
+
+    ``degrees`` are those of the patches, ``(n_u - du, n_v - dv)``.
+    """
     span_u, s = basis_u.locate(u)
     span_v, t = basis_v.locate(v)
-    cells_v, ku, kv = Q.shape[1], Q.shape[2] - 1, Q.shape[3] - 1
-    flat = Q.reshape(Q.shape[0] * cells_v, (ku + 1) * (kv + 1), 3)
+    cells_v = Q.shape[1]
+    flat = Q.reshape((Q.shape[0] * cells_v,) + Q.shape[2:])        # (cells, 3, K)
     cell = span_u * cells_v + span_v
-    out = np.empty((u.size, 1, 3))
+    out = np.empty((u.size, 3))
     for start in range(0, u.size, PATCH_BLOCK):
         block = slice(start, start + PATCH_BLOCK)
-        weights = bernstein(s[block], ku)[:, :, None] * bernstein(t[block], kv)[:, None, :]
-        np.matmul(weights.reshape(-1, 1, (ku + 1) * (kv + 1)),
-                  np.take(flat, cell[block], axis=0), out=out[block])
-    return out[:, 0]
-
-
-def point_patches(surface: Any, du: int, dv: int) -> Array | None:
-    """:func:`patch_net` laid out for one point at a time: ``(cells_u, cells_v, 3, K)``.
-
-    ``K = (n_u+1-du)(n_v+1-dv)`` coefficients of each coordinate side by side, so one
-    point is a single matrix-vector product ``Q_ij w`` with ``w_kl = B_k(s) B_l(t)``.
-    """
-    key = ("point patches", du, dv)
-    if key not in surface._cache:
-        Q = patch_net(surface, du, dv)
-        if Q is not None:
-            Q = np.ascontiguousarray(Q.reshape(Q.shape[:2] + (-1, 3)).transpose(0, 1, 3, 2))
-            Q.setflags(write=False)
-        surface._cache[key] = Q
-    return surface._cache[key]
+        weights = (bernstein(s[block], degrees[0])[:, :, None]
+                   * bernstein(t[block], degrees[1])[:, None, :])    # (B, k, l)
+        np.einsum("pck,pk->pc", np.take(flat, cell[block], axis=0),
+                  weights.reshape(weights.shape[0], -1), out=out[block])
+    return out
 
 
 def evaluate_patch_point(Q: Array, degrees: tuple[int, int], basis_u: Any, basis_v: Any,
                          u: float, v: float) -> Array:
-    """One point ``Σ_kl Q_{ij,kl} B_k(s) B_l(t)`` from plain floats and :func:`point_patches`."""
+    """One point ``Σ_kl Q_{ij,kl} B_k(s) B_l(t)`` from plain floats; shape ``(3,)``."""
     i, s = basis_u.locate_scalar(u)
     j, t = basis_v.locate_scalar(v)
     weights_v = scalar_bernstein(t, degrees[1])

@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .basis import BSplineBasis
 from .deboor import BLOCK
-from .patches import evaluate_patch_point, evaluate_patches, patch_net, point_patches
+from .patches import evaluate_patch_point, evaluate_patches, patch_net
 from .errors import InputError
 from .knots import KnotVectorBasis, RationalBasis
 
@@ -25,7 +25,7 @@ Basis = BSplineBasis | KnotVectorBasis | RationalBasis
 
 
 _SCALARS = (float, int, np.float64)
-_POINTS = ("point patches", 0, 0)
+_POINTS = ("patches", 0, 0)
 
 
 def _order(order: object) -> bool:
@@ -139,16 +139,14 @@ class Surface:
         """
         Q = None
         if control_points is None and _order(du) and _order(dv):
-            if type(u) in _SCALARS and type(v) in _SCALARS:
-                point = point_patches(self, du, dv)
-                if point is not None:
-                    degrees = (self.basis_u.degree - du, self.basis_v.degree - dv)
-                    return evaluate_patch_point(point, degrees, self.basis_u, self.basis_v,
-                                                u, v)
             Q = patch_net(self, du, dv)
+        degrees = (self.basis_u.degree - du, self.basis_v.degree - dv)
+        if Q is not None and type(u) in _SCALARS and type(v) in _SCALARS:
+            return evaluate_patch_point(Q, degrees, self.basis_u, self.basis_v, u, v)
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
         if Q is not None:
-            points = evaluate_patches(Q, self.basis_u, self.basis_v, u.ravel(), v.ravel())
+            points = evaluate_patches(Q, degrees, self.basis_u, self.basis_v, u.ravel(),
+                                      v.ravel())
             return points.reshape(u.shape + (3,))
         P = self.control_points if control_points is None else np.asarray(control_points, float)
         uf, vf = u.ravel(), v.ravel()
