@@ -74,10 +74,11 @@ def evaluate_patches(Q: Array, degrees: tuple[int, int], basis_u: Any, basis_v: 
     out = np.empty((u.size, 3))
     for start in range(0, u.size, PATCH_BLOCK):
         block = slice(start, start + PATCH_BLOCK)
-        weights = (bernstein(s[block], degrees[0])[:, :, None]
-                   * bernstein(t[block], degrees[1])[:, None, :])    # (B, k, l)
+        # w_kl = B_k(s) B_l(t) formed with the points last (contiguous), then one transpose
+        weights = (bernstein(s[block], degrees[0])[:, None, :]
+                   * bernstein(t[block], degrees[1])[None, :, :])        # (k, l, B)
         np.einsum("pck,pk->pc", np.take(flat, cell[block], axis=0),
-                  weights.reshape(weights.shape[0], -1), out=out[block])
+                  np.ascontiguousarray(weights.reshape(-1, weights.shape[2]).T), out=out[block])
     return out
 
 

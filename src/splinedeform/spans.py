@@ -56,13 +56,13 @@ class SpanForm:
         n = self.degree
         top = min(max_derivative, n)
         if s.size <= BLOCK and max_derivative == 0:             # the common case, one product
-            return np.einsum("prk,pk->pr", self.coefficients[0][span], bernstein(s, n))[None]
+            return np.einsum("prk,kp->pr", self.coefficients[0][span], bernstein(s, n))[None]
         out = np.zeros((max_derivative + 1, s.size, n + 1))
         for start in range(0, s.size, BLOCK):
             block = slice(start, start + BLOCK)
             for j in range(top + 1):
                 # Σ_k β^{(j)}_{r,k} B_{k,n-j}(s): gathered coefficients against Bernstein values
-                np.einsum("prk,pk->pr", self.coefficients[j][span[block]],
+                np.einsum("prk,kp->pr", self.coefficients[j][span[block]],
                           bernstein(s[block], n - j), out=out[j, block])
         return out
 
@@ -87,27 +87,30 @@ def _binomials(m: int) -> list[float]:
 
 
 _BINOMIALS = [[float(comb(m, k)) for k in range(m + 1)] for m in range(16)]
-_TO_BERNSTEIN: list[Array] = []
 
 
 def bernstein(s: Array, degree: int) -> Array:
-    """Bernstein polynomials ``B_{k,m}(s) = C(m,k) s^k (1-s)^{m-k}``, shape ``(N, m+1)``.
+    """Bernstein polynomials ``B_{k,m}(s) = C(m,k) s^k (1-s)^{m-k}``, shape ``(m+1, N)``.
 
-    As powers times the integer matrix ``C_{jk} = (-1)^{j-k} C(m,k) C(m-k, j-k)`` (one
-    matrix product): at ``s = 0`` and ``s = 1`` every product is exact, so the values at
-    knots are exact; elsewhere the cancellation costs at most ``2^m`` roundings.
+    Products of the powers of ``s`` and ``1 - s``: no cancellation, and exact where
+    ``s`` is 0 or 1 (at knots).
     """
-    return np.vander(s, degree + 1, increasing=True) @ _power_to_bernstein(degree)
-
-
-def _power_to_bernstein(m: int) -> Array:
-    if m >= len(_TO_BERNSTEIN):
-        return np.array([[(-1) ** (j - k) * comb(m, k) * comb(m - k, j - k) if j >= k else 0
-                          for k in range(m + 1)] for j in range(m + 1)], dtype=float)
-    return _TO_BERNSTEIN[m]
-
-
-_TO_BERNSTEIN.extend(_power_to_bernstein(m) for m in range(16))
+    m = degree
+    t = 1.0 - s
+    powers_s, powers_t = [s], [t]
+    for _ in range(m - 1):
+        powers_s.append(powers_s[-1] * s)
+        powers_t.append(powers_t[-1] * t)
+    out = np.empty((m + 1, s.size))
+    if m == 0:
+        out[0] = 1.0
+        return out
+    out[0] = powers_t[m - 1]
+    out[m] = powers_s[m - 1]
+    for k in range(1, m):
+        np.multiply(powers_s[k - 1], powers_t[m - k - 1], out=out[k])
+        out[k] *= comb(m, k)
+    return out
 
 
 def span_form(left: Array, right: Array, widths: Array, degree: int) -> SpanForm:
