@@ -99,3 +99,19 @@ def test_one_point_outside_the_domain_or_not_finite_is_refused():
     np.testing.assert_array_equal(s.evaluate(2.0 + 1e-15, 0.5), s.evaluate(2.0, 0.5))
     with pytest.raises(InputError, match="derivative order"):
         s.derivative(0.5, 0.5, -1, 0)
+
+
+def test_patches_are_built_once_as_many_points_as_cells_were_asked_for():
+    """One point on a new surface goes the direct way; the patches come with enough points."""
+    s = surface_on(BSplineBasis(3, 6, 2.0, "open"), BSplineBasis(2, 5, 1.0, "open"))
+    spline = reference(s)
+    direct = s.evaluate(0.3, 0.7)
+    assert ("patches", 0, 0) not in s._cache                 # a single point builds nothing
+    u = np.linspace(0.0, 2.0, 29)                            # 29 + 1 = 30 = 6 x 5 cells
+    s.evaluate(u, np.full_like(u, 0.4))
+    assert s._cache[("patches", 0, 0)] is not None
+    by_patches = s.evaluate(0.3, 0.7)
+    scale = np.abs(s.control_points).max()
+    # two summation orders of the same O((n+1)²) terms, and scipy's: 1e-13 of the net's size
+    np.testing.assert_allclose(by_patches, direct, rtol=0, atol=1e-13 * scale)
+    np.testing.assert_allclose(direct, spline([0.3, 0.7]), rtol=0, atol=1e-13 * scale)

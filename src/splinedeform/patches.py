@@ -10,7 +10,8 @@ surface and its derivatives are tensor-product Bernstein polynomials:
 with the per-span Bernstein coefficients ``β``, ``γ`` of the two bases
 (:mod:`splinedeform.spans`; derivative factors included) and ``f_i``, ``g_j`` the first
 functions of the spans. The patches ``Q`` are computed once per surface and order (they
-are a property of the immutable control net) and kept while they take at most
+are a property of the immutable control net), once the surface has been asked for as many
+points as it has cells (:func:`patches_when_worth`), and kept while they take at most
 :data:`MAX_PATCH_VALUES` numbers; an evaluation is then one contiguous gather of
 ``(n_u+1)(n_v+1)`` points per parameter pair and one small contraction, or for a single
 pair given as two floats a handful of float operations and one matrix-vector product.
@@ -58,6 +59,24 @@ def patch_net(surface: Any, du: int, dv: int) -> Array | None:
             Q.setflags(write=False)
     surface._cache[key] = Q
     return Q
+
+
+def patches_when_worth(surface: Any, du: int, dv: int, count: int) -> Array | None:
+    """:func:`patch_net` once the surface has been asked for as many points as it has cells.
+
+    Computing the patches costs about as much as evaluating one point per cell the direct
+    way, so they are computed once ``count`` points (summed over the calls of one order)
+    reach the number of cells: a single point on a new surface (``sol.surface(t).evaluate(u,
+    v)``) never pays for them, and many points pay at most about twice the direct cost.
+    """
+    key = ("patches", du, dv)
+    if key in surface._cache:
+        return surface._cache[key]
+    seen = surface._cache.get(("points", du, dv), 0) + count
+    surface._cache[("points", du, dv)] = seen
+    if seen < surface.basis_u.cells * surface.basis_v.cells:
+        return None
+    return patch_net(surface, du, dv)
 
 
 def evaluate_patches(Q: Array, degrees: tuple[int, int], basis_u: Any, basis_v: Any,

@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .basis import BSplineBasis
 from .deboor import BLOCK
-from .patches import evaluate_patch_point, evaluate_patches, patch_net
+from .patches import evaluate_patch_point, evaluate_patches, patches_when_worth
 from .errors import InputError
 from .knots import KnotVectorBasis, RationalBasis
 
@@ -134,12 +134,14 @@ class Surface:
         ``control_points`` evaluates another net (e.g. a displacement) on the same bases.
 
         The surface's own net is evaluated from its Bézier patches (:mod:`splinedeform.patches`,
-        computed at the first call per order), another net by the sum over the ``(n+1)²``
-        control points of each parameter's cell, ``Σ_r Σ_s D^du b_r(u) D^dv b_s(v) p_rs``.
+        computed once it has been asked for as many points as it has cells); until then, and
+        for another net, by the sum over the ``(n+1)²`` control points of each parameter's
+        cell, ``Σ_r Σ_s D^du b_r(u) D^dv b_s(v) p_rs``.
         """
         Q = None
         if control_points is None and _order(du) and _order(dv):
-            Q = patch_net(self, du, dv)
+            one = type(u) in _SCALARS and type(v) in _SCALARS
+            Q = patches_when_worth(self, du, dv, 1 if one else np.broadcast(u, v).size)
         degrees = (self.basis_u.degree - du, self.basis_v.degree - dv)
         if Q is not None and type(u) in _SCALARS and type(v) in _SCALARS:
             return evaluate_patch_point(Q, degrees, self.basis_u, self.basis_v, u, v)
