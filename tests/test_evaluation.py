@@ -115,3 +115,27 @@ def test_patches_are_built_once_as_many_points_as_cells_were_asked_for():
     # two summation orders of the same O((n+1)²) terms, and scipy's: 1e-13 of the net's size
     np.testing.assert_allclose(by_patches, direct, rtol=0, atol=1e-13 * scale)
     np.testing.assert_allclose(direct, spline([0.3, 0.7]), rtol=0, atol=1e-13 * scale)
+
+
+@pytest.mark.parametrize("name", SURFACES)
+def test_one_point_on_a_new_surface_equals_ndbspline_for_every_order(name):
+    """The direct way (no patches yet): the cell's (n+1)² control points, every order."""
+    bu, bv = SURFACES[name]
+    for du, dv in ORDERS:
+        s = surface_on(bu, bv, seed=7)                       # new: no patches
+        expected = reference(s)([0.37, 0.61], nu=(du, dv))
+        got = s.derivative(0.37, 0.61, du, dv)
+        assert ("patches", du, dv) not in s._cache
+        # 1e-13 of the order's scale (the net's size times the basis derivatives' scale)
+        scale = max(np.abs(expected).max(), np.abs(s.control_points).max())
+        np.testing.assert_allclose(got, expected, rtol=0, atol=1e-13 * scale)
+
+
+def test_one_point_on_a_new_periodic_surface_equals_the_array_path():
+    s = surface_on(BSplineBasis(3, 6, 2.0, "open"), BSplineBasis(3, 5, 1.0, "periodic"), 4)
+    for du, dv in ORDERS:
+        by_sum = s.derivative(np.array([1.3]), np.array([2.9]), du, dv,
+                              control_points=s.control_points)[0]
+        fresh = s.with_control_points(s.control_points)
+        np.testing.assert_allclose(fresh.derivative(1.3, 2.9, du, dv), by_sum, rtol=0,
+                                   atol=1e-13 * max(np.abs(by_sum).max(), 1.0))

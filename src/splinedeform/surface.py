@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from .basis import BSplineBasis
 from .deboor import BLOCK
 from .patches import evaluate_patch_point, evaluate_patches, patches_when_worth
+from .spans import scalar_bernstein
 from .errors import InputError
 from .knots import KnotVectorBasis, RationalBasis
 
@@ -26,6 +27,25 @@ Basis = BSplineBasis | KnotVectorBasis | RationalBasis
 
 _SCALARS = (float, int, np.float64)
 _POINTS = ("patches", 0, 0)
+
+
+def _has_span_form(basis: Basis) -> bool:
+    return getattr(basis, "form", None) is not None
+
+
+def span_values(basis: Basis, span: int, s: float, derivative: int) -> NDArray[np.float64]:
+    """``D^j`` of the ``n + 1`` functions of one span at local parameter ``s`` (a float)."""
+    return basis.form.coefficients[derivative][span] @ np.array(
+        scalar_bernstein(s, basis.degree - derivative))
+
+
+def span_indices(basis: Basis, span: int) -> NDArray[np.int64]:
+    """Indices of the ``n + 1`` functions not vanishing on one span."""
+    n = basis.degree
+    if basis.kind == "periodic":
+        return (span - n + np.arange(n + 1)) % basis.cells
+    first = basis.first[span] if basis.kind == "general" else span
+    return first + np.arange(n + 1)
 
 
 def _order(order: object) -> bool:
@@ -139,12 +159,16 @@ class Surface:
         cell, ``Σ_r Σ_s D^du b_r(u) D^dv b_s(v) p_rs``.
         """
         Q = None
-        if control_points is None and _order(du) and _order(dv):
-            one = type(u) in _SCALARS and type(v) in _SCALARS
+        own = control_points is None and _order(du) and _order(dv)
+        one = type(u) in _SCALARS and type(v) in _SCALARS
+        if own:
             Q = patches_when_worth(self, du, dv, 1 if one else np.broadcast(u, v).size)
         degrees = (self.basis_u.degree - du, self.basis_v.degree - dv)
-        if Q is not None and type(u) in _SCALARS and type(v) in _SCALARS:
-            return evaluate_patch_point(Q, degrees, self.basis_u, self.basis_v, u, v)
+        if own and one:
+            if Q is not None:
+                return evaluate_patch_point(Q, degrees, self.basis_u, self.basis_v, u, v)
+            if _has_span_form(self.basis_u) and _has_span_form(self.basis_v) and min(degrees) >= 0:
+                return self._direct_point(u, v, du, dv)
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
         if Q is not None:
             points = evaluate_patches(Q, degrees, self.basis_u, self.basis_v, u.ravel(),
@@ -165,6 +189,16 @@ class Surface:
             weights = (bu[:, :, None] * bv[:, None, :]).reshape(count, -1)
             np.einsum("pk,pkc->pc", weights, flat[index], out=out[block])
         return out.reshape(u.shape + P.shape[2:])
+
+    def _direct_point(self, u: float, v: float, du: int, dv: int) -> NDArray[np.float64]:
+        """One point by the ``(n+1)²`` control points of its cell, from plain floats."""
+        i, s = self.basis_u.locate_scalar(u)
+        j, t = self.basis_v.locate_scalar(v)
+        bu = span_values(self.basis_u, i, s, du)
+        bv = span_values(self.basis_v, j, t, dv)
+        net = self.control_points[np.ix_(span_indices(self.basis_u, i),
+                                         span_indices(self.basis_v, j))]   # (n+1, n+1, 3)
+        return bu @ (bv @ net)
 
     def evaluate(self, u: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
         """Points ``x(u, v)``; ``u`` and ``v`` broadcast to ``S``, result ``S + (3,)``."""
