@@ -83,3 +83,9 @@ def test_a_second_load_reuses_the_factorisation():
     assert model._stiffness_factor is kept
     # linear in the load: twice the force, twice the displacement (to rounding)
     np.testing.assert_allclose(second, 2 * first, rtol=0, atol=1e-13 * np.abs(second).max())
+
+
+def test_cholmod_without_scikit_sparse_says_how_to_get_it(monkeypatch):
+    monkeypatch.setattr(factor, "_cholmod", lambda: None)
+    with pytest.raises(InputError, match="scikit-sparse"):
+        factorise(plate_stiffness(), "cholmod")

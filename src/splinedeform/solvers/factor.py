@@ -18,8 +18,9 @@ the bench plate (docs/cost.md, "where the time goes"):
     ``SymmetricMode``. The default column ordering (``COLAMD``) ignores the symmetry and
     fills in several times more. The fallback for any matrix.
 ``"cholmod"``
-    CHOLMOD's supernodal Cholesky (scikit-sparse, the ``cholmod`` extra); used by
-    ``"auto"`` only where it is installed and the band is too wide.
+    CHOLMOD's supernodal Cholesky (scikit-sparse, not a dependency: it has no wheel and
+    builds only against a SuiteSparse installation); used by ``"auto"`` only where it is
+    installed and the band is too wide.
 
 ``factorise(K)`` returns an object with ``solve(b)`` for ``b`` of shape ``(N,)`` or
 ``(N, k)`` and the name of the method used.
@@ -93,9 +94,9 @@ def factorise(K: sp.spmatrix, method: str = "auto") -> Factorisation:
         if method == "cholmod":
             module = _cholmod()
             if module is None:
-                raise InputError("factorisation 'cholmod' needs scikit-sparse "
-                                 "(pip install 'splinedeform[cholmod]', which builds against "
-                                 "the SuiteSparse headers, e.g. Debian's libsuitesparse-dev)")
+                raise InputError("factorisation 'cholmod' needs scikit-sparse, which is not "
+                                 "installed (it builds from source against SuiteSparse: e.g. "
+                                 "Debian's libsuitesparse-dev with scikit-sparse 0.4.16)")
             factor = module.cholesky(sp.csc_matrix(K))
             return Factorisation("cholmod", factor)
     except np.linalg.LinAlgError:
