@@ -21,7 +21,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
-from .assembly import _largest, mass, stiffness  # noqa: F401 (public here too)
+from .assembly import (_largest, full_matrices, mass, reduced_matrices,  # noqa: F401
+                       stiffness)
 from .boundary import Constraints, build_constraints
 from .errors import InputError, SingularSystemError
 from .loads import Load, as_load, static_time
@@ -33,6 +34,7 @@ from .modal_solve import check_count as _check_count
 from .solution import ModalSolution, Readout, SampledSolution, StaticSolution
 from . import spectrum
 from .solvers import modal_basis, numeric
+from .solvers.factor import factorise
 from .solvers.forcing import ReducedForcing
 from .solvers.system import KroneckerFactors, Reduction
 from .surface import Surface
@@ -130,12 +132,12 @@ class Model:
         if physics == "intrinsic":
             K, M = intrinsic.matrices(surface, material, mass_matrix == "lumped")
         else:
-            K = stiffness(self.gram_u, self.gram_v, material)
-            M = mass(self.gram_u, self.gram_v, material.mass, mass_matrix == "lumped")
+            K, M = full_matrices(self.gram_u, self.gram_v, material, mass_matrix == "lumped")
         T = self.constraints.T
         self.K_full, self.M_full = K, M
-        self._K = (T.T @ K @ T).tocsc()
-        self._M = (T.T @ M @ T).tocsc()
+        reduced = None if physics == "intrinsic" else reduced_matrices(
+            self.gram_u, self.gram_v, material, mass_matrix == "lumped", M, self.constraints)
+        self._K, self._M = reduced or ((T.T @ K @ T).tocsc(), (T.T @ M @ T).tocsc())
         if self._M.nnz:
             check_scales(material, _largest(self._K), _largest(self._M))
         self._C = ((material.damping / material.mass) * self._M
@@ -217,7 +219,9 @@ class Model:
             raise SingularSystemError(message + f" ({self.rigid_modes} deformation(s) without "
                                       "energy, counted from the weights and the constraints)")
         try:
-            lu = spla.splu(self._K)
+            lu = getattr(self, "_stiffness_factor", None)
+            if lu is None:                     # once constrained K is SPD: a Cholesky,
+                lu = self._stiffness_factor = factorise(self._K)   # kept for further loads
             d = lu.solve(F)
         except RuntimeError:
             raise SingularSystemError(message) from None
