@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterator
 
+from ._progress import reporting_simulated_time
 from .budget import Budget, check as check_budget
 from .errors import InputError
 from .outputs import make_report, planned_outputs, summary_rows, write_outputs
@@ -78,6 +79,12 @@ class _Stages:
         self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - start
         self.tick(name, 1, 1)
 
+    def simulated(self, name: str) -> Any:
+        """A block in which the integrators' simulated time goes to the bar of ``name``
+        (when the progress callback draws it: a ``receiver(stage)`` method)."""
+        receiver = getattr(self.progress, "receiver", None)
+        return reporting_simulated_time(receiver(name) if callable(receiver) else None)
+
 
 def run(scenario: Scenario, outdir: str | Path | None = None,
         progress: ProgressCallback | None = None, budget: Budget | None = None) -> RunResult:
@@ -142,7 +149,7 @@ def _solve(scenario: Scenario, built: Built, stages: _Stages) -> RunResult:
     solution, omegas, shapes = None, None, None
     times = np.asarray(solve.frame_times() if solve.kind == "dynamic"
                        else np.linspace(0.0, 1.0, solve.frames))
-    with stages.stage("solve"), _located(scenario, "solve"):
+    with stages.stage("solve"), _located(scenario, "solve"), stages.simulated("solve"):
         if solve.kind == "static":
             solution = model.static(built.load)
         elif solve.kind == "dynamic":
