@@ -5,6 +5,8 @@ command-line overrides, draws progress bars (stderr) and prints a closing summar
 (stdout). Bad input (:class:`~splinedeform.errors.InputError`, which includes
 :class:`~splinedeform.errors.ScenarioError`) prints its message on stderr and exits with
 code 2, without a traceback unless ``--debug``; any other failure exits with code 1.
+Ctrl-C during a run prints one line (where it stopped, what it left incomplete) and exits
+with code 130.
 """
 
 from __future__ import annotations
@@ -25,6 +27,8 @@ from .errors import InputError
 
 EXIT_INPUT_ERROR = 2
 EXIT_INTERNAL_ERROR = 1
+#: exit status after Ctrl-C (128 + SIGINT), as shells report it
+EXIT_INTERRUPTED = 130
 
 #: optional modules reported by ``splinedeform info``: import name -> (distribution, use)
 OPTIONAL = {
@@ -164,12 +168,16 @@ def _run(scenario: Any, outdir: Path, quiet: bool, budget: str | None = None) ->
     """Run a validated scenario with progress bars and print the summary table."""
     from ._progress import StageProgress
     from .budget import Budget
-    from .pipeline import run, summary_rows
+    from .pipeline import RunInterrupted, run, summary_rows
 
     limits = Budget.parse(budget) if budget is not None else None
     out, err = _consoles()
-    with StageProgress(err, enabled=not quiet) as progress:
-        result = run(scenario, outdir, progress=progress, budget=limits)
+    try:
+        with StageProgress(err, enabled=not quiet) as progress:
+            result = run(scenario, outdir, progress=progress, budget=limits)
+    except RunInterrupted as exc:          # Ctrl-C: one line, not a traceback
+        err.print(_escape(str(exc)), style="bold yellow", highlight=False, soft_wrap=True)
+        raise typer.Exit(EXIT_INTERRUPTED) from None
     if not quiet:
         out.print(_table(f"splinedeform: {scenario.title or scenario.name}",
                          summary_rows(result)))

@@ -23,6 +23,11 @@ from .scenario import Built, Scenario, SolveSpec, _located, build
 ProgressCallback = Callable[[str, int, int], None]
 
 
+class RunInterrupted(KeyboardInterrupt):
+    """A run stopped by Ctrl-C (SIGINT); ``str()`` is one line saying where it stopped, what
+    it left incomplete and that re-running the same command cleans it up."""
+
+
 @dataclass
 class RunResult:
     """Everything a run produced; the command line prints :func:`summary_rows` of it.
@@ -66,8 +71,10 @@ class _Stages:
     def __init__(self, progress: ProgressCallback | None) -> None:
         self.progress = progress
         self.timings: dict[str, float] = {}
+        self.current = "start"
 
     def tick(self, stage: str, done: int, total: int) -> None:
+        self.current = stage
         if self.progress is not None:
             self.progress(stage, done, total)
 
@@ -105,15 +112,30 @@ def run(scenario: Scenario, outdir: str | Path | None = None,
     stages = _Stages(progress)
     formats = scenario.output.formats
     folder = _prepare_outdir(scenario, outdir) if formats else None
-    with stages.stage("build"):
-        built = build(scenario)
-        check_budget(scenario, built.model, budget)
-    result = _solve(scenario, built, stages)
-    result.timings = stages.timings
-    if folder is not None:
-        write_outputs(result, folder, stages)
+    try:
+        with stages.stage("build"):
+            built = build(scenario)
+            check_budget(scenario, built.model, budget)
+        result = _solve(scenario, built, stages)
+        result.timings = stages.timings
+        if folder is not None:
+            write_outputs(result, folder, stages)
+    except KeyboardInterrupt:
+        raise RunInterrupted(_interrupted(scenario, folder, stages.current)) from None
     result.timings = dict(stages.timings)
     return result
+
+
+def _interrupted(scenario: Scenario, folder: Path | None, stage: str) -> str:
+    """The line said when Ctrl-C stops a run during ``stage``."""
+    from .export.run_folder import incomplete_note
+
+    note = incomplete_note(folder, scenario.name) if folder is not None else None
+    if note is not None:
+        return (f"interrupted during {stage}: {note}; run the same command again to clean "
+                "it up and write the whole set")
+    where = f" in {folder}" if folder is not None else ""
+    return f"interrupted during {stage}: no output of this run was written{where}"
 
 
 def _prepare_outdir(scenario: Scenario, outdir: str | Path | None) -> Path:
