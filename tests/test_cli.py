@@ -229,6 +229,12 @@ def test_bench_is_forwarded_when_the_module_exists(monkeypatch, tmp_path):
                                            str(tmp_path), "--quiet"])
         assert result.exit_code == 0, result.output
         assert calls == [([4, 8], True, tmp_path, True)]
+        plain = runner.invoke(fresh.app, ["bench", "--quick"])
+        assert plain.exit_code == 0, plain.output
+        assert "BLAS threads" not in plain.output              # bench.main says it, once
+        assert calls[-1][2] == fresh.BENCH_OUTDIR == Path("out", "bench")
+        ignored = (Path(__file__).resolve().parents[1] / ".gitignore").read_text().split()
+        assert "out/" in ignored                     # the default folder is git-ignored
         bad = runner.invoke(fresh.app, ["bench", "--sizes", "4,x"])
         assert bad.exit_code == 2 and "--sizes must be comma-separated integers" in bad.stderr
     finally:

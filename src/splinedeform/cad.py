@@ -61,6 +61,19 @@ class NurbsPatch:
         if np.any(np.asarray(self.weights) <= 0):
             raise InputError("NURBS weights must be > 0")
 
+    def __repr__(self) -> str:
+        """One line: net size, degrees, knot counts, domain, weights (never the arrays)."""
+        shape = np.shape(self.weights)
+        spans = []
+        for n, knots in zip(self.degrees, (self.knots_u, self.knots_v)):
+            t = np.asarray(knots, dtype=float).ravel()
+            spans.append(f"[{t[n]:.6g}, {t[t.size - n - 1]:.6g}]")
+        w = np.asarray(self.weights, dtype=float)
+        rational = "equal weights" if np.ptp(w) <= WEIGHT_TOL * np.abs(w).max() else "rational"
+        return (f"NurbsPatch({shape[0]}×{shape[1]} control points, degree={tuple(self.degrees)}, "
+                f"knots=(knot vector of {np.size(self.knots_u)}, knot vector of "
+                f"{np.size(self.knots_v)}), domain={spans[0]} × {spans[1]}, {rational})")
+
     def evaluate(self, u: NDArray[np.float64], v: NDArray[np.float64]) -> NDArray[np.float64]:
         """``S(u_a, v_b)`` on the grid ``u × v``, shape ``(len(u), len(v), 3)``."""
         Bu = KnotVectorBasis(self.degrees[0], self.knots_u)(u)

@@ -5,6 +5,8 @@ command-line overrides, draws progress bars (stderr) and prints a closing summar
 (stdout). Bad input (:class:`~splinedeform.errors.InputError`, which includes
 :class:`~splinedeform.errors.ScenarioError`) prints its message on stderr and exits with
 code 2, without a traceback unless ``--debug``; any other failure exits with code 1.
+Ctrl-C during a run prints one line (where it stopped, what it left incomplete) and exits
+with code 130.
 """
 
 from __future__ import annotations
@@ -26,6 +28,8 @@ from .errors import InputError
 
 EXIT_INPUT_ERROR = 2
 EXIT_INTERNAL_ERROR = 1
+#: exit status after Ctrl-C (128 + SIGINT), as shells report it
+EXIT_INTERRUPTED = 130
 
 #: optional modules reported by ``splinedeform info``: import name -> (distribution, use)
 OPTIONAL = {
@@ -185,12 +189,16 @@ def _run(scenario: Any, outdir: Path, quiet: bool, budget: str | None = None) ->
     """Run a validated scenario with progress bars and print the summary table."""
     from ._progress import StageProgress
     from .budget import Budget
-    from .pipeline import run, summary_rows
+    from .pipeline import RunInterrupted, run, summary_rows
 
     limits = Budget.parse(budget) if budget is not None else None
     out, err = _consoles()
-    with StageProgress(err, enabled=not quiet) as progress:
-        result = run(scenario, outdir, progress=progress, budget=limits)
+    try:
+        with StageProgress(err, enabled=not quiet) as progress:
+            result = run(scenario, outdir, progress=progress, budget=limits)
+    except RunInterrupted as exc:          # Ctrl-C: one line, not a traceback
+        err.print(_escape(str(exc)), style="bold yellow", highlight=False, soft_wrap=True)
+        raise typer.Exit(EXIT_INTERRUPTED) from None
     if not quiet:
         out.print(_table(f"splinedeform: {scenario.title or scenario.name}",
                          summary_rows(result)))
@@ -322,6 +330,10 @@ def info_command() -> None:
     out.print(_table("optional packages", _optional_rows()))
 
 
+#: default folder of ``splinedeform bench`` (``out/`` is git-ignored in a source checkout)
+BENCH_OUTDIR = Path("out") / "bench"
+
+
 def _register_bench() -> None:
     """Add ``splinedeform bench`` when the cost study module is installed."""
     try:
@@ -334,16 +346,16 @@ def _register_bench() -> None:
     @app.command("bench")
     def bench_command(sizes: Optional[str] = typer.Option(
                           None, "--sizes", help="Comma-separated net sizes, e.g. 8,16,32."),
-                      quick: bool = typer.Option(False, "--quick", help="A short run."),
-                      outdir: Path = typer.Option(Path("bench-output"), "-o", "--outdir",
-                                                  help="Output folder."),
+                      quick: bool = typer.Option(
+                          False, "--quick", help="A smoke run of a few seconds: nets of 3×3 "
+                                                 "and 4×4 cells, target 1e-3, regime a only."),
+                      outdir: Path = typer.Option(BENCH_OUTDIR, "-o", "--outdir",
+                                                  help="Output folder (created if missing)."),
                       quiet: bool = QUIET_OPT, debug: bool = DEBUG_OPT) -> None:
         """Cost study: analytic against numerical solvers, cost against net size."""
-        from . import bench, bench_goals
+        from . import bench
 
-        with _reported_errors(debug), bench_goals.blas_threads(1) as threads:
-            if not quiet:
-                typer.echo(threads)
+        with _reported_errors(debug):              # bench.main limits the BLAS threads
             parsed = None
             if sizes is not None:
                 try:

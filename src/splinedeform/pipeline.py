@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterator
 
+from ._progress import reporting_simulated_time
 from .budget import Budget, check as check_budget
 from .errors import InputError
 from .outputs import make_report, planned_outputs, summary_rows, write_outputs
@@ -20,6 +21,11 @@ from .scenario import Built, Scenario, SolveSpec, _located, build
 
 #: ``progress(stage, done, total)``, called as each stage advances
 ProgressCallback = Callable[[str, int, int], None]
+
+
+class RunInterrupted(KeyboardInterrupt):
+    """A run stopped by Ctrl-C (SIGINT); ``str()`` is one line saying where it stopped, what
+    it left incomplete and that re-running the same command cleans it up."""
 
 
 @dataclass
@@ -68,8 +74,10 @@ class _Stages:
     def __init__(self, progress: ProgressCallback | None) -> None:
         self.progress = progress
         self.timings: dict[str, float] = {}
+        self.current = "start"
 
     def tick(self, stage: str, done: int, total: int) -> None:
+        self.current = stage
         if self.progress is not None:
             self.progress(stage, done, total)
 
@@ -80,6 +88,12 @@ class _Stages:
         yield
         self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - start
         self.tick(name, 1, 1)
+
+    def simulated(self, name: str) -> Any:
+        """A block in which the integrators' simulated time goes to the bar of ``name``
+        (when the progress callback draws it: a ``receiver(stage)`` method)."""
+        receiver = getattr(self.progress, "receiver", None)
+        return reporting_simulated_time(receiver(name) if callable(receiver) else None)
 
 
 def run(scenario: Scenario, outdir: str | Path | None = None,
@@ -101,15 +115,30 @@ def run(scenario: Scenario, outdir: str | Path | None = None,
     stages = _Stages(progress)
     formats = scenario.output.formats
     folder = _prepare_outdir(scenario, outdir) if formats else None
-    with stages.stage("build"):
-        built = build(scenario)
-        check_budget(scenario, built.model, budget)
-    result = _solve(scenario, built, stages)
-    result.timings = stages.timings
-    if folder is not None:
-        write_outputs(result, folder, stages)
+    try:
+        with stages.stage("build"):
+            built = build(scenario)
+            check_budget(scenario, built.model, budget)
+        result = _solve(scenario, built, stages)
+        result.timings = stages.timings
+        if folder is not None:
+            write_outputs(result, folder, stages)
+    except KeyboardInterrupt:
+        raise RunInterrupted(_interrupted(scenario, folder, stages.current)) from None
     result.timings = dict(stages.timings)
     return result
+
+
+def _interrupted(scenario: Scenario, folder: Path | None, stage: str) -> str:
+    """The line said when Ctrl-C stops a run during ``stage``."""
+    from .export.run_folder import incomplete_note
+
+    note = incomplete_note(folder, scenario.name) if folder is not None else None
+    if note is not None:
+        return (f"interrupted during {stage}: {note}; run the same command again to clean "
+                "it up and write the whole set")
+    where = f" in {folder}" if folder is not None else ""
+    return f"interrupted during {stage}: no output of this run was written{where}"
 
 
 def _prepare_outdir(scenario: Scenario, outdir: str | Path | None) -> Path:
@@ -145,7 +174,7 @@ def _solve(scenario: Scenario, built: Built, stages: _Stages) -> RunResult:
     solution, omegas, shapes = None, None, None
     times = np.asarray(solve.frame_times() if solve.kind == "dynamic"
                        else np.linspace(0.0, 1.0, solve.frames))
-    with stages.stage("solve"), _located(scenario, "solve"):
+    with stages.stage("solve"), _located(scenario, "solve"), stages.simulated("solve"):
         if solve.kind == "static":
             solution = model.static(built.load)
         elif solve.kind == "dynamic":

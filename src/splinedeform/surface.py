@@ -105,6 +105,15 @@ class Surface:
         P.setflags(write=False)
         object.__setattr__(self, "control_points", P)
 
+    def __repr__(self) -> str:
+        """One line: name, net size, degrees, knot layouts, domain (never the net itself)."""
+        (_, lu), (_, lv) = self.domain
+        fit = "" if self.fit_error is None else f", fit_error={self.fit_error:.3g}"
+        return (f"Surface({self.name!r}, {self.shape[0]}×{self.shape[1]} control points, "
+                f"degree=({self.basis_u.degree}, {self.basis_v.degree}), "
+                f"knots=({knots_summary(self.basis_u)}, {knots_summary(self.basis_v)}), "
+                f"domain=[0, {lu:.6g}] × [0, {lv:.6g}]{fit})")
+
     # -- layout ---------------------------------------------------------------
     @property
     def shape(self) -> tuple[int, int]:
@@ -270,6 +279,16 @@ def _collocation(basis: Basis, x: ArrayLike, derivative: int) -> sp.csr_array:
     width = index.shape[-1]
     indptr = np.arange(0, x.size * width + 1, width)
     return sp.csr_array((values.ravel(), index.ravel(), indptr), shape=(x.size, basis.size))
+
+
+def knots_summary(basis: Basis) -> str:
+    """A basis's knots in a few words: ``'open' 4 cells``, ``knot vector of 11``, or
+    ``rational`` before either."""
+    if isinstance(basis, RationalBasis):
+        return f"rational {knots_summary(basis.basis)}"
+    if isinstance(basis, KnotVectorBasis):
+        return f"knot vector of {np.size(basis.knots)}"
+    return f"{basis.kind!r} {basis.cells} cells"
 
 
 def grid_faces(ru: int, rv: int) -> NDArray[np.int64]:

@@ -58,9 +58,9 @@ def main(sizes: Sequence[int] | None = None, quick: bool = False,
 
     Parameters
     ----------
-    sizes : cells per direction (default 8, 16, 32, 64, 128; quick: 4, 6).
-    quick : a short smoke run (:data:`QUICK`: 4×4 and 6×6 nets, 20 frames, target 1e-4,
-        5 s budget, no regimes b–e, no goals at scale).
+    sizes : cells per direction (default 8, 16, 32, 64, 128; quick: 3, 4).
+    quick : a short smoke run (:data:`QUICK`: 3×3 and 4×4 nets, 20 frames, target 1e-3,
+        5 s budget, Radau IIA-7/-3 and generalised-α, no regimes b–e, no goals at scale).
     outdir : output folder (created).
     quiet : print nothing.
     frames, target, budget, methods, families, goals, regimes_too : override the

@@ -10,8 +10,9 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..errors import InputError
 from ..surface import Surface
-from .atomic import _check_stem, _require_folder, write_text
+from .atomic import _check_stem, write_text
 from .frames import check_frames, check_net, tessellate_frames
 from .mesh import write_mesh
 from .weld import weld
@@ -24,6 +25,16 @@ def pvd_text(entries: Sequence[tuple[float, str]]) -> str:
     return ('<?xml version="1.0"?>\n'
             '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">\n'
             f"  <Collection>\n{rows}\n  </Collection>\n</VTKFile>\n")
+
+
+def _output_folder(directory: str | os.PathLike[str]) -> Path:
+    """``directory``, created with its parents if missing (an error names it otherwise)."""
+    folder = Path(directory)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"cannot create the output folder {folder}: {exc}") from None
+    return folder
 
 
 def frame_file_names(stem: str, count: int) -> list[str]:
@@ -46,13 +57,37 @@ def write_time_series(directory: str | os.PathLike[str], stem: str, surface: Sur
 
     The points are the same in every frame, so a warp by the field is applied exactly
     once. Grid points that coincide at rest and in every frame (a periodic seam, a pole)
-    are one point (:func:`~splinedeform.export.weld.weld`). The ``.pvd`` is written last and lists every frame with its time. Returns the
-    ``.pvd`` path.
+    are one point (:func:`~splinedeform.export.weld.weld`). Each file is written
+    atomically and the ``.pvd`` last, listing every frame with its time (see
+    docs/outputs.md).
+
+    Parameters
+    ----------
+    directory : path
+        Output folder, created (with its parents) if missing.
+    stem : str
+        File name stem, without a folder: ``stem.pvd``, ``stem_0000.vtu`` …
+    surface : Surface
+        The bases the nets are evaluated on.
+    rest_net : array_like, shape ``(n_u, n_v, 3)``
+        The rest control net ``P_rest`` (the points of every frame).
+    times : array_like, shape ``(F,)``
+        Non-decreasing time of each frame.
+    nets : array_like, shape ``(F, n_u, n_v, 3)``
+        The control net ``P_f`` of each frame, e.g. ``solution.control_points(times)``.
+    resolution : int
+        Samples per parameter direction of each mesh (``resolution²`` points before
+        welding).
+
+    Returns
+    -------
+    Path
+        The ``.pvd`` file.
     """
-    folder = _require_folder(directory)
     _check_stem(stem)
     t, P = check_frames(surface, times, nets)
     rest = check_net(surface, rest_net, "rest net")
+    folder = _output_folder(directory)
     X, faces = tessellate_frames(surface, P, resolution)
     X0, _ = tessellate_frames(surface, rest, resolution)
     keep, faces = weld(np.concatenate([X0[None], X]), faces)
