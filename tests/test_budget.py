@@ -236,3 +236,19 @@ def test_rendering_is_counted_in_the_work(tmp_path):
     assert any(f.startswith("viewer.html") for f in terms)
     assert "rendering 20000 animation frames" in refusal(
         text.replace("frames = 40", "frames = 20000"), tmp_path)
+
+
+def test_validate_refuses_what_run_refuses_for_its_budget(tmp_path):
+    # the same 93.8 GiB case as run's: validate exits 2 (input error) with the same
+    # message, and passes once the budget is raised the same way
+    from splinedeform import cli
+
+    scenario = tmp_path / "case.toml"
+    scenario.write_text(BASE.replace("frames = 5", "frames = 2000").replace(
+        "formats = []", "formats = []\nresolution = 1024"))
+    runner = CliRunner()
+    refused = runner.invoke(cli.app, ["validate", str(scenario)])
+    assert refused.exit_code == 2 and "memory: about 93.8 GiB" in refused.output
+    assert ": valid" not in refused.output
+    allowed = runner.invoke(cli.app, ["validate", str(scenario), "--budget", "memory=100GiB"])
+    assert allowed.exit_code == 0 and "estimated memory" in allowed.output
