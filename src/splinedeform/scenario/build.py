@@ -79,11 +79,13 @@ def _fit_options(spec: SurfaceSpec) -> dict[str, Any]:
 def _surface_from_cad(scenario: Scenario) -> Any:
     """Surface ``face`` of a CAD file, as a deformable NURBS surface (trimming dropped)."""
     from ..cad import read_cad, surface_from_patch
+    from ..input_files import open_input
 
     path = scenario.surface.path
     assert path is not None
     face = scenario.surface.parameters["face"]
     with _located(scenario, "surface.path"):
+        open_input(path, "CAD file").close()     # a regular file, not a pipe or device
         patch = read_cad(path, face)
         return surface_from_patch(patch, name=f"{path.stem} face {face}",
                                   source=f"{path} face {face}")
@@ -97,7 +99,7 @@ def _surface_from_file(scenario: Scenario) -> Any:
     path = spec.path
     assert path is not None
     suffix = path.suffix.lower()
-    if not path.is_file():
+    if not path.exists():          # a pipe or device is refused on opening, naming it
         raise scenario.error("surface.path", f"file not found: {path}")
     if suffix not in (".json", ".npz", ".npy"):
         raise scenario.error("surface.path", f"expected a control net (.json, .npz) or a point "
@@ -126,9 +128,11 @@ def _point_grid(scenario: Scenario, path: Path) -> Any:
     import numpy as np
 
     from ..export.nets import real_array
+    from ..input_files import check_array_file, open_input
 
     try:
-        with open(path, "rb") as fh:
+        with open_input(path, "point grid") as fh:
+            check_array_file(fh, path)
             data = np.load(fh, allow_pickle=False)
             if isinstance(data, np.lib.npyio.NpzFile):
                 if "control_points" in data.files and "kind_u" in data.files:
@@ -138,6 +142,10 @@ def _point_grid(scenario: Scenario, path: Path) -> Any:
                     raise scenario.error("surface.path", f"{path.name} holds {names}; a point "
                                                          "grid .npz needs one array or 'points'")
                 data = data["points" if "points" in names else names[0]]
+    except ScenarioError:
+        raise
+    except InputError as exc:       # not a regular file, or arrays larger than memory
+        raise scenario.error("surface.path", str(exc)) from None
     except (OSError, ValueError) as exc:
         raise scenario.error("surface.path", f"cannot read {path.name}: {exc}") from None
     if data.ndim != 3 or data.shape[2] != 3:
