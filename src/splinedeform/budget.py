@@ -246,6 +246,15 @@ def explicit_work(solve: Any, model: Any) -> Term:
                 ("solve.t_end", "solve.method", "surface.cells"))
 
 
+def net_memory(cells_u: int, cells_v: int, degree: int = 3) -> float:
+    """Bytes of a plane net and its assembled model, estimated before building it:
+    ``G (3 · 8 + 3 (2p + 1)² · 12)`` for ``G = (c_u + p)(c_v + p)`` control points (their
+    coordinates, and mass, damping and stiffness in compressed sparse rows, 12 bytes an
+    entry, ``(2p + 1)²`` entries a row)."""
+    G = float(cells_u + degree) * float(cells_v + degree)
+    return G * (24.0 + 3.0 * (2 * degree + 1) ** 2 * 12.0)
+
+
 def _strategy(model: Any) -> str:
     from .spectrum import choose
 
