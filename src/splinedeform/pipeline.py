@@ -16,7 +16,8 @@ from typing import Any, Callable, Iterator
 from .budget import Budget, check as check_budget
 from .errors import InputError
 from .outputs import make_report, planned_outputs, summary_rows, write_outputs
-from .scenario import Built, Scenario, SolveSpec, _located, build
+from .load_scale import ScaledSolution, load_scale
+from .scenario import Built, Scenario, SolveSpec, _located, build, build_load
 
 #: ``progress(stage, done, total)``, called as each stage advances
 ProgressCallback = Callable[[str, int, int], None]
@@ -142,12 +143,16 @@ def _solve(scenario: Scenario, built: Built, stages: _Stages) -> RunResult:
     solution, omegas, shapes = None, None, None
     times = np.asarray(solve.frame_times() if solve.kind == "dynamic"
                        else np.linspace(0.0, 1.0, solve.frames))
+    scale = load_scale(scenario)           # extreme loads solved at order one, then scaled
     with stages.stage("solve"), _located(scenario, "solve"):
+        load = built.load if scale == 1.0 else build_load(scenario, scale)
         if solve.kind == "static":
-            solution = model.static(built.load)
+            solution = model.static(load)
         elif solve.kind == "dynamic":
-            solution = model.dynamic(built.load, solve.t_end, method=solve.method,
+            solution = model.dynamic(load, solve.t_end, method=solve.method,
                                      **_method_options(solve, times, scenario.output.time))
+        if solution is not None and scale != 1.0:
+            solution = ScaledSolution(solution, scale)
     if solve.modes > 0 and solve.kind != "static":
         with stages.stage("modes"), _located(scenario, "solve.modes"):
             omegas, shapes = model.modes(min(solve.modes, model.n_free))
@@ -275,7 +280,9 @@ def _measure(result: RunResult) -> None:
     Bu = surface.basis_u.matrix(uu).toarray()
     Bv = surface.basis_v.matrix(vv).toarray()
     grid = np.einsum("ik,fklc,jl->fijc", Bu, D, Bv, optimize=True)
-    result.max_displacement = float(np.linalg.norm(grid, axis=-1).max())
+    size = float(np.abs(grid).max(initial=0.0))      # |d| of tiny d without squares underflowing
+    result.max_displacement = size * float(np.linalg.norm(grid / size, axis=-1).max()) \
+        if 0.0 < size < np.inf else size
     solution = result.solution
     if scenario.solve.kind == "dynamic":
         energy = solution.energy(result.times)

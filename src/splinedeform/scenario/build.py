@@ -155,8 +155,9 @@ def _point_grid(scenario: Scenario, path: Path) -> Any:
         return real_array(data, f"point grid {path.name}")
 
 
-def build_load(scenario: Scenario) -> Any:
-    """The sum of the ``[[load]]`` tables as a :mod:`splinedeform.loads` object (or None).
+def build_load(scenario: Scenario, scale: float = 1.0) -> Any:
+    """The sum of the ``[[load]]`` tables as a :mod:`splinedeform.loads` object (or None),
+    with forces and pressures divided by ``scale`` (see :mod:`splinedeform.load_scale`).
 
     Under ``physics = "shell"`` a ``uniform`` load is a force per unit surface area
     (:class:`~splinedeform.AreaForce`, e.g. self-weight).
@@ -168,14 +169,16 @@ def build_load(scenario: Scenario) -> Any:
 
     total = None
     for i, spec in enumerate(scenario.loads, start=1):
+        force = None if spec.force is None else tuple(f / scale for f in spec.force)
+        q = None if spec.q is None else spec.q / scale
         with _located(scenario, f"load[{i}]"):
             profile = {"constant": lambda: L.Constant(),
                        "step": lambda: L.Step(spec.t_on, spec.t_off),
                        "piecewise": lambda: L.Piecewise(spec.points),
                        "harmonic": lambda: L.Harmonic(spec.omega, spec.phase)}[spec.profile]()
-            load = {"point": lambda: L.Point(spec.at[0], spec.at[1], spec.force, profile),
-                    "uniform": lambda: uniform(force=spec.force, profile=profile),
-                    "pressure": lambda: L.Pressure(spec.q, profile)}[spec.kind]()
+            load = {"point": lambda: L.Point(spec.at[0], spec.at[1], force, profile),
+                    "uniform": lambda: uniform(force=force, profile=profile),
+                    "pressure": lambda: L.Pressure(q, profile)}[spec.kind]()
         total = load if total is None else total + load
     return total
 
