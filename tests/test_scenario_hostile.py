@@ -255,3 +255,56 @@ def test_a_byte_order_mark_at_the_start_of_a_scenario_is_accepted(tmp_path):
     assert parse_scenario("\ufeff" + DYNAMIC).solve.t_end == 2.0
     message = error_of("\ufeff" + DYNAMIC.replace("frames = 5", "frames = 0"))
     assert message.startswith(f"case.toml:{line_of(DYNAMIC, 'frames')}: solve.frames: ")
+
+
+# -- extreme lengths --------------------------------------------------------------------
+@pytest.mark.parametrize("surface, key, words", [
+    ('shape = "saddle"\ncells = 3\nheight = 1e200', "height", "a length of 1e+200 is outside"),
+    ('shape = "plane"\ncells = 3\nsize = 1e300', "size", "a length of 1e+300 is outside"),
+    ('shape = "cylinder"\ncells = 4\nradius = 1e-300', "radius", "a length of 1e-300 is outside"),
+    ('shape = "saddle"\ncells = 3\nheight = 1e15', "height",
+     "surface.height = 1e+15 against surface.size = 1: a ratio beyond 1e+12"),
+    ('shape = "torus"\ncells = 4\nR = 1.0\nr = 1e-13', "r",
+     "surface.r = 1e-13 against surface.R = 1: a ratio beyond 1e+12"),
+])
+def test_an_extreme_length_is_named_by_its_key(surface, key, words):
+    # these used to surface as a boundary, periodic-basis or "no single input is extreme"
+    # error far from the cause
+    text = DYNAMIC.replace('shape = "plane"\ncells = 3', surface)
+    message = error_of(text)
+    assert message.startswith(f"case.toml:{line_of(text, key + ' =')}: surface.{key}: {words}")
+
+
+@pytest.mark.parametrize("thickness, words", [
+    ("1e-100", "a thickness of 1e-100 is outside 1e-50 .. 1e+50"),
+    ("1e-8", "1e-08 is below 1e-06 times the shape's size 1"),
+])
+def test_an_extreme_shell_thickness_is_named(thickness, words):
+    text = DYNAMIC.replace("w10 = 1.0\nw01 = 1.0", 'physics = "shell"\nE = 1.0\nnu = 0.3\n'
+                                                   f"thickness = {thickness}\ndensity = 1.0")
+    message = error_of(text)
+    assert message.startswith(f"case.toml:{line_of(text, 'thickness')}: material.thickness: "
+                              f"{words}")
+
+
+def test_ordinary_lengths_in_other_units_are_accepted():
+    # nanometres and kilometres are far from 1 but well inside the usable range
+    for surface in ('shape = "plane"\ncells = 3\nsize = 1e-9', 'shape = "saddle"\ncells = 3\n'
+                    'size = 1e3\nheight = 250.0', 'shape = "saddle"\ncells = 3\nheight = 0.0'):
+        parse_scenario(DYNAMIC.replace('shape = "plane"\ncells = 3', surface))
+
+
+def test_a_net_file_of_extreme_extent_is_named_by_its_path(tmp_path):
+    from splinedeform.export import write_control_nets
+    from splinedeform.scenario import build
+
+    basis = BSplineBasis(2, 3, 1.0, "open")
+    P = np.zeros((5, 5, 3))
+    P[..., 0] = 1e200 * basis.greville()[:, None]
+    P[..., 1] = 1e200 * basis.greville()[None, :]
+    write_control_nets(tmp_path, "net", Surface(P, basis, basis), [0.0], P[None])
+    scenario = tmp_path / "case.toml"
+    scenario.write_text(file_text("net.json"))
+    with pytest.raises(ScenarioError, match=r"case\.toml:3: surface\.path: the surface spans "
+                                            r"1e\+200, outside 1e-50 \.\. 1e\+50"):
+        build(load_scenario(scenario))

@@ -239,6 +239,12 @@ def build(scenario: Scenario) -> Built:
     from ..model import Model
 
     surface = build_surface(scenario)
+    if scenario.surface.shape in ("file", "cad"):     # the built-in shapes' lengths are keys
+        from .geometry import extent_problem
+
+        problem = extent_problem(surface, scenario.material.thickness)
+        if problem is not None:
+            raise scenario.error("surface.path", problem)
     _check_parameters(scenario, surface)
     fixed = free_region_mask(scenario, surface)
     if scenario.material.physics == "shell":
