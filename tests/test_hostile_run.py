@@ -60,7 +60,8 @@ def test_tiny_loads_give_the_unit_load_response_scaled(method, force):
     import numpy as np
 
     text = BASE.format(mass=1.0, damping=0.5, force="{force}").replace(
-        "frames = 5", f'frames = 5\nmethod = "{method}"').replace('formats = ["json"]', "formats = []")
+        "frames = 5", f'frames = 5\nmethod = "{method}"').replace('formats = ["json"]',
+                                                                 "formats = []")
     unit = run(parse_scenario(text.format(force=-1.0)))
     tiny = run(parse_scenario(text.format(force=force)))
     rest = unit.built.surface.control_points

@@ -50,7 +50,7 @@ CAD_COSTS = {"3dm": (1e6, 2e4, 1024.0, 32.0, 1024.0, 64.0),
 
 
 def panel_work(samples: int) -> float:
-    """Operations of one shaded 3-D panel of ``samples²`` points: ``1.5·10⁸ + 1.5·10⁴ s²``."""
+    """Operations of one shaded 3-D panel of ``s²`` samples: ``1.5·10⁸ + 1.5·10⁴ s²``."""
     return PANEL_WORK + PANEL_WORK_PER_SAMPLE * samples ** 2
 
 
