@@ -211,15 +211,15 @@ def test_five_thousand_probes_with_pictures_are_refused_naming_probes(tmp_path):
 
 
 def test_probe_sampling_grows_with_the_probes_and_frames():
-    # P (5e5 + F max(6 G, 5e4)) operations: 5000 probes over 100 frames are 2.75e10
+    # P (5e4 + 6 F (p + 1)²) operations: 5000 probes over 100 frames of degree 3 are 7.3e8
     def work(probes: int, frames: int) -> float:
         listed = ", ".join(["[0.5, 0.5]"] * probes)
         s = scenario_of(BASE.replace("frames = 5", f"frames = {frames}").replace(
             "formats = []", f"formats = []\nprobes = [{listed}]"))
         return next(t.amount for t in estimate(s, build(s).model).work if "probe" in t.formula)
 
-    assert work(5000, 100) == pytest.approx(5000 * (5e5 + 100 * 5e4), rel=1e-12)  # exact sum
-    assert work(1, 100) == pytest.approx(5e5 + 100 * 5e4, rel=1e-12)
+    assert work(5000, 100) == pytest.approx(5000 * (5e4 + 6 * 100 * 16), rel=1e-12)  # exact
+    assert work(1, 100) == pytest.approx(5e4 + 6 * 100 * 16, rel=1e-12)
 
 
 def test_rendering_is_counted_in_the_work(tmp_path):

@@ -9,9 +9,10 @@ sampled surfaces
     ``2 F r² (p + 1)² 3`` operations per sampled output (``vtu``, viewer, GIF, MP4) and
     once for the largest displacement;
 probes
-    ``P (5·10⁵ + F max(6 G, 5·10⁴))`` (an evaluation row and one contraction per frame, the
-    interpreter's cost dominating); with ``images`` of the analytic solution another
-    ``2 P min(600 n², 3·10⁹)`` for the densely sampled curves;
+    ``P (5·10⁴ + 6 F (p + 1)²)`` (one sparse evaluation matrix for all probes, its product
+    with every frame's net, and the interpreter's cost of each probe's history); with
+    ``images`` of the analytic solution another ``2 P min(600 n², 3·10⁹)`` for the densely
+    sampled curves;
 pictures (``images``)
     ``surfaces.png`` two 3-D panels of 48² samples, ``probes.png`` one panel of
     ``800 × 250`` pixels per probe (``3·10⁸`` each), ``modes.png`` one panel per mode:
@@ -76,7 +77,7 @@ def output_terms(scenario: Any, model: Any, frames: int, frames_key: str
     sampled = [f for f in ("vtu", "viewer", "gif", "mp4") if f in formats]
     work = [Term(2.0 * F * r2 * (p + 1) ** 2 * 3 * (1 + len(sampled)),
                  f"{F} frames x {r}² samples, {1 + len(sampled)} time(s)", (frames_key, res)),
-            Term(P * (5e5 + F * max(6.0 * G, 5e4)), f"{P} probe(s) over {F} frames",
+            Term(P * (5e4 + 6.0 * F * (p + 1) ** 2), f"{P} probe(s) over {F} frames",
                  (probes_key, frames_key))]
 
     if "vtu" in formats:

@@ -271,10 +271,14 @@ def _measure(result: RunResult) -> None:
     scenario, surface = result.scenario, result.built.surface
     D = result.nets - surface.control_points
     probes = scenario.output.probes or (_domain_centre(surface),)
+    at = np.asarray(probes, dtype=float)
+    E = surface.evaluation_matrix(at[:, 0], at[:, 1])          # (P, n_u n_v), sparse
+    F = D.shape[0]
+    histories = (E @ np.moveaxis(D.reshape(F, -1, 3), 0, 1).reshape(E.shape[1], F * 3)
+                 ).reshape(len(probes), F, 3)
     for i, (u, v) in enumerate(probes, start=1):
-        E = surface.evaluation_matrix([u], [v]).toarray()[0].reshape(surface.shape)
         name = f"p{i} ({u:g}, {v:g})"
-        result.probes[name] = np.einsum("kl,fklc->fc", E, D)
+        result.probes[name] = histories[i - 1]
         result.probe_points[name] = (float(u), float(v))
     uu, vv = surface.sample_parameters(scenario.output.resolution)
     Bu = surface.basis_u.matrix(uu).toarray()
