@@ -5,9 +5,15 @@ format's memory, disk, files and work, each as a term naming the keys that drive
 ``F`` frames, ``r`` = ``output.resolution``, a net of ``G = n_u n_v`` control points,
 ``P`` probes and ``n`` free coordinates (operation counts at about 1e9 per second):
 
+frames
+    ``3·10⁵`` operations each (energies, checks: the interpreter's cost of a frame);
 sampled surfaces
     ``2 F r² (p + 1)² 3`` operations per sampled output (``vtu``, viewer, GIF, MP4) and
     once for the largest displacement;
+files of numbers
+    ``vtu`` ``2·10⁶ + 1.5·10³ r²`` operations per file; control nets ``1.5·10³`` (``json``)
+    and ``300`` (``npz``) per number of ``F G 3``; meshes (``obj``, ``stl``, ``ply``)
+    ``10⁴ r²`` each (welding and writing);
 probes
     ``P (5·10⁴ + 6 F (p + 1)²)`` (one sparse evaluation matrix for all probes, its product
     with every frame's net, and the interpreter's cost of each probe's history); with
@@ -75,7 +81,8 @@ def output_terms(scenario: Any, model: Any, frames: int, frames_key: str
     disk: list[Term] = []
     files: list[Term] = []
     sampled = [f for f in ("vtu", "viewer", "gif", "mp4") if f in formats]
-    work = [Term(2.0 * F * r2 * (p + 1) ** 2 * 3 * (1 + len(sampled)),
+    work = [Term(3e5 * F, f"{F} frames (energies and checks)", (frames_key,)),
+            Term(2.0 * F * r2 * (p + 1) ** 2 * 3 * (1 + len(sampled)),
                  f"{F} frames x {r}² samples, {1 + len(sampled)} time(s)", (frames_key, res)),
             Term(P * (5e4 + 6.0 * F * (p + 1) ** 2), f"{P} probe(s) over {F} frames",
                  (probes_key, frames_key))]
@@ -84,9 +91,13 @@ def output_terms(scenario: Any, model: Any, frames: int, frames_key: str
         disk.append(Term(F * r2 * 104.0, f"{F} .vtu files of {r}² points",
                          (frames_key, res, fmt)))
         files.append(Term(F + 1.0, f"{F} .vtu files and a .pvd", (frames_key, fmt)))
-    for ext, size in (("json", 25.0), ("npz", 8.0)):
+        work.append(Term(F * (2e6 + 1.5e3 * r2), f"writing {F} .vtu files of {r}² points",
+                         (frames_key, res, fmt)))
+    for ext, size, ops in (("json", 25.0, 1.5e3), ("npz", 8.0, 300.0)):
         if ext in formats:
             disk.append(Term(F * G * 3 * size, f"control nets .{ext}", (frames_key, fmt)))
+            work.append(Term(F * G * 3 * ops, f"writing control nets .{ext}",
+                             (frames_key, fmt)))
     if "viewer" in formats:
         numbers = (F * r2 + F * G) * 3.0
         disk.append(Term(numbers * 4 * 4 / 3 + 2**20, "viewer.html", (frames_key, res, fmt)))
@@ -95,6 +106,7 @@ def output_terms(scenario: Any, model: Any, frames: int, frames_key: str
     for ext in ("obj", "stl", "ply"):
         if ext in formats:
             disk.append(Term(r2 * 100.0, f".{ext} mesh", (res, fmt)))
+            work.append(Term(r2 * 1e4, f".{ext} mesh of {r}² points", (res, fmt)))
 
     for ext, (ops, ops_g, size, size_g, held, held_g) in CAD_COSTS.items():
         if ext in formats:
