@@ -256,3 +256,19 @@ def test_validate_refuses_what_run_refuses_for_its_budget(tmp_path):
     assert ": valid" not in refused.output
     allowed = runner.invoke(cli.app, ["validate", str(scenario), "--budget", "memory=100GiB"])
     assert allowed.exit_code == 0 and "estimated memory" in allowed.output
+
+
+def test_beyond_the_power_limit_the_frequency_estimate_stays_above_the_true_one(monkeypatch):
+    # without the factorisation: the Gershgorin rows times 2.5, between 1 and 2.5 times
+    # ω_max (the rows lie within a factor 2.5 below it); a 12² plate with the limit lowered
+    import numpy as np
+
+    import splinedeform as sd
+    from splinedeform import budget
+
+    model = sd.Model(sd.shapes.plane(cells=12, degree=3), sd.Material(w20=1, w11=1, w02=1),
+                     boundary="clamped")
+    monkeypatch.setattr(budget, "POWER_LIMIT", 10)
+    lam, _ = model.eigen()
+    ratio = budget.highest_frequency(model) / np.sqrt(lam.max())
+    assert 1.0 <= ratio <= 2.5, ratio
