@@ -392,3 +392,20 @@ def test_search_does_not_try_a_level_known_to_miss(monkeypatch):
     calls.clear()
     _, best = search.search(None, "radau7", 2, limits)
     assert best == 2 and calls == [2, 1]
+
+
+def test_a_net_too_large_for_memory_is_refused_by_its_estimate(tmp_path):
+    # 100000² cells: 1.0e10 control points x (24 + 3 x 49 x 12) bytes = 1.6e4 TiB, refused
+    # before anything is allocated (it used to ask numpy for a 74.5 GiB array)
+    from typer.testing import CliRunner
+
+    from splinedeform import cli
+    from splinedeform.budget import net_memory
+
+    assert net_memory(100_000, 100_000) == pytest.approx(100_003**2 * 1788.0, rel=1e-12)
+    result = CliRunner().invoke(cli.app, ["bench", "--sizes", "8,100000", "-q",
+                                          "-o", str(tmp_path / "b")])
+    assert result.exit_code == 2, result.output
+    assert "sizes [100000]: a 100000 x 100000-cell net needs about" in result.output
+    assert "more than the 4 GiB" in result.output and "internal error" not in result.output
+    assert not (tmp_path / "b").exists()

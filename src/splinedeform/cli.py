@@ -258,17 +258,19 @@ def demo_command(outdir: Path = typer.Option(Path("demo-output"), "-o", "--outdi
 
 @app.command("validate")
 def validate_command(scenario: Path = SCENARIO_ARG, allow_outside_paths: bool = OUTSIDE_OPT,
-                     debug: bool = DEBUG_OPT) -> None:
-    """Check a scenario file and print what it would run (with every default filled in)."""
-    from .budget import estimate
+                     budget: Optional[str] = BUDGET_OPT, debug: bool = DEBUG_OPT) -> None:
+    """Check a scenario file and print what it would run (with every default filled in);
+    a run over its budget is refused here as by ``run``."""
+    from .budget import Budget, check
     from .scenario import build, describe, load_scenario, scenario_to_toml
     from .terminal import printable
 
     with _reported_errors(debug):
         loaded = load_scenario(scenario, allow_outside_paths=allow_outside_paths)
         built = build(loaded)
+        found = check(loaded, built.model, Budget.parse(budget) if budget is not None else None)
         out, _ = _consoles()
-        rows = describe(loaded, built) + estimate(loaded, built.model).rows()
+        rows = describe(loaded, built) + found.rows()
         out.print(_table(f"{scenario}: valid", rows))
         out.print(printable(scenario_to_toml(loaded)), markup=False, highlight=False)
 

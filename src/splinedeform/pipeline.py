@@ -17,7 +17,8 @@ from ._progress import reporting_simulated_time
 from .budget import Budget, check as check_budget
 from .errors import InputError
 from .outputs import make_report, planned_outputs, summary_rows, write_outputs
-from .scenario import Built, Scenario, SolveSpec, _located, build
+from .load_scale import ScaledSolution, load_scale
+from .scenario import Built, Scenario, SolveSpec, _located, build, build_load
 
 #: ``progress(stage, done, total)``, called as each stage advances
 ProgressCallback = Callable[[str, int, int], None]
@@ -174,12 +175,16 @@ def _solve(scenario: Scenario, built: Built, stages: _Stages) -> RunResult:
     solution, omegas, shapes = None, None, None
     times = np.asarray(solve.frame_times() if solve.kind == "dynamic"
                        else np.linspace(0.0, 1.0, solve.frames))
+    scale = load_scale(scenario)           # extreme loads solved at order one, then scaled
     with stages.stage("solve"), _located(scenario, "solve"), stages.simulated("solve"):
+        load = built.load if scale == 1.0 else build_load(scenario, scale)
         if solve.kind == "static":
-            solution = model.static(built.load)
+            solution = model.static(load)
         elif solve.kind == "dynamic":
-            solution = model.dynamic(built.load, solve.t_end, method=solve.method,
+            solution = model.dynamic(load, solve.t_end, method=solve.method,
                                      **_method_options(solve, times, scenario.output.time))
+        if solution is not None and scale != 1.0:
+            solution = ScaledSolution(solution, scale)
     if solve.modes > 0 and solve.kind != "static":
         with stages.stage("modes"), _located(scenario, "solve.modes"):
             omegas, shapes = model.modes(min(solve.modes, model.n_free))
@@ -310,16 +315,22 @@ def _measure(result: RunResult) -> None:
     scenario, surface = result.scenario, result.built.surface
     D = result.nets - surface.control_points
     probes = scenario.output.probes or (_domain_centre(surface),)
+    at = np.asarray(probes, dtype=float)
+    E = surface.evaluation_matrix(at[:, 0], at[:, 1])          # (P, n_u n_v), sparse
+    F = D.shape[0]
+    histories = (E @ np.moveaxis(D.reshape(F, -1, 3), 0, 1).reshape(E.shape[1], F * 3)
+                 ).reshape(len(probes), F, 3)
     for i, (u, v) in enumerate(probes, start=1):
-        E = surface.evaluation_matrix([u], [v]).toarray()[0].reshape(surface.shape)
         name = f"p{i} ({u:g}, {v:g})"
-        result.probes[name] = np.einsum("kl,fklc->fc", E, D)
+        result.probes[name] = histories[i - 1]
         result.probe_points[name] = (float(u), float(v))
     uu, vv = surface.sample_parameters(scenario.output.resolution)
     Bu = surface.basis_u.matrix(uu).toarray()
     Bv = surface.basis_v.matrix(vv).toarray()
     grid = np.einsum("ik,fklc,jl->fijc", Bu, D, Bv, optimize=True)
-    result.max_displacement = float(np.linalg.norm(grid, axis=-1).max())
+    size = float(np.abs(grid).max(initial=0.0))      # |d| of tiny d without squares underflowing
+    result.max_displacement = size * float(np.linalg.norm(grid / size, axis=-1).max()) \
+        if 0.0 < size < np.inf else size
     solution = result.solution
     if scenario.solve.kind == "dynamic":
         energy = solution.energy(result.times)

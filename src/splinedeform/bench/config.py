@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from ..budget import Budget, net_memory, show
 from ..errors import InputError
 from .cases import FAMILIES
 from .search import DEFAULT_METHODS, NUMERICAL
@@ -68,6 +69,14 @@ def _sizes(sizes: Sequence[Any]) -> tuple[int, ...]:
     if not sizes or any(isinstance(s, bool) or not isinstance(s, (int, np.integer)) or s < 2
                         for s in sizes):
         raise InputError(f"sizes must be integers >= 2 (cells per direction), got {list(sizes)}")
+    limit = Budget().memory
+    too_large = [int(s) for s in sizes if net_memory(int(s), int(s)) > limit]
+    if too_large:
+        largest = max(too_large)
+        raise InputError(f"sizes {too_large}: a {largest} x {largest}-cell net needs about "
+                         f"{show('memory', net_memory(largest, largest))} for its control "
+                         f"points and matrices alone, more than the {show('memory', limit)} "
+                         "a run may take; choose smaller sizes (the default study goes to 128)")
     return tuple(sorted({int(s) for s in sizes}))
 
 

@@ -8,6 +8,7 @@ from typing import Any, Iterable, Mapping
 
 from ..boundary import EDGES
 from .checks import Key, _Invalid
+from .geometry import length_problems
 from .keys import (BOUNDARY_KEYS, FORMAT_ALIASES, FREE_REGION_KEYS, LOAD_KEYS, LOAD_KIND_KEYS,
                    METHOD_SETTINGS, MATERIAL_KEYS, PROFILE_KEYS, SHAPE_PARAMETERS, SOLVE_KEYS,
                    SOLVE_KIND_KEYS, SURFACE_KEYS, TABLES, TOP_KEYS, OUTPUT_KEYS)
@@ -89,6 +90,9 @@ def _validate(raw: dict[str, Any], source: str, lines: Mapping[str, int],
                 problems.add(key, str(exc))
     surface = _validate_surface(raw, problems, directory, allow_outside_paths)
     material = _validate_material(raw, problems, surface)
+    if surface is not None and material is not None:
+        for key, message in length_problems(surface, material):
+            problems.add(key, message)
     physics = material.physics if material is not None else "parametric"
     boundary = _validate_boundary(raw, problems, physics)
     solve = _validate_solve(raw, problems, physics)
