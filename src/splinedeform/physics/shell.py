@@ -197,7 +197,7 @@ def strain_vectors(G: metric.Grid, points: slice) -> Array:
 
 
 def by_cell(A: Array, q: tuple[int, int]) -> Array:
-    """Grid array ``(Q_a, Q_v, ...)`` → ``(cells_a, cells_v, q_u q_v, ...)``, a cell's points together.
+    """Grid array ``(Q_a, Q_v, ...)`` → ``(cells_a, cells_v, q_u q_v, ...)`` by cells.
 
     The ``q_u × q_v`` Gauss points of each cell are consecutive in the grid
     (:func:`~splinedeform.quadrature.gauss_points`).

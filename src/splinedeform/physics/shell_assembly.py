@@ -83,7 +83,7 @@ class Pattern:
         return out
 
     def _entry(self, i: Index, j: Index, ip: Index, jp: Index) -> Index:
-        """Data index of ``(k, i, j; l, i', j')`` for broadcast ``i, j, i', j'``: ``(..., c, c)``."""
+        """Data index of ``(k, i, j; l, i', j')`` at ``i, j, i', j'``, ``(..., c, c)``."""
         c, n_v = self.components, self.len_v.size
         k = np.arange(c)
         rowlen = (self.len_u[i] * self.len_v[j] * c)[..., None, None]

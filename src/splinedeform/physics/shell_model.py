@@ -34,6 +34,7 @@ from .shell import ShellMaterial, matrices
 from .shell_edges import EDGES, KINDS, check_edges, constraint_matrix  # noqa: F401
 from .shell_rigid import describe, free_rigid_motions
 from .shell_solution import ShellModalSolution, ShellStaticSolution
+from .shell_stress import ShellStresses, stresses
 
 Array = NDArray[np.float64]
 
@@ -201,6 +202,14 @@ class ShellModel:
         lam, phi = self.eigen(k, check_spectrum)
         shapes = np.asarray(self.T @ phi).T.reshape((phi.shape[1],) + self.surface.shape + (3,))
         return np.sqrt(lam), shapes
+
+    def stresses(self, displacement: ArrayLike, u: ArrayLike, v: ArrayLike) -> ShellStresses:
+        """Stresses of a displacement net ``(n_u, n_v, 3)`` (a solution's, a mode shape) at ``(u, v)``.
+
+        See :func:`.shell_stress.stresses`: ``N``, ``M`` in the local frame, ``σ`` at top,
+        middle and bottom, principal and von Mises stresses, normal displacement.
+        """
+        return stresses(self.surface, self.material, displacement, u, v)
 
     def _to_free(self, net: ArrayLike | None, what: str) -> Array:
         if net is None:

@@ -1,0 +1,144 @@
+"""Stress resultants and stresses of the linear Kirchhoff–Love shell at surface points.
+
+From the displacement ``d(u, v)`` of the rest surface (covariant basis ``a_α``, unit normal
+``a_3``), the strains of :mod:`.shell` (Voigt ``(·_11, ·_22, 2·_12)``)::
+
+    ε_αβ = ½ (a_α·d_,β + a_β·d_,α),   κ_αβ = d_,αβ·a_3 + a_αβ·δa_3
+
+give the contravariant membrane forces and bending moments::
+
+    n = E t/(1−ν²) H ε,     m = −E t³/(12(1−ν²)) H κ
+
+so that through the thickness (``ζ`` along ``a_3``, ``−t/2 ≤ ζ ≤ t/2``) the strain is
+``ε − ζ κ``, the stress ``σ(ζ) = n/t + 12 ζ m/t³``, ``n = ∫ σ dζ`` and ``m = ∫ ζ σ dζ``.
+A flat plate with ``a_3 = +z`` has ``m_11 = −D (w_,xx + ν w_,yy)``, the sign of
+Timoshenko and Woinowsky-Krieger (sagging under a load along ``a_3`` is positive).
+Components are taken in the local orthonormal frame ``e_1 = a_1/|a_1|``,
+``e_2 = a_3 × e_1``, ``e_3 = a_3``: ``T_(ij) = T^αβ (e_i·a_α)(e_j·a_β)``. Stresses at the
+top (``ζ = t/2``), middle and bottom (``ζ = −t/2``) are ``σ = N/t ± 6 M/t²``; principal
+stresses ``(σ_11+σ_22)/2 ± √(((σ_11−σ_22)/2)² + σ_12²)`` and von Mises
+``√(σ_11² − σ_11 σ_22 + σ_22² + 3 σ_12²)`` (plane stress).
+
+Transverse shear forces ``Q`` (the divergence of the moments) need third derivatives of
+the displacement and are not computed here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import InputError
+from ..surface import Surface
+from .shell import ShellMaterial, constitutive
+
+Array = NDArray[np.float64]
+#: through-thickness positions ``ζ / (t/2)`` of the three stress layers
+LAYERS = {"top": 1.0, "middle": 0.0, "bottom": -1.0}
+
+
+@dataclass(frozen=True)
+class ShellStresses:
+    """Resultants and stresses at points of shape ``S`` (components in the local frame).
+
+    ``N``, ``M`` ``S + (3,)``: ``(N_11, N_22, N_12)`` force per length, ``(M_11, M_22,
+    M_12)`` moment per length; ``sigma[layer]`` ``S + (3,)`` for ``"top"``, ``"middle"``,
+    ``"bottom"``; ``principal[layer]`` ``S + (2,)`` (larger first); ``von_mises[layer]``
+    ``S``; ``normal_displacement`` ``d·a_3`` ``S``; ``frame`` ``S + (3, 3)``, rows
+    ``e_1, e_2, e_3``.
+    """
+
+    N: Array
+    M: Array
+    sigma: dict[str, Array]
+    principal: dict[str, Array]
+    von_mises: dict[str, Array]
+    normal_displacement: Array
+    frame: Array
+
+    def maxima(self) -> dict[str, float]:
+        """Largest magnitudes: ``|N_ij|``, ``|M_ij|``, von Mises per layer, ``|d·a_3|``."""
+        out = {f"max |N{ij}|": float(np.abs(self.N[..., k]).max())
+               for k, ij in enumerate(("11", "22", "12"))}
+        out.update({f"max |M{ij}|": float(np.abs(self.M[..., k]).max())
+                    for k, ij in enumerate(("11", "22", "12"))})
+        out.update({f"max von Mises {layer}": float(s.max())
+                    for layer, s in self.von_mises.items()})
+        out["max |normal displacement|"] = float(np.abs(self.normal_displacement).max())
+        return out
+
+    def point_data(self) -> dict[str, Array]:
+        """Flat fields for a mesh: resultants, von Mises per layer, normal displacement."""
+        flat = self.normal_displacement.size
+        data = {"membrane_force": self.N.reshape(flat, 3),
+                "bending_moment": self.M.reshape(flat, 3),
+                "normal_displacement": self.normal_displacement.reshape(flat)}
+        data.update({f"von_mises_{layer}": s.reshape(flat) for layer, s in self.von_mises.items()})
+        return data
+
+
+def stresses(surface: Surface, material: ShellMaterial, displacement: ArrayLike,
+             u: ArrayLike, v: ArrayLike) -> ShellStresses:
+    """Stresses of a displacement net ``(n_u, n_v, 3)`` at ``u, v`` (broadcast to a shape ``S``)."""
+    net = np.asarray(displacement, dtype=float)
+    if net.shape != surface.shape + (3,):
+        raise InputError(f"a displacement net must have shape {surface.shape + (3,)}, "
+                         f"got {net.shape}")
+    u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
+    orders = ((1, 0), (0, 1), (2, 0), (1, 1), (0, 2))
+    a1, a2, a11, a12, a22 = (surface.derivative(u, v, p, q) for p, q in orders)
+    d1, d2, d11, d12, d22 = (surface.derivative(u, v, p, q, control_points=net)
+                             for p, q in orders)
+    cross = np.cross(a1, a2)
+    sqrt_g = np.linalg.norm(cross, axis=-1)
+    if np.any(sqrt_g <= 1e-12 * max(1.0, float(np.abs(surface.control_points).max())) ** 2):
+        raise InputError("the surface is degenerate (a_1 × a_2 = 0) at some of the given "
+                         "parameters (a pole); its stresses are undefined there")
+    a3 = cross / sqrt_g[..., None]
+    dot = lambda x, y: np.sum(x * y, axis=-1)  # noqa: E731
+    eps = np.stack([dot(a1, d1), dot(a2, d2), dot(a1, d2) + dot(a2, d1)], -1)
+
+    def kappa(second: Array, a_ab: Array) -> Array:
+        tilde = a_ab - dot(a_ab, a3)[..., None] * a3
+        return (dot(second, a3) + (dot(d1, np.cross(a2, tilde))
+                                   + dot(d2, np.cross(tilde, a1))) / sqrt_g)
+    kap = np.stack([kappa(d11, a11), kappa(d22, a22), 2 * kappa(d12, a12)], -1)
+    g = np.stack([np.stack([dot(a1, a1), dot(a1, a2)], -1),
+                  np.stack([dot(a2, a1), dot(a2, a2)], -1)], -2)
+    H = constitutive(np.linalg.inv(g), material.nu)
+    E, nu, t = material.E, material.nu, material.thickness
+    n = E * t / (1 - nu ** 2) * np.einsum("...ij,...j->...i", H, eps)
+    m = -E * t ** 3 / (12 * (1 - nu ** 2)) * np.einsum("...ij,...j->...i", H, kap)
+    e1 = a1 / np.linalg.norm(a1, axis=-1)[..., None]
+    e2 = np.cross(a3, e1)
+    # c[i, α] = e_i·a_α: T_(ij) = Σ_αβ T^αβ c[i, α] c[j, β]
+    c = np.stack([np.stack([dot(e, a1), dot(e, a2)], -1) for e in (e1, e2)], -2)
+    N, M = _physical(n, c), _physical(m, c)
+    sigma = {layer: N / t + z * 6 * M / t ** 2 for layer, z in LAYERS.items()}
+    normal = dot(surface.derivative(u, v, control_points=net), a3)
+    return ShellStresses(N, M, sigma, {k: principal(s) for k, s in sigma.items()},
+                         {k: von_mises(s) for k, s in sigma.items()}, normal,
+                         np.stack([e1, e2, a3], -2))
+
+
+def _physical(T: Array, c: Array) -> Array:
+    """Voigt contravariant ``(T^11, T^22, T^12)`` → local frame ``(T_(11), T_(22), T_(12))``."""
+    tensor = np.stack([np.stack([T[..., 0], T[..., 2]], -1),
+                       np.stack([T[..., 2], T[..., 1]], -1)], -2)
+    local = np.einsum("...ia,...ab,...jb->...ij", c, tensor, c)
+    return np.stack([local[..., 0, 0], local[..., 1, 1], local[..., 0, 1]], -1)
+
+
+def principal(sigma: Array) -> Array:
+    """Principal stresses ``(σ_I, σ_II)`` of plane stress ``(σ_11, σ_22, σ_12)``, larger first."""
+    mean = 0.5 * (sigma[..., 0] + sigma[..., 1])
+    radius = np.hypot(0.5 * (sigma[..., 0] - sigma[..., 1]), sigma[..., 2])
+    return np.stack([mean + radius, mean - radius], -1)
+
+
+def von_mises(sigma: Array) -> Array:
+    """``√(σ_11² − σ_11 σ_22 + σ_22² + 3 σ_12²)`` of plane stress."""
+    s11, s22, s12 = sigma[..., 0], sigma[..., 1], sigma[..., 2]
+    return np.sqrt(np.maximum(s11 ** 2 - s11 * s22 + s22 ** 2 + 3 * s12 ** 2, 0.0))
