@@ -111,9 +111,13 @@ def _write_files(result: RunResult, folder: Path, stages: Stages) -> None:
                 result.outputs.append((f"mesh .{ext}", export.write_mesh(
                     folder / f"{name}.{ext}", vertices, faces, point_data=data)))
     if "vtu" in formats:
+        from .export.shell_fields import is_shell, stress_fields
+
+        model = result.built.model          # a shell's frames also carry its stresses
+        fields = stress_fields(model, rest, nets, res) if is_shell(model) else None
         with stages.stage("time series"):
             result.outputs.append(("time series .pvd", export.write_time_series(
-                folder, name, surface, rest, times, nets, resolution=res)))
+                folder, name, surface, rest, times, nets, resolution=res, fields=fields)))
     if "json" in formats or "npz" in formats:
         with stages.stage("control nets"):
             wanted = [ext for ext in export.CONTROL_NET_FORMATS if ext in formats]
@@ -250,10 +254,16 @@ def make_report(result: RunResult) -> dict[str, Any]:
                    "max displacement": result.max_displacement},
         "timings": {**_solution_timings(result), **result.timings},
     }
+    from .export.shell_fields import is_shell, mode_maxima, stress_report
+
+    shell = is_shell(result.built.model)
     if result.omegas is not None:
         report["modes"] = {"mode": list(range(1, len(result.omegas) + 1)),
                            "omega": result.omegas,
                            "frequency (omega / 2 pi)": np.asarray(result.omegas) / (2 * np.pi)}
+        if shell and result.mode_nets is not None:
+            report["modes"].update(mode_maxima(result.built.model, result.mode_nets,
+                                               s.output.resolution))
     if result.energy is not None:
         report["energies"] = result.energy
     frame_label = {"dynamic": "time", "static": "load factor", "modes": "phase"}[s.solve.kind]
@@ -262,6 +272,10 @@ def make_report(result: RunResult) -> dict[str, Any]:
         probes.update({f"{name} d{c}": d[:, i] for i, c in enumerate("xyz")})
         probes[f"{name} magnitude"] = np.linalg.norm(d, axis=1)
     report["probes"] = probes
+    if shell:
+        report.update(stress_report(result.built.model, result.rest_net, result.times,
+                                    result.nets, s.output.resolution, result.probe_points,
+                                    frame_label))
     return report
 
 

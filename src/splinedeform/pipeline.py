@@ -38,6 +38,8 @@ class RunResult:
     nets: Any
     omegas: Any = None
     mode_shapes: Any = None
+    #: the shell's mode shapes as displacement nets ``(k, n_u, n_v, 3)`` (None otherwise)
+    mode_nets: Any = None
     probes: dict[str, Any] = field(default_factory=dict)
     probe_points: dict[str, tuple[float, float]] = field(default_factory=dict)
     energy: dict[str, Any] | None = None
@@ -153,10 +155,12 @@ def _solve(scenario: Scenario, built: Built, stages: _Stages) -> RunResult:
             omegas, shapes = model.modes(min(solve.modes, model.n_free))
     with stages.stage("frames"), _located(scenario, "solve"):
         nets = _frames(scenario, built, solution, times, shapes)
+    mode_nets = None
     if shapes is not None and shapes.ndim == 4:     # the shell's modes move x, y, z
+        mode_nets = shapes
         shapes = np.einsum("kabc,abc->kab", shapes, _net_normals(built.surface))
     result = RunResult(scenario=scenario, built=built, solution=solution, times=times,
-                       nets=nets, omegas=omegas, mode_shapes=shapes)
+                       nets=nets, omegas=omegas, mode_shapes=shapes, mode_nets=mode_nets)
     with np.errstate(over="ignore", invalid="ignore"):
         _measure(result)
     _require_finite(result)

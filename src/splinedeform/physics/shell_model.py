@@ -203,13 +203,15 @@ class ShellModel:
         shapes = np.asarray(self.T @ phi).T.reshape((phi.shape[1],) + self.surface.shape + (3,))
         return np.sqrt(lam), shapes
 
-    def stresses(self, displacement: ArrayLike, u: ArrayLike, v: ArrayLike) -> ShellStresses:
+    def stresses(self, displacement: ArrayLike, u: ArrayLike, v: ArrayLike,
+                 at_poles: str = "raise") -> ShellStresses:
         """Stresses of a displacement net ``(n_u, n_v, 3)`` (a solution's, a mode shape) at ``(u, v)``.
 
         See :func:`.shell_stress.stresses`: ``N``, ``M`` in the local frame, ``σ`` at top,
-        middle and bottom, principal and von Mises stresses, normal displacement.
+        middle and bottom, principal and von Mises stresses, normal displacement;
+        ``at_poles="nan"`` gives NaN at degenerate points instead of refusing them.
         """
-        return stresses(self.surface, self.material, displacement, u, v)
+        return stresses(self.surface, self.material, displacement, u, v, at_poles)
 
     def _to_free(self, net: ArrayLike | None, what: str) -> Array:
         if net is None:

@@ -47,7 +47,7 @@ class ShellStresses:
     M_12)`` moment per length; ``sigma[layer]`` ``S + (3,)`` for ``"top"``, ``"middle"``,
     ``"bottom"``; ``principal[layer]`` ``S + (2,)`` (larger first); ``von_mises[layer]``
     ``S``; ``normal_displacement`` ``d·a_3`` ``S``; ``frame`` ``S + (3, 3)``, rows
-    ``e_1, e_2, e_3``.
+    ``e_1, e_2, e_3``. From several nets every field but ``frame`` has a leading axis.
     """
 
     N: Array
@@ -60,14 +60,20 @@ class ShellStresses:
 
     def maxima(self) -> dict[str, float]:
         """Largest magnitudes: ``|N_ij|``, ``|M_ij|``, von Mises per layer, ``|d·a_3|``."""
-        out = {f"max |N{ij}|": float(np.abs(self.N[..., k]).max())
-               for k, ij in enumerate(("11", "22", "12"))}
-        out.update({f"max |M{ij}|": float(np.abs(self.M[..., k]).max())
+        top = lambda x: float(np.nanmax(np.abs(x), initial=0.0))  # noqa: E731 (NaN: poles)
+        out = {f"max |N{ij}|": top(self.N[..., k]) for k, ij in enumerate(("11", "22", "12"))}
+        out.update({f"max |M{ij}|": top(self.M[..., k])
                     for k, ij in enumerate(("11", "22", "12"))})
-        out.update({f"max von Mises {layer}": float(s.max())
-                    for layer, s in self.von_mises.items()})
-        out["max |normal displacement|"] = float(np.abs(self.normal_displacement).max())
+        out.update({f"max von Mises {layer}": top(s) for layer, s in self.von_mises.items()})
+        out["max |normal displacement|"] = top(self.normal_displacement)
         return out
+
+    def select(self, index: int | slice) -> ShellStresses:
+        """The stresses of net ``index`` of several (the leading axis; ``frame`` is shared)."""
+        pick = lambda d: {k: a[index] for k, a in d.items()}  # noqa: E731
+        return ShellStresses(self.N[index], self.M[index], pick(self.sigma),
+                             pick(self.principal), pick(self.von_mises),
+                             self.normal_displacement[index], self.frame)
 
     def point_data(self) -> dict[str, Array]:
         """Flat fields for a mesh: resultants, von Mises per layer, normal displacement."""
@@ -80,22 +86,40 @@ class ShellStresses:
 
 
 def stresses(surface: Surface, material: ShellMaterial, displacement: ArrayLike,
-             u: ArrayLike, v: ArrayLike) -> ShellStresses:
-    """Stresses of a displacement net ``(n_u, n_v, 3)`` at ``u, v`` (broadcast to a shape ``S``)."""
+             u: ArrayLike, v: ArrayLike, at_poles: str = "raise") -> ShellStresses:
+    """Stresses of a displacement net ``(n_u, n_v, 3)`` at ``u, v`` (broadcast to a shape ``S``).
+
+    Several nets ``(F, n_u, n_v, 3)`` (frames, mode shapes) give every field with a
+    leading axis ``F`` (the geometry is evaluated once).
+
+    At a point where the surface degenerates (a pole, ``a_1 × a_2 = 0``) the local frame
+    and the stresses are undefined: ``at_poles="raise"`` refuses such a point,
+    ``"nan"`` gives NaN there (for output grids that run through a pole).
+    """
     net = np.asarray(displacement, dtype=float)
-    if net.shape != surface.shape + (3,):
-        raise InputError(f"a displacement net must have shape {surface.shape + (3,)}, "
-                         f"got {net.shape}")
+    if net.ndim not in (3, 4) or net.shape[-3:] != surface.shape + (3,):
+        raise InputError(f"a displacement net must have shape {surface.shape + (3,)} "
+                         f"(or (frames,) + that), got {net.shape}")
     u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
-    orders = ((1, 0), (0, 1), (2, 0), (1, 1), (0, 2))
-    a1, a2, a11, a12, a22 = (surface.derivative(u, v, p, q) for p, q in orders)
-    d1, d2, d11, d12, d22 = (surface.derivative(u, v, p, q, control_points=net)
-                             for p, q in orders)
+    orders = ((1, 0), (0, 1), (2, 0), (1, 1), (0, 2), (0, 0))
+    a1, a2, a11, a12, a22 = (surface.derivative(u, v, p, q) for p, q in orders[:5])
+    stacked = np.moveaxis(net.reshape((-1,) + net.shape[-3:]), 0, 2)      # (n_u, n_v, F, 3)
+    lead = net.shape[:-3]
+    d1, d2, d11, d12, d22, d0 = (
+        np.moveaxis(surface.derivative(u, v, p, q, control_points=stacked), -2, 0)
+        .reshape(lead + u.shape + (3,)) for p, q in orders)
     cross = np.cross(a1, a2)
     sqrt_g = np.linalg.norm(cross, axis=-1)
-    if np.any(sqrt_g <= 1e-12 * max(1.0, float(np.abs(surface.control_points).max())) ** 2):
+    scale = max(1.0, float(np.abs(surface.control_points).max()))
+    pole = sqrt_g <= 1e-9 * max(float(sqrt_g.max(initial=0.0)), 1e-300) + 1e-14 * scale ** 2
+    if np.any(pole) and at_poles != "nan":
         raise InputError("the surface is degenerate (a_1 × a_2 = 0) at some of the given "
                          "parameters (a pole); its stresses are undefined there")
+    if np.any(pole):                     # a regular stand-in frame, results set NaN below
+        a1, a2 = np.where(pole[..., None], [1.0, 0.0, 0.0], a1), \
+            np.where(pole[..., None], [0.0, 1.0, 0.0], a2)
+        cross = np.cross(a1, a2)
+        sqrt_g = np.linalg.norm(cross, axis=-1)
     a3 = cross / sqrt_g[..., None]
     dot = lambda x, y: np.sum(x * y, axis=-1)  # noqa: E731
     eps = np.stack([dot(a1, d1), dot(a2, d2), dot(a1, d2) + dot(a2, d1)], -1)
@@ -117,10 +141,17 @@ def stresses(surface: Surface, material: ShellMaterial, displacement: ArrayLike,
     c = np.stack([np.stack([dot(e, a1), dot(e, a2)], -1) for e in (e1, e2)], -2)
     N, M = _physical(n, c), _physical(m, c)
     sigma = {layer: N / t + z * 6 * M / t ** 2 for layer, z in LAYERS.items()}
-    normal = dot(surface.derivative(u, v, control_points=net), a3)
-    return ShellStresses(N, M, sigma, {k: principal(s) for k, s in sigma.items()},
-                         {k: von_mises(s) for k, s in sigma.items()}, normal,
-                         np.stack([e1, e2, a3], -2))
+    normal = dot(d0, a3)
+    out = ShellStresses(N, M, sigma, {k: principal(s) for k, s in sigma.items()},
+                        {k: von_mises(s) for k, s in sigma.items()}, normal,
+                        np.stack([e1, e2, a3], -2))
+    if np.any(pole):
+        out.frame[pole] = np.nan
+        for array in (N, M, normal, *sigma.values(), *out.principal.values(),
+                      *out.von_mises.values()):
+            where = pole.reshape(pole.shape + (1,) * (array.ndim - len(lead) - pole.ndim))
+            np.copyto(array, np.nan, where=np.broadcast_to(where, array.shape))
+    return out
 
 
 def _physical(T: Array, c: Array) -> Array:
