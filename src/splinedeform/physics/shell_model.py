@@ -33,6 +33,7 @@ from . import metric
 from .shell import ShellMaterial, matrices
 from .shell_edges import EDGES, KINDS, check_edges, constraint_matrix  # noqa: F401
 from .shell_rigid import describe, free_rigid_motions
+from .shell_solve import dissection_ranks, static_displacement, unknown_order
 from .shell_solution import ShellModalSolution, ShellStaticSolution
 from .shell_stress import ShellStresses, stresses
 
@@ -137,7 +138,20 @@ class ShellModel:
             "the shell against them (pin or clamp an edge, or fix components), or apply a "
             "self-equilibrated load")
 
+    def unknown_order(self) -> NDArray[np.int64]:
+        """The reduced unknowns in nested dissection order of their control points."""
+        if getattr(self, "_order", None) is None:
+            bu, bv = self.surface.basis_u, self.surface.basis_v
+            rank = dissection_ranks(bu.size, bv.size, (bu.degree, bv.degree),
+                                    bu.kind == "periodic", bv.kind == "periodic")
+            self._order = unknown_order(self.T, rank, np.arange(self.n_free))
+        return self._order
+
     def _static_solve(self, F: Array) -> Array:
+        """Nested dissection and no pivoting (:mod:`.shell_solve`), else the bordered system."""
+        d = static_displacement(self._K, self._M, self.rigid, F, self.unknown_order())
+        if d is not None:
+            return d
         C = self._M @ self.rigid
         k = C.shape[1]
         A = sp.bmat([[self._K, sp.csr_matrix(C)], [sp.csr_matrix(C.T), None]], format="csc")
