@@ -198,7 +198,8 @@ class ShellModel:
         """The lowest ``k`` modes by shift-invert Lanczos, refusals in the shell's words."""
         try:
             return modal_basis.sparse_basis(self._K, self._M, k, None, self.rigid.shape[1],
-                                            **self._guard(check_spectrum))
+                                            **self._guard(check_spectrum),
+                                            order=self.unknown_order())
         except UnresolvedSpectrum:
             raise
         except SingularSystemError:
