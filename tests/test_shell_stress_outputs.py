@@ -44,7 +44,7 @@ kind = "static"
 frames = 3
 
 [output]
-formats = ["report", "vtu"]
+formats = ["report", "vtu", "images"]
 resolution = 9
 probes = [[0.0, 2.0]]
 """
@@ -106,6 +106,11 @@ def test_pressurised_cylinder_stresses_in_report_and_series(tmp_path):
         np.testing.assert_allclose(field, value, rtol=5e-3)             # ends: as above
     first = meshio.read(sorted(tmp_path.glob("*_0000.vtu"))[0])
     assert np.abs(first.point_data["von_mises_top"]).max() == 0.0     # at rest: unloaded
+    # the picture coloured by von Mises: two panels (top, bottom face) and the colour bar
+    from PIL import Image
+
+    with Image.open(tmp_path / "stresses.png") as picture:
+        assert picture.size == (950, 400)
 
 
 def test_plate_mode_von_mises_maximum_in_the_report(tmp_path):

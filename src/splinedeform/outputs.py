@@ -58,6 +58,8 @@ def planned_outputs(result: RunResult) -> list[str]:
             names.append("probes.png")
         if result.omegas is not None:
             names.append("modes.png")
+        if getattr(result.built.model, "physics", None) == "shell":
+            names.append("stresses.png")
     names += [f"{name}.{ext}" for ext in ("gif", "mp4") if ext in formats]
     names += ["viewer.html"] if "viewer" in formats else []
     names += ["report.json", "report.md"] if "report" in formats else []
@@ -223,6 +225,16 @@ def _write_images(result: RunResult, folder: Path, stages: Stages) -> None:
         if result.omegas is not None:
             result.outputs.append(("mode shapes", viz.plot_modes(
                 folder / "modes.png", surface, result.omegas, result.mode_shapes)))
+        from .export.shell_fields import is_shell, peak_stress_frame
+
+        if is_shell(result.built.model):
+            from .viz.stresses import render_stresses
+
+            f = peak_stress_frame(result.built.model, rest, result.nets,
+                                  result.scenario.output.resolution)
+            result.outputs.append(("stress picture", render_stresses(
+                folder / "stresses.png", result.built.model, rest, result.nets[f],
+                f"{label} = {result.times[f]:.4g}", result.scenario.output.resolution)))
 
 
 def _write_animation(result: RunResult, path: Path, stages: Stages) -> None:

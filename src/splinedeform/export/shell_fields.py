@@ -59,6 +59,17 @@ def stress_fields(model: Any, rest: Array, nets: Array, resolution: int
     return fields
 
 
+def peak_stress_frame(model: Any, rest: Array, nets: Array, resolution: int) -> int:
+    """Index of the frame with the largest von Mises stress on the output grid (first such)."""
+    best = (-1.0, 0)
+    for first, chunk in frame_chunks(model, rest, nets, resolution):
+        peaks = np.max([np.nan_to_num(s, nan=0.0).reshape(len(chunk.N), -1).max(axis=1)
+                        for s in chunk.von_mises.values()], axis=0)
+        f = int(np.argmax(peaks))
+        best = max(best, (float(peaks[f]), -(first + f)))
+    return -best[1]
+
+
 def stress_report(model: Any, rest: Array, times: Array, nets: Array, resolution: int,
                   probe_points: dict[str, tuple[float, float]], frame_label: str
                   ) -> dict[str, Any]:
