@@ -220,7 +220,7 @@ class ShellModel:
 
     def stresses(self, displacement: ArrayLike, u: ArrayLike, v: ArrayLike,
                  at_poles: str = "raise") -> ShellStresses:
-        """Stresses of a displacement net ``(n_u, n_v, 3)`` (a solution's, a mode shape) at ``(u, v)``.
+        """Stresses of a displacement net ``(n_u, n_v, 3)`` (a solution's, a mode's) at ``u, v``.
 
         See :func:`.shell_stress.stresses`: ``N``, ``M`` in the local frame, ``σ`` at top,
         middle and bottom, principal and von Mises stresses, normal displacement;
