@@ -61,6 +61,8 @@ def planned_outputs(result: RunResult) -> list[str]:
             names.append("probes.png")
         if result.omegas is not None:
             names.append("modes.png")
+        if getattr(result.built.model, "physics", None) == "shell":
+            names.append("stresses.png")
     names += [f"{name}.{ext}" for ext in ("gif", "mp4") if ext in formats]
     names += ["viewer.html"] if "viewer" in formats else []
     names += ["report.json", "report.md"] if "report" in formats else []
@@ -143,9 +145,13 @@ def _write_files(result: RunResult, folder: Path, stages: Stages) -> None:
                 result.outputs.append((f"mesh .{ext}", export.write_mesh(
                     folder / f"{name}.{ext}", vertices, faces, point_data=data)))
     if "vtu" in formats:
+        from .export.shell_fields import is_shell, stress_fields
+
+        model = result.built.model          # a shell's frames also carry its stresses
+        fields = stress_fields(model, rest, nets, res) if is_shell(model) else None
         with stages.stage("time series"):
             result.outputs.append(("time series .pvd", export.write_time_series(
-                folder, name, surface, rest, times, nets, resolution=res)))
+                folder, name, surface, rest, times, nets, resolution=res, fields=fields)))
     if "json" in formats or "npz" in formats:
         with stages.stage("control nets"):
             wanted = [ext for ext in export.CONTROL_NET_FORMATS if ext in formats]
@@ -272,6 +278,16 @@ def _write_images(result: RunResult, folder: Path, stages: Stages) -> None:
             result.outputs.append(("mode shapes", viz.plot_modes(
                 folder / "modes.png", surface, result.omegas, result.mode_shapes,
                 camera=result.scenario.output.camera)))
+        from .export.shell_fields import is_shell, peak_stress_frame
+
+        if is_shell(result.built.model):
+            from .viz.stresses import render_stresses
+
+            f = peak_stress_frame(result.built.model, rest, result.nets,
+                                  result.scenario.output.resolution)
+            result.outputs.append(("stress picture", render_stresses(
+                folder / "stresses.png", result.built.model, rest, result.nets[f],
+                f"{label} = {result.times[f]:.4g}", result.scenario.output.resolution)))
 
 
 def _write_animation(result: RunResult, path: Path, stages: Stages, nets: Any = None,
@@ -336,10 +352,16 @@ def make_report(result: RunResult) -> dict[str, Any]:
                    "max displacement": result.max_displacement},
         "timings": {**_solution_timings(result), **result.timings},
     }
+    from .export.shell_fields import is_shell, mode_maxima, stress_report
+
+    shell = is_shell(result.built.model)
     if result.omegas is not None:
         report["modes"] = {"mode": list(range(1, len(result.omegas) + 1)),
                            "omega": result.omegas,
                            "frequency (omega / 2 pi)": np.asarray(result.omegas) / (2 * np.pi)}
+        if shell and result.shell_modes is not None:
+            report["modes"].update(mode_maxima(result.built.model, result.shell_modes,
+                                               s.output.resolution))
     if result.energy is not None:
         report["energies"] = result.energy
     frame_label = {"dynamic": "time", "static": "load factor", "modes": "phase"}[s.solve.kind]
@@ -348,6 +370,10 @@ def make_report(result: RunResult) -> dict[str, Any]:
         probes.update({f"{name} d{c}": d[:, i] for i, c in enumerate("xyz")})
         probes[f"{name} magnitude"] = np.linalg.norm(d, axis=1)
     report["probes"] = probes
+    if shell:
+        report.update(stress_report(result.built.model, result.rest_net, result.times,
+                                    result.nets, s.output.resolution, result.probe_points,
+                                    frame_label))
     return report
 
 

@@ -48,6 +48,8 @@ class RunResult:
     #: each computed mode as a displacement of the control net ``(k, n_u, n_v, 3)``, scaled
     #: as the frames of a modes solve draw it (:func:`mode_displacements`)
     mode_nets: Any = None
+    #: the shell's mass-normalised mode shapes ``(k, n_u, n_v, 3)`` (None otherwise)
+    shell_modes: Any = None
     probes: dict[str, Any] = field(default_factory=dict)
     probe_points: dict[str, tuple[float, float]] = field(default_factory=dict)
     energy: dict[str, Any] | None = None
@@ -191,10 +193,13 @@ def _solve(scenario: Scenario, built: Built, stages: _Stages) -> RunResult:
     mode_nets = None if shapes is None else mode_displacements(built.surface, shapes)
     with stages.stage("frames"), _located(scenario, "solve"):
         nets = _frames(scenario, built, solution, times, mode_nets)
+    shell_modes = None
     if shapes is not None and shapes.ndim == 4:     # the shell's modes move x, y, z
+        shell_modes = shapes
         shapes = np.einsum("kabc,abc->kab", shapes, _net_normals(built.surface))
     result = RunResult(scenario=scenario, built=built, solution=solution, times=times,
-                       nets=nets, omegas=omegas, mode_shapes=shapes, mode_nets=mode_nets)
+                       nets=nets, omegas=omegas, mode_shapes=shapes, mode_nets=mode_nets,
+                       shell_modes=shell_modes)
     with np.errstate(over="ignore", invalid="ignore"):
         _measure(result)
     _require_finite(result)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -45,7 +45,8 @@ def frame_file_names(stem: str, count: int) -> list[str]:
 
 def write_time_series(directory: str | os.PathLike[str], stem: str, surface: Surface,
                       rest_net: ArrayLike, times: ArrayLike, nets: ArrayLike,
-                      resolution: int = 32) -> Path:
+                      resolution: int = 32,
+                      fields: Callable[[int], Mapping[str, np.ndarray]] | None = None) -> Path:
     """Write the motion as a ParaView time series: ``stem.pvd`` plus ``stem_0000.vtu``, ...
 
     Every frame holds the **rest** geometry ``X_0 = B_u P_rest B_vᵀ`` as its points and
@@ -53,7 +54,10 @@ def write_time_series(directory: str | os.PathLike[str], stem: str, surface: Sur
 
     * ``displacement`` ``= B_u (P_f - P_rest) B_vᵀ`` (3 components): the deformed surface
       is ``X_0 + displacement``, which is what ParaView's *Warp By Vector* (scale 1) draws;
-    * ``displacement_magnitude`` ``= |displacement|``, for colouring.
+    * ``displacement_magnitude`` ``= |displacement|``, for colouring;
+    * with ``fields``, the arrays ``fields(f)`` of frame ``f``, one row per point of the
+      ``surface.sample_parameters(resolution)`` grid in row-major order (e.g. a shell's
+      stresses, :func:`splinedeform.export.shell_fields.stress_fields`).
 
     The points are the same in every frame, so a warp by the field is applied exactly
     once. Grid points that coincide at rest and in every frame (a periodic seam, a pole)
@@ -95,6 +99,8 @@ def write_time_series(directory: str | os.PathLike[str], stem: str, surface: Sur
     names = frame_file_names(stem, t.size)
     for f, name in enumerate(names):
         d = X[f] - X0
-        write_mesh(folder / name, X0, faces,
-                   {"displacement": d, "displacement_magnitude": np.linalg.norm(d, axis=1)})
+        data = {"displacement": d, "displacement_magnitude": np.linalg.norm(d, axis=1)}
+        if fields is not None:
+            data.update({key: np.asarray(value)[keep] for key, value in fields(f).items()})
+        write_mesh(folder / name, X0, faces, data)
     return write_text(folder / f"{stem}.pvd", pvd_text(list(zip(t.tolist(), names))))
