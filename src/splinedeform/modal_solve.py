@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import time
 import weakref
+from collections.abc import Callable
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -27,28 +29,49 @@ if TYPE_CHECKING:
 
 Array = NDArray[np.float64]
 _KRYLOV: weakref.WeakKeyDictionary[Any, BlockLanczos] = weakref.WeakKeyDictionary()
+"""Per model: the Krylov space and LU of the automatic mode count, kept for further load
+cases (a model's ``K`` and ``M`` never change; the space lives as long as the model)."""
 #: up to this many free coordinates ``tolerance=`` takes all modes at once: the dense
 #: eigen-solution is cheaper than starting the sparse one (cost study, 2026-11-29: 16²
 #: plate, 225 free, 0.04 s all modes against 0.16 s for the sparse path, which then needed
 #: more than half the modes anyway; at 32², 961 free, the sparse path was the faster)
 DENSE_BELOW = 256
-"""Per model: the Krylov space and LU of the automatic mode count, kept for further load
-cases (a model's ``K`` and ``M`` never change; the space lives as long as the model)."""
+DEFAULT_TOLERANCE = 1e-8
+"""The accuracy :meth:`splinedeform.Model.dynamic` keeps by default: largest control-point
+coordinate error at most this fraction of the largest static displacement, at any time."""
+DEFAULT_TIMES = 201
+"""Without ``times=`` the modes are chosen for this many evenly spaced times on ``[0, t_end]``."""
+_POINTWISE: weakref.WeakKeyDictionary[Any, float] = weakref.WeakKeyDictionary()
 
 
 def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
-             function_samples: int = 400, modes: int | None = None,
+             function_samples: int = 400, modes: int | str | None = None,
              omega_max: float | None = None, eigensolver: str = "auto",
              tolerance: float | None = None, times: ArrayLike | None = None
              ) -> ModalSolution:
     """Closed-form modal solution; ``modes``/``omega_max`` truncate with mode acceleration,
-    ``tolerance`` chooses the number of modes (:mod:`~splinedeform.solvers.mode_count`)."""
+    ``tolerance`` chooses the number of modes (:mod:`~splinedeform.solvers.mode_count`).
+
+    With none of ``modes``, ``omega_max`` and ``tolerance`` the modes are chosen for
+    :data:`DEFAULT_TOLERANCE` where the bound applies (piecewise-constant loads from rest,
+    no rigid modes) and all modes are taken otherwise; ``modes="all"`` takes all modes.
+    """
+    requested = tolerance
+    if isinstance(modes, str):
+        if modes != "all":
+            raise InputError(f"modes must be an integer >= 1 or 'all', got {modes!r}")
+        if tolerance is not None or omega_max is not None:
+            raise InputError("modes='all' takes every mode: give it without tolerance= or "
+                             "omega_max=")
+        modes = None
+    elif modes is None and omega_max is None and tolerance is None:
+        tolerance = DEFAULT_TOLERANCE
     modes, omega_max = truncation_request(model, modes, omega_max)
     # the reduced force terms in space: modal terms of the identity basis
     spatial = forcing.modal_terms(sp.identity(model.n_free, format="csr"), t_end,
                                   function_samples)
     report: dict[str, Any] = {}
-    if tolerance is not None:
+    if tolerance is not None and (requested is not None or _bound_applies(model, spatial, d0, v0)):
         report = _automatic_modes(model, spatial, d0, v0, t_end, tolerance, times,
                                   modes, omega_max)
         if report["modes"] < model.n_free:
@@ -63,6 +86,7 @@ def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
     response = ModalResponse(lam, c, basis.project(M @ d0), basis.project(M @ v0),
                              jumps, harmonics)
     correction, truncation = report.pop("correction", None), {}
+    estimate, chosen_at = report.pop("estimate", None), report.pop("times", None)
     if not basis.complete:
         correction, truncation = _truncation(model, basis, spatial, d0, v0, correction)
     if report:
@@ -70,16 +94,57 @@ def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
                                                         "static_residual") if key in report})
     timings = dict(model.timings)
     timings["modal setup"] = time.perf_counter() - start
+    accuracy = None
+    if estimate is not None and not basis.complete:
+        accuracy = Accuracy(float(report["tolerance"]), estimate, chosen_at,
+                            lambda at: analytic(model, forcing, t_end, d0, v0,
+                                                function_samples, tolerance=report["tolerance"],
+                                                times=at))
     return ModalSolution(model.readout, t_end, forcing, timings, basis, response, truncation,
-                         correction)
+                         correction, accuracy)
+
+
+@dataclass
+class Accuracy:
+    """What keeps a solution of the automatic mode count within ``tolerance`` at any time.
+
+    ``estimate`` bounds the error of the solution's basis at any ``t``; times at which it
+    exceeds ``tolerance`` (only just after a load jump: the bound is non-increasing between
+    jumps) are computed by ``refine(times)``, a solution whose modes are chosen for exactly
+    those times. ``chosen_at``: the times the basis was chosen for (the bound holds there).
+    """
+
+    tolerance: float
+    estimate: mode_select.ErrorEstimate
+    chosen_at: Array
+    refine: Callable[[Array], ModalSolution]
+
+    def outside(self, times: Array) -> Array:
+        """Mask of the ``times`` at which the basis' bound exceeds the tolerance."""
+        times = np.asarray(times, dtype=float)
+        ask = ~np.isin(times, self.chosen_at)
+        out = np.zeros(times.shape, dtype=bool)
+        if np.any(ask):
+            out[ask] = self.estimate.relative(times[ask]) > self.tolerance
+        return out
+
+
+def _bound_applies(model: Model, spatial: tuple[list, list], d0: Array, v0: Array) -> bool:
+    """Whether the automatic mode count's bound covers the problem (piecewise-constant
+    load from rest, no rigid modes) and the net is large enough for it to pay."""
+    return bool(not spatial[1] and not np.any(d0) and not np.any(v0)
+                and model.rigid_modes == 0 and model.n_free > DENSE_BELOW)
+
 
 def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Array,
                      t_end: float, tolerance: Any, times: ArrayLike | None,
                      modes: int | None, omega_max: float | None) -> dict[str, Any]:
-    """Lowest modes meeting ``tolerance`` (relative M-norm at ``times``): the report of
+    """Lowest modes meeting ``tolerance`` (largest control-point coordinate error relative
+    to the largest static displacement, at ``times``): the report of
     :func:`~splinedeform.solvers.mode_select.automatic_basis` (``modes = n_free``: all),
-    with its static correction under ``"correction"``; all modes, exact, on nets of at most
-    :data:`DENSE_BELOW` free coordinates."""
+    with its static correction under ``"correction"``, its error estimate under
+    ``"estimate"``; all modes, exact, on nets of at most :data:`DENSE_BELOW` free
+    coordinates."""
     try:
         tolerance = float(tolerance)
     except (TypeError, ValueError):
@@ -93,20 +158,38 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
                          "rest on a model without rigid modes; give modes=k otherwise")
     if model.n_free <= DENSE_BELOW:
         return {"tolerance": tolerance, "modes": model.n_free, "bound": 0.0}
-    at = np.linspace(0.0, t_end, 201) if times is None else np.asarray(times, dtype=float)
+    at = (np.linspace(0.0, t_end, DEFAULT_TIMES) if times is None
+          else np.asarray(times, dtype=float).ravel())
     m = model.material
     M, _, K = model.matrices()
     krylov = _KRYLOV.get(model)
     if krylov is None:
         krylov = _KRYLOV[model] = BlockLanczos(K, M)
     basis, correction, report = mode_select.automatic_basis(
-        K, M, spatial[0], m.damping / m.mass, m.rayleigh, at, tolerance, krylov=krylov)
+        K, M, spatial[0], m.damping / m.mass, m.rayleigh, at, tolerance, krylov=krylov,
+        pointwise=pointwise_factor(model))
     if basis is None:
         report["modes"] = model.n_free
     else:
         model._bases[("sparse", report["modes"], None)] = basis
         report["correction"] = correction
+        report["times"] = at
     return report
+
+
+def pointwise_factor(model: Model) -> float:
+    """``c_∞ ≥ max_p √((M_r⁻¹)_pp)`` of the model (:func:`.mode_select.pointwise_bound`):
+    for the parametric consistent mass ``M = μ G0u⊗G0v`` the diagonal of ``M⁻¹`` is the
+    Kronecker product of the 1-D ones over ``μ``; cached per model."""
+    if model not in _POINTWISE:
+        M = model.matrices()[0]
+        inverse = None
+        if model.physics == "parametric" and model.mass_matrix == "consistent":
+            gu, gv = (np.diag(np.linalg.inv(g[0].toarray())) for g in (model.gram_u,
+                                                                       model.gram_v))
+            inverse = np.kron(gu, gv) / model.material.mass
+        _POINTWISE[model] = mode_select.pointwise_bound(M, model.constraints.T, inverse)
+    return _POINTWISE[model]
 
 def truncation_request(model: Model, modes: int | None, omega_max: float | None
                        ) -> tuple[int | None, float | None]:

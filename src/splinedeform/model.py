@@ -36,6 +36,7 @@ from .solvers import modal_basis, numeric
 from .solvers.forcing import ReducedForcing
 from .solvers.system import KroneckerFactors, Reduction
 from .surface import Surface
+from .threads import owned
 
 Array = NDArray[np.float64]
 METHODS = ("analytic", "newmark", "radau3", "radau5", "radau7", "genalpha", "rk45", "dop853",
@@ -183,6 +184,7 @@ class Model:
         return np.asarray(self.constraints.T.T @ F_full)
 
     # -- static ----------------------------------------------------------------------
+    @owned
     def static(self, load: Load | None, t: float | None = None) -> StaticSolution:
         """Equilibrium ``K_r d = Tᵀ F(t)`` by a sparse direct solve.
 
@@ -240,6 +242,7 @@ class Model:
             "Raise the smallest weight, or use fewer cells or a lower degree")
 
     # -- modes -------------------------------------------------------------------------
+    @owned
     def eigen(self, k: int | None = None) -> tuple[Array, Array]:
         """Lowest ``k`` (default all) eigenpairs of ``K_r φ = λ M_r φ`` with ``Φᵀ M_r Φ = I``.
 
@@ -254,6 +257,7 @@ class Model:
         """
         return spectrum.eigen(self, None if k is None else _check_count(k, self.n_free))
 
+    @owned
     def modal_basis(self, eigensolver: str = "auto", modes: int | None = None,
                     omega_max: float | None = None) -> modal_basis.ModalBasis:
         """Modes as a :class:`~splinedeform.solvers.modal_basis.ModalBasis` (cached).
@@ -313,6 +317,7 @@ class Model:
             raise InputError(f"{what} moves control points that the boundary conditions fix")
         return free
 
+    @owned
     def dynamic(self, load: Load | None, t_end: float, method: str = "analytic",
                 times: ArrayLike | None = None, initial_displacement: ArrayLike | None = None,
                 initial_velocity: ArrayLike | None = None, **options: Any) -> Any:
@@ -356,9 +361,7 @@ class Model:
         d0, v0 = self.initial_state(initial_displacement, initial_velocity)
         forcing = ReducedForcing(self.reduction, load)
         if method == "analytic":
-            if options.get("tolerance") is not None:
-                options["times"] = times
-            return self._analytic(forcing, t_end, d0, v0, **options)
+            return self._analytic(forcing, t_end, d0, v0, times=times, **options)
         start = time.perf_counter()
         M, C, K = self.matrices()
         out_times, d, v, stats = numeric.run(M, C, K, forcing, forcing.breakpoints, method,
