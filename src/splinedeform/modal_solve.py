@@ -18,11 +18,13 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
+from . import spectrum
 from .errors import InputError
 from .solution import ModalSolution
 from .solvers import modal_basis, mode_select
 from .solvers.sparse_eigen import BlockLanczos
 from .solvers.analytic import ModalResponse
+from .solvers.rigid import UnresolvedSpectrum
 
 if TYPE_CHECKING:
     from .model import Model
@@ -31,11 +33,11 @@ Array = NDArray[np.float64]
 _KRYLOV: weakref.WeakKeyDictionary[Any, BlockLanczos] = weakref.WeakKeyDictionary()
 """Per model: the Krylov space and LU of the automatic mode count, kept for further load
 cases (a model's ``K`` and ``M`` never change; the space lives as long as the model)."""
-#: up to this many free coordinates ``tolerance=`` takes all modes at once: the dense
-#: eigen-solution is cheaper than starting the sparse one (cost study, 2026-11-29: 16²
-#: plate, 225 free, 0.04 s all modes against 0.16 s for the sparse path, which then needed
-#: more than half the modes anyway; at 32², 961 free, the sparse path was the faster)
-DENSE_BELOW = 256
+#: up to this many free coordinates the automatic mode count takes all modes at once: the
+#: dense eigen-solution costs no more than the sparse one (one BLAS thread, the bench
+#: plate at 1e-8, load average 4: 32², 961 free, 1.7 s all modes against 1.6 s for 201
+#: sparse modes; 24², 529 free, 0.18 s against 0.77 s; at 64² 35 s against 5 s)
+DENSE_BELOW = 1024
 DEFAULT_TOLERANCE = 1e-8
 """The accuracy :meth:`splinedeform.Model.dynamic` keeps by default: largest control-point
 coordinate error at most this fraction of the largest static displacement, at any time."""
@@ -71,9 +73,15 @@ def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
     spatial = forcing.modal_terms(sp.identity(model.n_free, format="csr"), t_end,
                                   function_samples)
     report: dict[str, Any] = {}
-    if tolerance is not None and (requested is not None or _bound_applies(model, spatial, d0, v0)):
+    if requested is not None:
         report = _automatic_modes(model, spatial, d0, v0, t_end, tolerance, times,
                                   modes, omega_max)
+    elif tolerance is not None and _bound_applies(model, spatial, d0, v0, eigensolver):
+        try:
+            report = _automatic_modes(model, spatial, d0, v0, t_end, tolerance, times,
+                                      modes, omega_max)
+        except UnresolvedSpectrum:
+            report = {}                  # all modes: the auto eigen-solution resolves them
         if report["modes"] < model.n_free:
             modes, eigensolver = report["modes"], "sparse"
     basis = model.modal_basis(eigensolver, modes, omega_max)
@@ -129,11 +137,15 @@ class Accuracy:
         return out
 
 
-def _bound_applies(model: Model, spatial: tuple[list, list], d0: Array, v0: Array) -> bool:
-    """Whether the automatic mode count's bound covers the problem (piecewise-constant
-    load from rest, no rigid modes) and the net is large enough for it to pay."""
-    return bool(not spatial[1] and not np.any(d0) and not np.any(v0)
-                and model.rigid_modes == 0 and model.n_free > DENSE_BELOW)
+def _bound_applies(model: Model, spatial: tuple[list, list], d0: Array, v0: Array,
+                   eigensolver: str) -> bool:
+    """Whether the default call counts its modes: the bound covers the problem
+    (piecewise-constant load from rest, no rigid modes), no eigensolver was asked for, and
+    all modes are not cheaper (more than :data:`DENSE_BELOW` free coordinates, no
+    separable factors, which give all modes in ``O(n^{3/2})``)."""
+    return bool(eigensolver == "auto" and not spatial[1] and not np.any(d0)
+                and not np.any(v0) and model.n_free > DENSE_BELOW
+                and model.rigid_modes == 0 and spectrum.separable_reason(model) is not None)
 
 
 def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Array,

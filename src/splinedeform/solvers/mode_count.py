@@ -47,7 +47,7 @@ def decay_bound(lam: Array, c: Array, tau: Array) -> Array:
     wd = np.sqrt(np.where(under, -d, 1.0))
     b_under = np.exp(-a * tau) * (1.0 + a * np.minimum(tau, 1.0 / wd))
     kappa = np.sqrt(np.where(under, 0.0, d))
-    rate = lam / np.maximum(a + kappa, 1e-300)
+    rate = lam / np.where(a + kappa > 0, a + kappa, 1.0)     # used where over-damped
     ratio = np.where(kappa > 0, (a + kappa) / (2.0 * np.where(kappa > 0, kappa, 1.0)), np.inf)
     b_over = np.exp(-rate * tau) * np.minimum(ratio, 1.0 + a * tau)
     out = np.minimum(out, np.where(under, b_under, b_over))
