@@ -82,8 +82,8 @@ def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
                                       modes, omega_max)
         except UnresolvedSpectrum:
             report = {}                  # all modes: the auto eigen-solution resolves them
-        if report["modes"] < model.n_free:
-            modes, eigensolver = report["modes"], "sparse"
+    if report and report["modes"] < model.n_free:
+        modes, eigensolver = report["modes"], "sparse"
     basis = model.modal_basis(eigensolver, modes, omega_max)
     start = time.perf_counter()
     M, _, K = model.matrices()
