@@ -49,8 +49,8 @@ _POINTWISE: weakref.WeakKeyDictionary[Any, float] = weakref.WeakKeyDictionary()
 def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
              function_samples: int = 400, modes: int | str | None = None,
              omega_max: float | None = None, eigensolver: str = "auto",
-             tolerance: float | None = None, times: ArrayLike | None = None
-             ) -> ModalSolution:
+             tolerance: float | None = None, times: ArrayLike | None = None,
+             _of_static: bool = False) -> ModalSolution:
     """Closed-form modal solution; ``modes``/``omega_max`` truncate with mode acceleration,
     ``tolerance`` chooses the number of modes (:mod:`~splinedeform.solvers.mode_count`).
 
@@ -75,7 +75,7 @@ def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
     report: dict[str, Any] = {}
     if requested is not None:
         report = _automatic_modes(model, spatial, d0, v0, t_end, tolerance, times,
-                                  modes, omega_max)
+                                  modes, omega_max, _of_static)
     elif tolerance is not None and _bound_applies(model, spatial, d0, v0, eigensolver):
         try:
             report = _automatic_modes(model, spatial, d0, v0, t_end, tolerance, times,
@@ -104,10 +104,11 @@ def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
     timings["modal setup"] = time.perf_counter() - start
     accuracy = None
     if estimate is not None and not basis.complete:
-        accuracy = Accuracy(float(report["tolerance"]), estimate, chosen_at,
+        of_static = float(report["of_static"])
+        accuracy = Accuracy(of_static, estimate, chosen_at,
                             lambda at: analytic(model, forcing, t_end, d0, v0,
-                                                function_samples, tolerance=report["tolerance"],
-                                                times=at))
+                                                function_samples, tolerance=of_static,
+                                                times=at, _of_static=True))
     return ModalSolution(model.readout, t_end, forcing, timings, basis, response, truncation,
                          correction, accuracy)
 
@@ -150,13 +151,21 @@ def _bound_applies(model: Model, spatial: tuple[list, list], d0: Array, v0: Arra
 
 def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Array,
                      t_end: float, tolerance: Any, times: ArrayLike | None,
-                     modes: int | None, omega_max: float | None) -> dict[str, Any]:
-    """Lowest modes meeting ``tolerance`` (largest control-point coordinate error relative
-    to the largest static displacement, at ``times``): the report of
+                     modes: int | None, omega_max: float | None, of_static: bool = False
+                     ) -> dict[str, Any]:
+    """Lowest modes meeting ``tolerance`` at ``times``: the largest control-point coordinate
+    error relative to the largest displacement on ``[0, t_end]`` (``of_static``: to the
+    largest static displacement ``S``). The report of
     :func:`~splinedeform.solvers.mode_select.automatic_basis` (``modes = n_free``: all),
     with its static correction under ``"correction"``, its error estimate under
-    ``"estimate"``; all modes, exact, on nets of at most :data:`DENSE_BELOW` free
-    coordinates."""
+    ``"estimate"`` and the tolerance relative to ``S`` it met under ``"of_static"``; all
+    modes, exact, on nets of at most :data:`DENSE_BELOW` free coordinates.
+
+    The bound is relative to ``S``. When the motion stays below it (a short horizon),
+    ``D = max_t |d_p(t)| − bound(t)·S`` at the coordinate ``p`` of ``S``, on the
+    :data:`DEFAULT_TIMES` grid and ``times``, is a lower bound of the largest displacement,
+    and the modes are chosen again for ``tolerance · D / S``.
+    """
     try:
         tolerance = float(tolerance)
     except (TypeError, ValueError):
@@ -177,9 +186,21 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
     krylov = _KRYLOV.get(model)
     if krylov is None:
         krylov = _KRYLOV[model] = BlockLanczos(K, M)
+    gamma, beta, c_inf = m.damping / m.mass, m.rayleigh, pointwise_factor(model)
     basis, correction, report = mode_select.automatic_basis(
-        K, M, spatial[0], m.damping / m.mass, m.rayleigh, at, tolerance, krylov=krylov,
-        pointwise=pointwise_factor(model))
+        K, M, spatial[0], gamma, beta, at, tolerance, krylov=krylov, pointwise=c_inf)
+    report["of_static"] = tolerance
+    if basis is not None and not of_static:
+        grid = np.union1d(np.linspace(0.0, t_end, DEFAULT_TIMES), at)
+        largest = _largest_below(basis, correction, report, spatial[0], gamma, beta, grid)
+        if largest < report["scale"]:
+            below = tolerance * max(largest, 0.0) / report["scale"]
+            basis, correction, report = (None, None, {"tolerance": tolerance}) if below <= 0 \
+                else mode_select.automatic_basis(K, M, spatial[0], gamma, beta, at, below,
+                                                 krylov=krylov, pointwise=c_inf)
+            report.update(tolerance=tolerance, of_static=below)
+            if basis is not None:
+                report["bound"] *= tolerance / below
     if basis is None:
         report["modes"] = model.n_free
     else:
@@ -187,6 +208,29 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
         report["correction"] = correction
         report["times"] = at
     return report
+
+
+def _largest_below(basis: Any, correction: Any, report: dict[str, Any], jumps: list,
+                   gamma: float, beta: float, times: Array) -> float:
+    """A lower bound of the largest displacement coordinate: at the coordinate of the
+    largest static displacement, ``max_t |d_m(t)| − bound(t) · S`` over ``times``
+    (``d_m``: the chosen basis with its static correction)."""
+    merged: dict[float, Array] = {}
+    for t_j, F in jumps:
+        merged[t_j] = merged.get(t_j, 0.0) + np.asarray(F, dtype=float)
+    order = sorted(merged)
+    coef = [basis.project(merged[t_j]) / basis.lam[:, None] for t_j in order]
+    statics = np.cumsum([basis.expand(g[None])[0] + part
+                         for g, part in zip(coef, correction.jump_parts)], axis=0)
+    _, p, c = np.unravel_index(int(np.argmax(np.abs(statics))), statics.shape)
+    lam = basis.lam
+    zero = np.zeros((lam.size, 3))
+    response = ModalResponse(lam, gamma + beta * lam, zero, zero,
+                             [(t_j, basis.project(merged[t_j])) for t_j in order], [])
+    row = basis.columns(np.arange(lam.size))[p]
+    d = response(times)[0][:, :, c] @ row + correction(times)[:, p, c]
+    error = report["estimate"].relative(times) * report["scale"]
+    return float(np.max(np.abs(d) - error))
 
 
 def pointwise_factor(model: Model) -> float:

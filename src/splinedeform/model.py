@@ -330,18 +330,27 @@ class Model:
             ``analytic`` is the closed-form modal solution, valid at any ``t``.
             Numerical methods integrate to the output ``times``.
         times : array, optional
-            Output times for numerical methods (default 201 evenly spaced on ``[0, t_end]``).
+            Output times for numerical methods (default 201 evenly spaced on ``[0, t_end]``);
+            for ``analytic``, the times the modes are chosen for (below).
         options
-            ``analytic``: ``function_samples`` (piecewise-constant sampling of time-dependent
-            ``Function`` loads, default 400); ``modes`` (keep the lowest k modes) or
-            ``omega_max`` (keep ``ω <= omega_max``), both with the exact static part of the
-            omitted modes (mode acceleration) and a report in ``solution.truncation``;
-            ``tolerance`` (piecewise-constant loads from rest): the fewest lowest modes for
-            which an a-priori bound of the omitted modes' dynamic response at ``times``
-            (default 201 on ``[0, t_end]``; one time for one state) is at most ``tolerance``
-            of the largest static displacement in the M-norm
-            (:mod:`splinedeform.solvers.mode_select`), the bound reached in
-            ``solution.truncation["bound"]``;
+            ``analytic``: by default (no ``modes``, ``omega_max`` or ``tolerance``) the modes
+            are chosen for ``tolerance = 1e-8``
+            (:data:`splinedeform.modal_solve.DEFAULT_TOLERANCE`) where the bound applies
+            (piecewise-constant loads from rest, no rigid modes, more than 1024 free
+            coordinates and no separable factors), all modes otherwise;
+            ``modes="all"`` takes all modes. ``tolerance``: the fewest lowest modes, plus
+            the exact static part of the rest, for which an a-priori bound of the omitted
+            modes' dynamic response ``c_∞ Σ_j ‖R_j‖_M E(t − t_j)`` is at most ``tolerance``
+            of the largest static displacement ``max_t ‖K⁻¹F(t)‖_∞``, in the largest
+            control-point coordinate (``c_∞ ≥ max_p √((M⁻¹)_pp)``,
+            :mod:`splinedeform.solvers.mode_select`) at ``times`` (default 201 on
+            ``[0, t_end]``; one time for one state). It holds at **any** time asked later:
+            ``E`` never grows between jumps, and a time where the basis' bound misses
+            (just after a jump) is computed with modes chosen for it
+            (``solution.accuracy``); the bound reached is ``solution.truncation["bound"]``.
+            ``modes`` (keep the lowest k modes) or ``omega_max`` (keep ``ω <= omega_max``),
+            both with the exact static part of the omitted modes (mode acceleration) and a
+            report in ``solution.truncation``;
             ``eigensolver`` (``"auto"``, ``"dense"``, ``"separable"``, ``"sparse"``, see
             :func:`splinedeform.solvers.modal_basis.choose`). ``newmark``: ``dt``.
             ``radau3/5/7`` (Radau IIA, order 5/9/13) and ``genalpha``: ``dt`` or

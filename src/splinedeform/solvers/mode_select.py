@@ -248,7 +248,7 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
                        for p, s in zip(parts, statics)]
             residual = [np.linalg.norm(K @ s - f) / max(np.linalg.norm(f), 1e-300)
                         for s, f in zip(statics, F)]
-            report.update(modes=m, bound=float(relative[m]),
+            report.update(modes=m, bound=float(relative[m]), scale=float(scale),
                           omitted_static=float(max(omitted, default=0.0)),
                           static_residual=float(max(residual, default=0.0)),
                           estimate=ErrorEstimate(jump_times, norms[:, m], float(lam[m]),
