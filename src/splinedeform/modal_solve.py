@@ -117,10 +117,11 @@ def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
 class Accuracy:
     """What keeps a solution of the automatic mode count within ``tolerance`` at any time.
 
-    ``estimate`` bounds the error of the solution's basis at any ``t``; times at which it
-    exceeds ``tolerance`` (only just after a load jump: the bound is non-increasing between
-    jumps) are computed by ``refine(times)``, a solution whose modes are chosen for exactly
-    those times. ``chosen_at``: the times the basis was chosen for (the bound holds there).
+    ``estimate`` bounds the error of the solution's basis at any ``t``; when it exceeds
+    ``tolerance`` at a time asked (only just after a load jump: the bound is
+    non-increasing between jumps), ``refine(times)`` gives a solution whose modes are chosen
+    for ``times``, which the solution then keeps. ``chosen_at``: the times the basis was
+    chosen for (the bound holds there).
     """
 
     tolerance: float

@@ -258,8 +258,10 @@ class ModalSolution(Solution):
     its truncation in ``truncation`` (see :meth:`splinedeform.Model.dynamic`). Times are
     processed in chunks of about :attr:`chunk_entries` modal values so that many frames of a
     large net fit in memory. ``accuracy`` (automatic mode count) keeps every time asked
-    within its tolerance: times where the basis' bound exceeds it (just after a load jump)
-    are computed with more modes (:class:`splinedeform.modal_solve.Accuracy`).
+    within its tolerance: when a time asked is one where the basis' bound exceeds it (just
+    after a load jump), the modes are chosen again for the times asked and those chosen
+    for before, and the solution keeps the new basis
+    (:class:`splinedeform.modal_solve.Accuracy`).
     """
 
     chunk_entries = 4_000_000
@@ -286,16 +288,19 @@ class ModalSolution(Solution):
     def _displacements(self, times: Array, velocities: bool) -> tuple[Array, Array | None]:
         """``d`` (and ``v``) at ``times``; with an ``accuracy`` (automatic mode count), the
         times where its bound exceeds the tolerance come from a solution chosen for them."""
-        if self.accuracy is not None:
-            finer = self.accuracy.outside(times)
-            if np.any(finer):
-                d, v = self._own(times, velocities)
-                refined = self.accuracy.refine(times[finer])
-                d[finer], v_finer = refined._displacements(times[finer], velocities)
-                if v is not None and v_finer is not None:
-                    v[finer] = v_finer
-                return d, v
+        if self.accuracy is not None and np.any(self.accuracy.outside(times)):
+            self._choose_again(times)
         return self._own(times, velocities)
+
+    def _choose_again(self, times: Array) -> None:
+        """Take the basis chosen for these ``times`` and those it was chosen for (the same
+        Krylov space, extended): later calls use it too."""
+        assert self.accuracy is not None
+        finer = self.accuracy.refine(np.union1d(self.accuracy.chosen_at, times))
+        self.basis, self.response = finer.basis, finer.response
+        self.correction, self.accuracy = finer.correction, finer.accuracy
+        self.truncation = finer.truncation
+        self.timings["modal setup, chosen again"] = finer.timings.get("modal setup", 0.0)
 
     def _own(self, times: Array, velocities: bool) -> tuple[Array, Array | None]:
         """``d`` (and ``v``) at ``times`` from this solution's own basis and correction."""
