@@ -120,8 +120,8 @@ class Accuracy:
     ``estimate`` bounds the error of the solution's basis at any ``t``; when it exceeds
     ``tolerance`` at a time asked (only just after a load jump: the bound is
     non-increasing between jumps), ``refine(times)`` gives a solution whose modes are chosen
-    for ``times``, which the solution then keeps. ``chosen_at``: the times the basis was
-    chosen for (the bound holds there).
+    for ``times``, which serves such times from then on. ``chosen_at``: the times the basis
+    was chosen for (the bound holds there).
     """
 
     tolerance: float

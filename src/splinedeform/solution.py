@@ -258,10 +258,9 @@ class ModalSolution(Solution):
     its truncation in ``truncation`` (see :meth:`splinedeform.Model.dynamic`). Times are
     processed in chunks of about :attr:`chunk_entries` modal values so that many frames of a
     large net fit in memory. ``accuracy`` (automatic mode count) keeps every time asked
-    within its tolerance: when a time asked is one where the basis' bound exceeds it (just
-    after a load jump), the modes are chosen again for the times asked and those chosen
-    for before, and the solution keeps the new basis
-    (:class:`splinedeform.modal_solve.Accuracy`).
+    within its tolerance: times where the basis' bound exceeds it (just after a load jump)
+    come from :attr:`finer`, a solution whose modes are chosen for them
+    (:class:`splinedeform.modal_solve.Accuracy`); the other times keep the cheaper basis.
     """
 
     chunk_entries = 4_000_000
@@ -275,6 +274,9 @@ class ModalSolution(Solution):
         self.truncation = omitted
         self.correction = correction
         self.accuracy = accuracy
+        self.finer: ModalSolution | None = None
+        """The solution chosen for the first times asked where ``accuracy``'s bound missed;
+        it serves every such time (choosing its own finer one when its bound misses)."""
 
     @property
     def phi(self) -> Array:
@@ -288,19 +290,17 @@ class ModalSolution(Solution):
     def _displacements(self, times: Array, velocities: bool) -> tuple[Array, Array | None]:
         """``d`` (and ``v``) at ``times``; with an ``accuracy`` (automatic mode count), the
         times where its bound exceeds the tolerance come from a solution chosen for them."""
-        if self.accuracy is not None and np.any(self.accuracy.outside(times)):
-            self._choose_again(times)
+        if self.accuracy is not None:
+            finer = self.accuracy.outside(times)
+            if np.any(finer):
+                d, v = self._own(times, velocities)
+                if self.finer is None:
+                    self.finer = self.accuracy.refine(times[finer])
+                d[finer], v_finer = self.finer._displacements(times[finer], velocities)
+                if v is not None and v_finer is not None:
+                    v[finer] = v_finer
+                return d, v
         return self._own(times, velocities)
-
-    def _choose_again(self, times: Array) -> None:
-        """Take the basis chosen for these ``times`` and those it was chosen for (the same
-        Krylov space, extended): later calls use it too."""
-        assert self.accuracy is not None
-        finer = self.accuracy.refine(np.union1d(self.accuracy.chosen_at, times))
-        self.basis, self.response = finer.basis, finer.response
-        self.correction, self.accuracy = finer.correction, finer.accuracy
-        self.truncation = finer.truncation
-        self.timings["modal setup, chosen again"] = finer.timings.get("modal setup", 0.0)
 
     def _own(self, times: Array, velocities: bool) -> tuple[Array, Array | None]:
         """``d`` (and ``v``) at ``times`` from this solution's own basis and correction."""
