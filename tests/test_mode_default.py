@@ -13,7 +13,7 @@ import pytest
 
 import splinedeform as sd
 from splinedeform import modal_solve, threads
-from splinedeform.solvers import mode_count, mode_select
+from splinedeform.solvers import mode_count
 
 PLATE = sd.Material(mass=1.0, damping=0.8, rayleigh=5e-4, w10=10.0, w01=10.0, w20=1.0,
                     w11=1.0, w02=1.0)

@@ -22,7 +22,9 @@ What makes choosing ``m`` cheap:
   row below it, the supremum over a larger set, so the bound is never lowered.
 
 So ``m`` is the smallest count whose bound meets the tolerance at the requested ``times``
-(one state: the fewest modes that time allows). When even all ``k`` computed modes miss it,
+(one state: the fewest modes that time allows), relative to ``max_t ‖K⁻¹F(t)‖_M`` or, with
+``pointwise = c_∞``, as ``c_∞ × bound`` relative to ``max_t ‖K⁻¹F(t)‖_∞`` — the largest
+control-point coordinate, since ``|x_p| ≤ c_∞ ‖x‖_M`` (:func:`pointwise_bound`). When even all ``k`` computed modes miss it,
 ``k`` grows to an estimate of the count needed (:func:`_grown`) and the same Krylov space
 is extended: the LU and every solve so far are kept. An estimate of ``n/2`` modes or more
 made from at least 64 computed ends the search: all modes are cheaper then (a frame a few
