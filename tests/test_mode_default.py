@@ -184,3 +184,21 @@ def test_a_short_horizon_is_measured_against_its_own_largest_displacement():
     assert largest < 0.5 * static                     # the case: the motion stays below
     error = np.abs(sol.control_points(times) - reference).max() / largest
     assert error <= modal_solve.DEFAULT_TOLERANCE
+
+
+def test_times_the_net_cannot_serve_are_warned_of_not_silently_missed(monkeypatch):
+    """A time 1e-4 after a jump needs all modes; with the complete eigen-solution out of
+    reach (the dense limit lowered below the net) the solution says so (a warning and
+    truncation["met"] False) and gives the computed modes' answer with its bound."""
+    from splinedeform.solvers import modal_basis
+
+    material, load, options, cells = CASES["plate, point force on and off"]
+    monkeypatch.setattr(modal_basis, "DENSE_MAX", 300)
+    surf = sd.shapes.plane(cells=(cells, cells))
+    sol = sd.Model(surf, material, **options).dynamic(load, 4.0)
+    assert sol.truncation["bound"] <= modal_solve.DEFAULT_TOLERANCE
+    with pytest.warns(UserWarning, match="not met"):
+        net = sol.control_points(2.0 + 1e-4)
+    assert np.all(np.isfinite(net))
+    assert sol.finer.truncation["met"] is False
+    assert sol.finer.truncation["bound"] > modal_solve.DEFAULT_TOLERANCE

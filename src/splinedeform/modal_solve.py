@@ -9,6 +9,7 @@
 from __future__ import annotations
 
 import time
+import warnings
 import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -99,7 +100,8 @@ def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
         correction, truncation = _truncation(model, basis, spatial, d0, v0, correction)
     if report:
         truncation.update({key: report[key] for key in ("tolerance", "bound", "omitted_static",
-                                                        "static_residual") if key in report})
+                                                        "static_residual", "met")
+                           if key in report})
     timings = dict(model.timings)
     timings["modal setup"] = time.perf_counter() - start
     accuracy = None
@@ -188,8 +190,10 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
     if krylov is None:
         krylov = _KRYLOV[model] = BlockLanczos(K, M)
     gamma, beta, c_inf = m.damping / m.mass, m.rayleigh, pointwise_factor(model)
+    out_of_reach = model.n_free > modal_basis.DENSE_MAX    # all modes cannot be had
     basis, correction, report = mode_select.automatic_basis(
-        K, M, spatial[0], gamma, beta, at, tolerance, krylov=krylov, pointwise=c_inf)
+        K, M, spatial[0], gamma, beta, at, tolerance, krylov=krylov, pointwise=c_inf,
+        best_effort=out_of_reach)
     report["of_static"] = tolerance
     if basis is not None and not of_static:
         grid = np.union1d(np.linspace(0.0, t_end, DEFAULT_TIMES), at)
@@ -198,10 +202,19 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
             below = tolerance * max(largest, 0.0) / report["scale"]
             basis, correction, report = (None, None, {"tolerance": tolerance}) if below <= 0 \
                 else mode_select.automatic_basis(K, M, spatial[0], gamma, beta, at, below,
-                                                 krylov=krylov, pointwise=c_inf)
+                                                 krylov=krylov, pointwise=c_inf,
+                                                 best_effort=out_of_reach)
             report.update(tolerance=tolerance, of_static=below)
             if basis is not None:
                 report["bound"] *= tolerance / below
+    if report.get("met") is False:
+        warnings.warn(
+            f"the tolerance {tolerance:g} is not met at every time asked: all "
+            f"{model.n_free} modes would be needed (times just after a load jump), more than "
+            f"a dense eigen-solution takes ({modal_basis.DENSE_MAX}); {report['modes']} modes "
+            f"reach a bound of {report['bound']:.2g} (solution.truncation['bound']). Ask "
+            "times further after the jumps, a looser tolerance=, or fewer cells",
+            stacklevel=4)
     if basis is None:
         report["modes"] = model.n_free
     else:

@@ -159,7 +159,8 @@ def _m_norm2(M: sp.spmatrix, x: Array) -> float:
 def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Array]],
                     gamma: float, beta: float, times: Array, tolerance: float,
                     start: int = START, advice: str = "", krylov: BlockLanczos | None = None,
-                    pointwise: float | None = None) -> tuple[Any, Any, dict[str, Any]]:
+                    pointwise: float | None = None, best_effort: bool = False
+                    ) -> tuple[Any, Any, dict[str, Any]]:
     """The fewest lowest modes whose a-priori bound (module docstring) meets ``tolerance``
     at ``times``: relative to ``max_t ‖K⁻¹F(t)‖_M`` in the M-norm, or, with ``pointwise``,
     in the largest control-point coordinate (:func:`pointwise_bound`).
@@ -173,6 +174,9 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
     krylov : the Krylov space (and its LU of ``K``) of an earlier call on the same ``K``
         and ``M``, extended if more modes are needed; a further load case then costs its
         static solves and the bound, not a new eigen-solution.
+    best_effort : where all modes would be needed, return the computed ones instead (their
+        bound, above ``tolerance``, in the report with ``met = False``): for nets whose
+        complete eigen-solution is out of reach.
     pointwise : ``c_∞ ≥ max_p √((M⁻¹)_pp)``: the bound becomes
         ``c_∞ Σ_j ‖R_j‖_M E(t − t_j) / max_t ‖K⁻¹F(t)‖_∞`` (:func:`pointwise_bound`).
 
@@ -215,6 +219,7 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
     top = float(np.max(K.diagonal() / M.diagonal()))
     k = min(start, n // 2)
     table: tuple[Array, Array] | None = None
+    last: tuple | None = None
     while 1 <= k < n // 2:
         modes = krylov.lowest(k)
         lam = check_resolved(modes.lam, 0, "sparse eigen-solution",
@@ -239,6 +244,7 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
         relative = factor * bound.max(axis=1, initial=0.0) / max(scale, 1e-300)
         fits = np.flatnonzero(relative[1:] <= tolerance) + 1
         report.update(computed=k, solves=modes.solves)
+        last = (k, modes, lam, coef, norms, relative)
         if fits.size:
             m = int(fits[0])
             parts = statics - np.array([modes.combine(c[:m]) for c in coef])
@@ -260,5 +266,15 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
         if k >= 64 and np.isfinite(needed) and needed >= n // 2:
             break                   # half the modes or more: all of them are cheaper
         k = grown
+    if best_effort and last is not None:
+        m, modes, lam, coef, norms, relative = last       # every mode computed, bound missed
+        parts = statics - np.array([modes.combine(c[:m]) for c in coef])
+        jump_parts = np.zeros((J, n, width))
+        jump_parts[:, :, active] = parts
+        basis = DenseBasis(lam[:m], modes.columns(m), "sparse", False, lu.solve, float(lam[m]))
+        report.update(modes=m, bound=float(relative[m]), scale=float(scale), met=False,
+                      estimate=ErrorEstimate(jump_times, norms[:, m], float(lam[m]), gamma,
+                                             beta, factor / max(scale, 1e-300)))
+        return basis, StaticCorrection(jump_times, jump_parts, []), report
     report.update(modes=n, bound=0.0)
     return None, None, report
