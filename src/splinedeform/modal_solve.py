@@ -241,7 +241,7 @@ def _largest_below(basis: Any, correction: Any, report: dict[str, Any], jumps: l
     zero = np.zeros((lam.size, 3))
     response = ModalResponse(lam, gamma + beta * lam, zero, zero,
                              [(t_j, basis.project(merged[t_j])) for t_j in order], [])
-    row = basis.columns(np.arange(lam.size))[p]
+    row = basis.phi[p]                          # a DenseBasis (automatic_basis)
     d = response(times)[0][:, :, c] @ row + correction(times)[:, p, c]
     error = report["estimate"].relative(times) * report["scale"]
     return float(np.max(np.abs(d) - error))
