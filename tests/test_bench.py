@@ -44,7 +44,7 @@ def test_quick_run_writes_the_table_the_csv_and_the_plots(quick):
     assert "## a. Cost against net size, family `clamped`" in text
     assert "## a. Cost against net size, family `region`" in text
     assert "| cells | free | analytic (automatic modes) | modes (a-priori bound) |" in text
-    assert "BLAS threads limited to 1" in text and "load average" in text
+    assert "BLAS threads not pinned by the study" in text and "load average" in text
     assert not list(out.glob(".*tmp*"))                       # atomic writes left nothing
 
 

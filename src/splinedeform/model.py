@@ -38,6 +38,7 @@ from .solvers.factor import factorise
 from .solvers.forcing import ReducedForcing
 from .solvers.system import KroneckerFactors, Reduction
 from .surface import Surface
+from .threads import owned
 
 Array = NDArray[np.float64]
 METHODS = ("analytic", "newmark", "radau3", "radau5", "radau7", "genalpha", "rk45", "dop853",
@@ -185,6 +186,7 @@ class Model:
         return np.asarray(self.constraints.T.T @ F_full)
 
     # -- static ----------------------------------------------------------------------
+    @owned
     def static(self, load: Load | None, t: float | None = None) -> StaticSolution:
         """Equilibrium ``K_r d = Tᵀ F(t)`` by a sparse direct solve.
 
@@ -244,6 +246,7 @@ class Model:
             "Raise the smallest weight, or use fewer cells or a lower degree")
 
     # -- modes -------------------------------------------------------------------------
+    @owned
     def eigen(self, k: int | None = None) -> tuple[Array, Array]:
         """Lowest ``k`` (default all) eigenpairs of ``K_r φ = λ M_r φ`` with ``Φᵀ M_r Φ = I``.
 
@@ -258,6 +261,7 @@ class Model:
         """
         return spectrum.eigen(self, None if k is None else _check_count(k, self.n_free))
 
+    @owned
     def modal_basis(self, eigensolver: str = "auto", modes: int | None = None,
                     omega_max: float | None = None) -> modal_basis.ModalBasis:
         """Modes as a :class:`~splinedeform.solvers.modal_basis.ModalBasis` (cached).
@@ -317,6 +321,7 @@ class Model:
             raise InputError(f"{what} moves control points that the boundary conditions fix")
         return free
 
+    @owned
     def dynamic(self, load: Load | None, t_end: float, method: str = "analytic",
                 times: ArrayLike | None = None, initial_displacement: ArrayLike | None = None,
                 initial_velocity: ArrayLike | None = None, **options: Any) -> Any:
@@ -329,18 +334,27 @@ class Model:
             ``analytic`` is the closed-form modal solution, valid at any ``t``.
             Numerical methods integrate to the output ``times``.
         times : array, optional
-            Output times for numerical methods (default 201 evenly spaced on ``[0, t_end]``).
+            Output times for numerical methods (default 201 evenly spaced on ``[0, t_end]``);
+            for ``analytic``, the times the modes are chosen for (below).
         options
-            ``analytic``: ``function_samples`` (piecewise-constant sampling of time-dependent
-            ``Function`` loads, default 400); ``modes`` (keep the lowest k modes) or
-            ``omega_max`` (keep ``ω <= omega_max``), both with the exact static part of the
-            omitted modes (mode acceleration) and a report in ``solution.truncation``;
-            ``tolerance`` (piecewise-constant loads from rest): the fewest lowest modes for
-            which an a-priori bound of the omitted modes' dynamic response at ``times``
-            (default 201 on ``[0, t_end]``; one time for one state) is at most ``tolerance``
-            of the largest static displacement in the M-norm
-            (:mod:`splinedeform.solvers.mode_select`), the bound reached in
-            ``solution.truncation["bound"]``;
+            ``analytic``: by default (no ``modes``, ``omega_max`` or ``tolerance``) the modes
+            are chosen for ``tolerance = 1e-8``
+            (:data:`splinedeform.modal_solve.DEFAULT_TOLERANCE`) where the bound applies
+            (piecewise-constant loads from rest, no rigid modes, more than 1024 free
+            coordinates and no separable factors), all modes otherwise;
+            ``modes="all"`` takes all modes. ``tolerance``: the fewest lowest modes, plus
+            the exact static part of the rest, for which an a-priori bound of the omitted
+            modes' dynamic response ``c_∞ Σ_j ‖R_j‖_M E(t − t_j)`` is at most ``tolerance``
+            of the largest static displacement ``max_t ‖K⁻¹F(t)‖_∞``, in the largest
+            control-point coordinate (``c_∞ ≥ max_p √((M⁻¹)_pp)``,
+            :mod:`splinedeform.solvers.mode_select`) at ``times`` (default 201 on
+            ``[0, t_end]``; one time for one state). It holds at **any** time asked later:
+            ``E`` never grows between jumps, and a time where the basis' bound misses
+            (just after a jump) is computed with modes chosen for it
+            (``solution.accuracy``); the bound reached is ``solution.truncation["bound"]``.
+            ``modes`` (keep the lowest k modes) or ``omega_max`` (keep ``ω <= omega_max``),
+            both with the exact static part of the omitted modes (mode acceleration) and a
+            report in ``solution.truncation``;
             ``eigensolver`` (``"auto"``, ``"dense"``, ``"separable"``, ``"sparse"``, see
             :func:`splinedeform.solvers.modal_basis.choose`). ``newmark``: ``dt``.
             ``radau3/5/7`` (Radau IIA, order 5/9/13) and ``genalpha``: ``dt`` or
@@ -360,9 +374,7 @@ class Model:
         d0, v0 = self.initial_state(initial_displacement, initial_velocity)
         forcing = ReducedForcing(self.reduction, load)
         if method == "analytic":
-            if options.get("tolerance") is not None:
-                options["times"] = times
-            return self._analytic(forcing, t_end, d0, v0, **options)
+            return self._analytic(forcing, t_end, d0, v0, times=times, **options)
         start = time.perf_counter()
         M, C, K = self.matrices()
         out_times, d, v, stats = numeric.run(M, C, K, forcing, forcing.breakpoints, method,

@@ -49,8 +49,9 @@ def main(sizes: Sequence[int] | None = None, quick: bool = False,
          frames: int | None = None, target: float | None = None, budget: float | None = None,
          methods: Sequence[str] | None = None, families: Sequence[str] | None = None,
          goals: bool | None = None, regimes_too: bool | None = None,
-         threads: int = 1) -> dict[str, Any]:
-    """Run the cost study with BLAS on ``threads`` threads and write its results to ``outdir``.
+         threads: int | None = None) -> dict[str, Any]:
+    """Run the cost study and write its results to ``outdir``; ``threads`` pins BLAS to that
+    many threads for the whole study (default: not pinned, the library as it ships).
 
     Files: ``bench.json`` (every number, see :func:`render`), ``bench.md`` (the tables and
     goals), ``bench.csv`` (one row per run) and ``cost_<family>.png`` (log–log time against
