@@ -28,6 +28,7 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from ..knots import c0_refusal
 from ..surface import Surface
 from . import metric
 
@@ -114,10 +115,7 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
         raise InputError("the Kirchhoff–Love shell needs degree >= 2 in u and v (curvatures)")
     for name, basis in (("u", surface.basis_u), ("v", surface.basis_v)):
         if getattr(basis, "continuity", basis.degree - 1) < 1:
-            raise InputError(
-                f"the Kirchhoff–Love shell needs a C1 basis in {name}, but its knot vector "
-                f"repeats an interior knot {basis.degree} times (the surface may kink there, "
-                "where bending energy is undefined); use a knot vector without such knots")
+            raise InputError(c0_refusal(basis, name, "the Kirchhoff–Love shell"))
     G = metric.grid(surface, extra_points=1)
     q = (surface.basis_u.degree + 2, surface.basis_v.degree + 2)    # Gauss points per cell
     N = metric.shape_derivatives(G)
