@@ -75,11 +75,11 @@ def test_boehm_step_equals_fitpack_knot_insertion():
     t = np.array([0, 0, 0, 0, 0.3, 0.5, 0.5, 1, 1, 1, 1.0])
     c = np.array([0.2, -1.0, 0.7, 2.0, 0.1, -0.4, 1.3])
     for x in (0.1, 0.3, 0.42, 0.5, 0.9):
-        knots, T = boehm_insert(t, 3, x)
+        knots, new = boehm_insert(t, 3, x, c)
         tck = interpolate.insert(x, (t, np.concatenate([c, np.zeros(4)]), 3))
         assert np.array_equal(knots, tck[0])
         # two evaluations of the same affine combinations: round-off, 1e-14 of |c|
-        assert np.abs(T @ c - tck[1][:knots.size - 4]).max() <= 1e-14 * np.abs(c).max()
+        assert np.abs(new - tck[1][:knots.size - 4]).max() <= 1e-14 * np.abs(c).max()
 
 
 def test_elevation_keeps_the_continuity_of_every_knot():
@@ -115,6 +115,10 @@ def test_refusals_name_the_problem():
         refine_surface(surf, insert=(1, -1))
     with pytest.raises(InputError, match="elevate in u is 9; at most 6"):
         refine_surface(surf, elevate=(9, 0))
+    big = sd.shapes.plane(cells=(40, 2), degree=2)
+    with pytest.raises(InputError, match="refining direction u .* gives about 2602 functions "
+                                         "from 42; at most 1024"):
+        refine_surface(big, insert=(64, 0))
 
 
 CASE = ('[material]\nw10 = 1.0\nw01 = 1.0\n[boundary]\nu0 = "pinned"\nu1 = "pinned"\n'

@@ -47,28 +47,28 @@ from .surface import Basis, Surface
 
 #: largest number of knots inserted per span, and of degrees added (the bases stay small)
 MAX_INSERT, MAX_ELEVATE = 64, 6
+#: most functions a refined direction may have (its refinement matrix is dense)
+MAX_SIZE = 1024
 
 
-def boehm_insert(knots: NDArray[np.float64], degree: int, x: float
+def boehm_insert(knots: NDArray[np.float64], degree: int, x: float, points: NDArray[np.float64]
                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Insert one knot ``x`` (Boehm's algorithm, see the module docstring).
 
-    Returns the new knot vector and ``T`` (``(N + 1) × N``) with ``c' = T c``.
+    ``points`` has the ``N`` coefficients along its first axis (control points, or the
+    columns of a refinement matrix); returns the new knot vector and the ``N + 1`` new
+    coefficients.
     """
-    t, n = np.asarray(knots, dtype=float), degree
+    t, n, c = np.asarray(knots, dtype=float), degree, np.asarray(points, dtype=float)
     size = t.size - n - 1
     mu = int(np.searchsorted(t, x, side="right")) - 1
-    if not (t[n] <= x < t[size]) or mu < n:
-        raise InputError(f"knot {x:g} lies outside the domain [{t[n]:g}, {t[size]:g})")
-    T = np.zeros((size + 1, size))
-    i = np.arange(size + 1)
-    T[i[i <= mu - n], i[i <= mu - n]] = 1.0
-    T[i[i > mu], i[i > mu] - 1] = 1.0
-    middle = i[(i > mu - n) & (i <= mu)]
-    alpha = (x - t[middle]) / (t[middle + n] - t[middle])
-    T[middle, middle] = alpha
-    T[middle, middle - 1] = 1.0 - alpha
-    return np.insert(t, mu + 1, x), T
+    if not (t[n] <= x < t[size]) or mu < n or c.shape[0] != size:
+        raise InputError(f"knot {x:g} lies outside the domain [{t[n]:g}, {t[size]:g}), or "
+                         f"{c.shape[0]} coefficients for {size} functions")
+    i = np.arange(mu - n + 1, mu + 1)
+    alpha = ((x - t[i]) / (t[i + n] - t[i])).reshape((-1,) + (1,) * (c.ndim - 1))
+    middle = alpha * c[i] + (1.0 - alpha) * c[i - 1]
+    return np.insert(t, mu + 1, x), np.concatenate([c[:mu - n + 1], middle, c[mu:]])
 
 
 def insert_knots(basis: Basis, k: int) -> tuple[Basis, NDArray[np.float64]]:
@@ -85,9 +85,8 @@ def insert_knots(basis: Basis, k: int) -> tuple[Basis, NDArray[np.float64]]:
     breaks = basis.breaks
     new = (breaks[:-1, None] + np.diff(breaks)[:, None] * np.arange(1, k + 1) / (k + 1)).ravel()
     knots, T = np.asarray(basis.knots, dtype=float), np.eye(basis.size)
-    for x in new:
-        knots, step = boehm_insert(knots, basis.degree, float(x))
-        T = step @ T
+    for x in new:                      # one pass over the rows of T per inserted knot
+        knots, T = boehm_insert(knots, basis.degree, float(x), T)
     return KnotVectorBasis(basis.degree, knots), T
 
 
@@ -134,6 +133,11 @@ def refine_basis(basis: Basis, elevate: int = 0, insert: int = 0, direction: str
             raise InputError(f"{name} in {direction} must be an integer >= 0, got {value!r}")
         if value > top:
             raise InputError(f"{name} in {direction} is {value}; at most {top}")
+    size = (basis.cells * (insert + 1) + basis.degree + elevate
+            + elevate * (basis.cells - 1) * (not getattr(basis, "periodic", False)))
+    if size > MAX_SIZE:
+        raise InputError(f"refining direction {direction} (elevate {elevate}, refine {insert}) "
+                         f"gives about {size} functions from {basis.size}; at most {MAX_SIZE}")
     new: Basis = basis
     T = np.eye(basis.size)
     if elevate:
