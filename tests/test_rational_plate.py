@@ -20,7 +20,8 @@ def general_weights() -> np.ndarray:
     return w
 
 
-def _energy_by_scipy(d: np.ndarray, w: np.ndarray, points: int = 24) -> tuple[float, float]:
+def _energy_by_scipy(d: np.ndarray, w: np.ndarray, points: int = 24
+                     ) -> tuple[float, float]:
     """½ ∫∫ (plate energy density) and ∫∫ μ d² of the field ``d = Σ w d N N / Σ w N N``,
     evaluated by scipy's BSpline and integrated with ``points`` Gauss points per span."""
     x, a = np.polynomial.legendre.leggauss(points)

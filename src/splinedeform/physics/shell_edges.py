@@ -131,8 +131,8 @@ def end_map(basis: Basis, start: tuple[int, ...], end: tuple[int, ...]
         R = np.setdiff1d(support, E)
         if np.linalg.cond(C[:, E]) > 1e12 or np.intersect1d(E, list(eliminated)).size:
             raise InputError(f"cannot impose these edge conditions with degree "
-                             f"{basis.degree} and {basis.cells} cell(s); use more cells (a CAD surface: insert "
-                             "knots, surface.refine)")
+                             f"{basis.degree} and {basis.cells} cell(s); use more cells "
+                             "(a CAD surface: insert knots, surface.refine)")
         coupling = -np.linalg.solve(C[:, E], C[:, R])
         for row, e in enumerate(E):
             full = np.zeros(size)
