@@ -167,3 +167,19 @@ def test_c0_refusals_say_where_the_line_is_and_what_to_do():
     with pytest.raises(InputError, match=r"shell needs a C1 basis in u.*at u = 0\.25.*"
                                          r"surface\.elevate does not help"):
         sd.ShellModel(surf, sd.ShellMaterial(E=1.0, nu=0.3, thickness=0.01, density=1.0))
+
+
+def test_c0_refusal_in_a_scenario_is_located_at_the_bending_weight(tmp_path):
+    pytest.importorskip("rhino3dm", reason="the 'cad' extra (rhino3dm) is not installed")
+    from splinedeform.cad import write_3dm
+
+    knots_u = np.array([0, 0, 0, 0.5, 0.5, 1, 1, 1.0])
+    knots_v = np.array([0, 0, 0, 1, 1, 1.0])
+    x, y = np.meshgrid(np.linspace(0, 1, 5), np.linspace(0, 1, 3), indexing="ij")
+    write_3dm(tmp_path / "kinked.3dm", [NurbsPatch((2, 2), knots_u, knots_v,
+                                                   np.stack([x, y, x * y], -1), np.ones((5, 3)))])
+    path = tmp_path / "case.toml"
+    path.write_text('[surface]\nshape = "cad"\npath = "kinked.3dm"\n'
+                    + CASE.replace("w01 = 1.0\n", "w01 = 1.0\nw20 = 0.1\n"))
+    with pytest.raises(ScenarioError, match=r"case\.toml:\d+: material\.w20: .* at u = 0\.5"):
+        build(load_scenario(path))

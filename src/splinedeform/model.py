@@ -104,9 +104,11 @@ class Model:
                 raise InputError(f"bending weight w{'20' if name == 'u' else '02'} needs degree "
                                  f">= 2 in {name} (second derivatives), got {basis.degree}")
             if weight and getattr(basis, "continuity", basis.degree - 1) < 1:
-                raise InputError(c0_refusal(
-                    basis, name, f"bending weight w{'20' if name == 'u' else '02'}")
-                    + "; or use tension weights only (w10, w01)")
+                key = f"w{'20' if name == 'u' else '02'}"
+                error = InputError(c0_refusal(basis, name, f"bending weight {key}")
+                                   + "; or use tension weights only (w10, w01)")
+                error.key = f"material.{key}"  # type: ignore[attr-defined]
+                raise error
         self.surface = surface
         self.material = material
         self.mass_matrix = mass_matrix

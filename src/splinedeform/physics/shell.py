@@ -115,7 +115,9 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
         raise InputError("the Kirchhoff–Love shell needs degree >= 2 in u and v (curvatures)")
     for name, basis in (("u", surface.basis_u), ("v", surface.basis_v)):
         if getattr(basis, "continuity", basis.degree - 1) < 1:
-            raise InputError(c0_refusal(basis, name, "the Kirchhoff–Love shell"))
+            error = InputError(c0_refusal(basis, name, "the Kirchhoff–Love shell"))
+            error.key = "surface"  # type: ignore[attr-defined]
+            raise error
     G = metric.grid(surface, extra_points=1)
     q = (surface.basis_u.degree + 2, surface.basis_v.degree + 2)    # Gauss points per cell
     N = metric.shape_derivatives(G)
