@@ -144,3 +144,26 @@ def test_step_and_iges_solids_and_their_faces(tmp_path, suffix):
     # the box 1 x 2 x 3: faces of areas 6, 6, 3, 3, 2, 2 (exact for bilinear planes)
     assert sorted(f["area"] for f in faces[3:]) == pytest.approx([2, 2, 3, 3, 6, 6], rel=1e-12)
     assert not any(f["trimmed"] for f in faces[3:])
+
+
+def test_an_unreadable_face_is_listed_with_its_error(tmp_path):
+    pytest.importorskip("OCP", reason="the 'cad-step' extra (cadquery-ocp) is not installed")
+    from splinedeform.cad_step import write_step
+
+    ring = np.array([[1.0, 0, 0], [1, 1, 0], [0, 1, 0]])
+    patch = NurbsPatch((2, 1), np.array([0, 0, 0, 1, 1, 1.0]), np.array([0, 0, 1, 1.0]),
+                       np.stack([ring, ring + [0, 0, 2.0]], axis=1),
+                       np.outer([1, np.sqrt(0.5), 1], [1, 1]))
+    lines = write_step(tmp_path / "good.igs", [patch, patch]).read_text().splitlines(True)
+    # the first B-spline entity's weight w10 = √½ (written 0.707106781) becomes -1
+    k = next(i for i, line in enumerate(lines) if line[72] == "P" and "0.707106781," in line)
+    lines[k] = lines[k][:64].replace("0.707106781,", "-1.00000000,", 1).ljust(64) + lines[k][64:]
+    path = tmp_path / "bad.igs"
+    path.write_text("".join(lines))
+    result = runner.invoke(cli.app, ["faces", "--json", str(path)])
+    assert result.exit_code == 0, result.output
+    bad, good = json.loads(result.output)["faces"]
+    assert "has weight w[1, 0] = -1; NURBS weights must be > 0" in bad["error"]
+    assert "error" not in good and good["weights"] == "product"
+    # a quarter of the unit cylinder of length 2: π (the file keeps 10 digits)
+    assert good["area"] == pytest.approx(np.pi, rel=1e-8)
