@@ -61,6 +61,10 @@ VALUES = {
                                       ["periodic", "open"], ["open", "periodic"],
                                       ["periodic", "periodic"]]),
     "surface.method": st.sampled_from(["interpolate", "l2", "quasi", "spline"]),
+    "surface.refine": SMALL_INT | st.lists(SMALL_INT, max_size=3)
+    | st.dictionaries(st.sampled_from(["u", "v", "w"]), SMALL_INT, max_size=2),
+    "surface.elevate": SMALL_INT | st.lists(SMALL_INT, max_size=3)
+    | st.dictionaries(st.sampled_from(["u", "v", "w"]), SMALL_INT, max_size=2),
     "surface.size": NUMBER | PAIR, "surface.radius": NUMBER, "surface.angle": NUMBER,
     "surface.height": NUMBER, "surface.length": NUMBER, "surface.R": NUMBER,
     "surface.r": NUMBER, "surface.path": st.sampled_from(["net.json", "../x.npy", "/etc/passwd"]),
@@ -102,6 +106,7 @@ PLAUSIBLE = {
     "surface.cells": st.integers(1, 5), "surface.degree": st.integers(1, 3),
     "surface.knots": st.sampled_from(["open", "uniform", "periodic"]),
     "surface.method": st.sampled_from(["interpolate", "l2", "quasi"]),
+    "surface.refine": st.integers(0, 2), "surface.elevate": st.integers(0, 1),
     "material.mass": st.floats(0.1, 10.0), "material.damping": st.floats(0.0, 5.0),
     "material.rayleigh": st.floats(0.0, 0.1), "material.w10": st.floats(0.0, 5.0),
     "material.w01": st.floats(0.0, 5.0), "material.w20": st.floats(0.0, 1.0),

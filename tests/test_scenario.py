@@ -181,7 +181,8 @@ SHAPE_TEXTS = {shape: shape_scenario(shape, {k: key.default for k, key in params
 FILE_TEXTS = [file_scenario("net.json", "frame = 0"),
               file_scenario("grid.npy", 'cells = 3\ndegree = 2\nknots = ["open", "open"]\n'
                                         'method = "l2"'),
-              file_scenario("patch.3dm", 'face = 1\nunits = "in"').replace('"file"', '"cad"')]
+              file_scenario("patch.3dm", 'face = 1\nunits = "in"\nrefine = {u = 2, v = 1}\n'
+                                         'elevate = [0, 1]').replace('"file"', '"cad"')]
 
 
 def all_test_texts() -> list[str]:

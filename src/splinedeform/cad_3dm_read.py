@@ -40,12 +40,11 @@ def read_3dm_arrays(path: Path, face: int) -> dict[str, Any]:
     if model is None:
         raise InputError(f"{path}: not a .3dm (openNURBS) file")
     found, geometry_of = [], []
-    for obj in model.Objects:
-        geometry = obj.Geometry
+    for _, _, geometry in _objects(model, r3):
         if isinstance(geometry, r3.Brep):
             found += [(f, True) for f in geometry.Faces]
             geometry_of += [geometry] * len(geometry.Faces)
-        elif isinstance(geometry, r3.Surface):
+        else:
             found.append((geometry, False))
             geometry_of.append(geometry)
     if not found:
@@ -63,6 +62,51 @@ def read_3dm_arrays(path: Path, face: int) -> dict[str, Any]:
     data = _patch_from_rhino(surface.ToNurbsSurface(), source)
     data["units"] = units_from_rhino(str(model.Settings.ModelUnitSystem).split(".")[-1])
     return data
+
+
+def _objects(model: Any, r3: Any) -> list[tuple[int, Any, Any]]:
+    """``(object index, object, geometry)`` of every object holding surfaces, in file order:
+    a Brep, a plain surface, or an extrusion as its Brep (its wall and caps)."""
+    out = []
+    for index, obj in enumerate(model.Objects):
+        geometry = obj.Geometry
+        if isinstance(geometry, r3.Extrusion):
+            geometry = geometry.ToBrep(False)
+        if isinstance(geometry, (r3.Brep, r3.Surface)):
+            out.append((index, obj, geometry))
+    return out
+
+
+def list_3dm_arrays(path: Path) -> dict[str, Any]:
+    """Every face of a ``.3dm`` file: its object (index, name, layer, kind), whether it is
+    trimmed, closed and periodic in the file, and its NURBS arrays (run in the child)."""
+    r3 = _rhino3dm()
+    model = r3.File3dm.Read(str(path))
+    if model is None:
+        raise InputError(f"{path}: not a .3dm (openNURBS) file")
+    layers = [layer.FullPath for layer in model.Layers]
+    faces = []
+    for index, obj, geometry in _objects(model, r3):
+        attributes = obj.Attributes
+        layer = attributes.LayerIndex
+        kind = ("extrusion" if isinstance(obj.Geometry, r3.Extrusion)
+                else "brep" if isinstance(geometry, r3.Brep) else "surface")
+        own = {"object": index, "name": attributes.Name or None, "kind": kind,
+               "layer": layers[layer] if 0 <= layer < len(layers) else None}
+        members = list(geometry.Faces) if isinstance(geometry, r3.Brep) else [geometry]
+        for number, member in enumerate(members):
+            entry = {**own, "member": number}
+            try:
+                surface = member.UnderlyingSurface() if kind != "surface" else member
+                entry["trimmed"] = kind != "surface" and _is_trimmed(geometry, member)
+                entry["closed"] = (bool(surface.IsClosed(0)), bool(surface.IsClosed(1)))
+                entry["periodic"] = (bool(surface.IsPeriodic(0)), bool(surface.IsPeriodic(1)))
+                entry.update(_patch_from_rhino(surface.ToNurbsSurface(), f"{path} object {index}"))
+            except InputError as exc:
+                entry["error"] = str(exc)
+            faces.append(entry)
+    return {"faces": faces,
+            "units": units_from_rhino(str(model.Settings.ModelUnitSystem).split(".")[-1])}
 
 
 def _is_trimmed(brep: object, brep_face: object) -> bool:

@@ -53,10 +53,6 @@ def ocp() -> Any:
 def read_arrays(path: Path, face: int) -> dict[str, Any]:
     """Face ``face`` of a STEP or IGES file as plain arrays (see the module docstring)."""
     ocp()
-    from OCP.BRep import BRep_Tool
-    from OCP.BRepTools import BRepTools
-    from OCP.GeomConvert import GeomConvert
-
     iges = path.suffix.lower() in IGES_SUFFIXES
     bad_weights = iges_bad_weights(path) if iges else {}
     reader, faces, units = read_faces(path)
@@ -71,31 +67,7 @@ def read_arrays(path: Path, face: int) -> dict[str, Any]:
     source = f"{path} face {face}"
     if bad_weights:
         _refuse_bad_weights(reader, faces[face], bad_weights, source)
-    surface = BRep_Tool.Surface_s(faces[face])
-    bounds = np.array(BRepTools.UVBounds_s(faces[face]))
-    kind = surface.DynamicType().Name()
-    try:
-        spline = GeomConvert.SurfaceToBSplineSurface_s(surface)
-    except Exception:  # OpenCASCADE raises Standard_Failure: an infinite plane, cone, …
-        spline = None
-    if spline is None:
-        spline = _bounded_spline(surface, _whole_periods(surface, bounds), source, kind)
-    else:
-        natural = np.array(spline.Bounds())
-        if np.abs(bounds - natural).max() > 1e-9 * max(1.0, np.abs(natural).max()):
-            warnings.warn(f"{source} is trimmed to (u, v) in {bounds.round(6).tolist()}; its "
-                          "whole underlying surface is used", stacklevel=2)
-    try:
-        if spline.IsUPeriodic():
-            spline.SetUNotPeriodic()
-        if spline.IsVPeriodic():
-            spline.SetVNotPeriodic()
-        arrays = _arrays(spline, source)
-    except InputError:
-        raise
-    except Exception as exc:  # Standard_OutOfRange and kin: a degenerate conversion
-        raise InputError(f"{source}: OpenCASCADE could not convert its surface ({kind}) to an "
-                         f"open B-spline surface ({type(exc).__name__}: {exc})") from None
+    arrays = face_arrays(faces[face], source)
     arrays["points"] /= millimetres(units)
     arrays["units"] = units
     return arrays
@@ -262,3 +234,117 @@ def _refuse_bad_weights(reader: Any, face: Any, bad: dict[int, tuple[tuple[int, 
         raise InputError(f"{source}: its B-spline surface (IGES entity 128, directory entry "
                          f"{number}) has weight w[{i}, {j}] = {w:g}; NURBS weights must be "
                          "> 0 (OpenCASCADE would read every weight as 1)")
+
+
+def face_arrays(face: Any, source: str) -> dict[str, Any]:
+    """One face's surface as open B-spline arrays (in millimetres), with whether it was
+    ``periodic`` and ``closed`` in u and v before it was opened (warns if trimmed)."""
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepTools import BRepTools
+    from OCP.GeomConvert import GeomConvert
+
+    surface = BRep_Tool.Surface_s(face)
+    bounds = np.array(BRepTools.UVBounds_s(face))
+    kind = surface.DynamicType().Name()
+    try:
+        spline = GeomConvert.SurfaceToBSplineSurface_s(surface)
+    except Exception:  # OpenCASCADE raises Standard_Failure: an infinite plane, cone, …
+        spline = None
+    if spline is None:
+        spline = _bounded_spline(surface, _whole_periods(surface, bounds), source, kind)
+    else:
+        natural = np.array(spline.Bounds())
+        if np.abs(bounds - natural).max() > 1e-9 * max(1.0, np.abs(natural).max()):
+            warnings.warn(f"{source} is trimmed to (u, v) in {bounds.round(6).tolist()}; its "
+                          "whole underlying surface is used", stacklevel=2)
+    periodic = (bool(spline.IsUPeriodic()), bool(spline.IsVPeriodic()))
+    closed = (bool(spline.IsUClosed()), bool(spline.IsVClosed()))
+    try:
+        if spline.IsUPeriodic():
+            spline.SetUNotPeriodic()
+        if spline.IsVPeriodic():
+            spline.SetVNotPeriodic()
+        arrays = _arrays(spline, source)
+    except InputError:
+        raise
+    except Exception as exc:  # Standard_OutOfRange and kin: a degenerate conversion
+        raise InputError(f"{source}: OpenCASCADE could not convert its surface ({kind}) to an "
+                         f"open B-spline surface ({type(exc).__name__}: {exc})") from None
+    arrays["periodic"], arrays["closed"] = periodic, closed
+    return arrays
+
+
+def list_step_arrays(path: Path) -> dict[str, Any]:
+    """Every face of a STEP or IGES file: its object (the index and type of the top-level
+    shape holding it), whether it is trimmed, closed and periodic, and its NURBS arrays in
+    the file's unit (run in the child). A face that cannot be read has an ``error``."""
+    ocp()
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS_Iterator
+
+    iges = path.suffix.lower() in IGES_SUFFIXES
+    bad_weights = iges_bad_weights(path) if iges else {}
+    reader, faces, units = read_faces(path)
+    shape = reader.OneShape()
+    children = []
+    iterator = TopoDS_Iterator(shape)
+    while iterator.More():
+        children.append(iterator.Value())
+        iterator.Next()
+    if shape.ShapeType().name != "TopAbs_COMPOUND" or not children:
+        children = [shape]
+    owners: list[int | None] = []        # the explorer visits a compound's children in order
+    for index, child in enumerate(children):
+        explorer = TopExp_Explorer(child, TopAbs_FACE)
+        while explorer.More():
+            k = len(owners)
+            owners.append(index if k < len(faces) and faces[k].IsSame(explorer.Current())
+                          else None)
+            explorer.Next()
+    if len(owners) != len(faces):
+        owners = [None] * len(faces)
+    entries = []
+    for number, face in enumerate(faces):
+        owner = owners[number]
+        kind = (children[owner] if owner is not None else shape).ShapeType().name
+        entry: dict[str, Any] = {"object": owner, "name": None, "layer": None,
+                                 "kind": kind.split("_")[-1].lower()}
+        source = f"{path} face {number}"
+        try:
+            if bad_weights:
+                _refuse_bad_weights(reader, face, bad_weights, source)
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                arrays = face_arrays(face, source)
+            arrays["points"] /= millimetres(units)
+            arrays["trimmed_area"] = _area(face) / millimetres(units) ** 2
+            entry.update(arrays)
+            entry["trimmed"] = _wires(face) > 1 or any("trimmed" in str(w.message)
+                                                         for w in caught)
+        except InputError as exc:
+            entry["error"] = str(exc)
+        entries.append(entry)
+    return {"faces": entries, "units": units}
+
+
+def _area(face: Any) -> float:
+    """Area of the face as bounded by its loops (OpenCASCADE's ``BRepGProp``), in mm²."""
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+
+    properties = GProp_GProps()
+    BRepGProp.SurfaceProperties_s(face, properties)
+    return float(properties.Mass())
+
+
+def _wires(face: Any) -> int:
+    """Number of wires (outer and inner loops) of a face."""
+    from OCP.TopAbs import TopAbs_WIRE
+    from OCP.TopExp import TopExp_Explorer
+
+    explorer, count = TopExp_Explorer(face, TopAbs_WIRE), 0
+    while explorer.More():
+        count += 1
+        explorer.Next()
+    return count

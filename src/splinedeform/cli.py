@@ -275,6 +275,18 @@ def validate_command(scenario: Path = SCENARIO_ARG, allow_outside_paths: bool = 
         out.print(printable(scenario_to_toml(loaded)), markup=False, highlight=False)
 
 
+@app.command("faces")
+def faces_command(path: Path = typer.Argument(..., help="A .3dm, STEP or IGES file."),
+                  as_json: bool = typer.Option(False, "--json", help="Print JSON."),
+                  debug: bool = DEBUG_OPT) -> None:
+    """List the objects and faces of a CAD file: degree, net, weights, trimming, C0 knots."""
+    from .cad_faces import faces_json, faces_text, read_faces
+
+    with _reported_errors(debug):
+        listing = read_faces(path)
+        sys.stdout.write(faces_json(listing) if as_json else faces_text(listing))
+
+
 @app.command("schema")
 def schema_command() -> None:
     """Print the JSON Schema of scenario files (for editors: see docs/scenario.md)."""

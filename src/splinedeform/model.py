@@ -25,6 +25,7 @@ from .assembly import (_largest, full_matrices, mass, reduced_matrices,  # noqa:
                        stiffness)
 from .boundary import Constraints, build_constraints
 from .errors import InputError, SingularSystemError
+from .knots import c0_refusal
 from .loads import Load, as_load, static_time
 from .material import Material, check_scales
 from .physics import PHYSICS, intrinsic
@@ -106,11 +107,11 @@ class Model:
                 raise InputError(f"bending weight w{'20' if name == 'u' else '02'} needs degree "
                                  f">= 2 in {name} (second derivatives), got {basis.degree}")
             if weight and getattr(basis, "continuity", basis.degree - 1) < 1:
-                raise InputError(
-                    f"bending weight w{'20' if name == 'u' else '02'} needs a C1 basis in "
-                    f"{name}, but its knot vector repeats an interior knot {basis.degree} "
-                    "times (the surface may kink there, where bending energy is undefined); "
-                    "use tension weights only, or a knot vector without such knots")
+                key = f"w{'20' if name == 'u' else '02'}"
+                error = InputError(c0_refusal(basis, name, f"bending weight {key}")
+                                   + "; or use tension weights only (w10, w01)")
+                error.key = f"material.{key}"  # type: ignore[attr-defined]
+                raise error
         self.surface = surface
         self.material = material
         self.mass_matrix = mass_matrix
@@ -124,7 +125,8 @@ class Model:
                 f"no free coordinate: the boundary {self.constraints.edges} fixes every one of "
                 f"the {surface.shape[0]} x {surface.shape[1]} control points (cells "
                 f"{surface.basis_u.cells} x {surface.basis_v.cells}, degree "
-                f"{surface.basis_u.degree}), so nothing can move; use more cells or free an edge")
+                f"{surface.basis_u.degree}), so nothing can move; free an edge, or use more cells "
+                "(surface.cells; a CAD or control net surface: insert knots with surface.refine)")
             error.key = "boundary"  # type: ignore[attr-defined]
             raise error
         top = lambda b: min(2, b.degree)  # noqa: E731

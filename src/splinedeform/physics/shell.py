@@ -28,6 +28,7 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from ..knots import c0_refusal
 from ..surface import Surface
 from . import metric
 from .shell_assembly import Pattern, assemble_cells
@@ -120,10 +121,9 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
         raise InputError("the Kirchhoff–Love shell needs degree >= 2 in u and v (curvatures)")
     for name, basis in (("u", surface.basis_u), ("v", surface.basis_v)):
         if getattr(basis, "continuity", basis.degree - 1) < 1:
-            raise InputError(
-                f"the Kirchhoff–Love shell needs a C1 basis in {name}, but its knot vector "
-                f"repeats an interior knot {basis.degree} times (the surface may kink there, "
-                "where bending energy is undefined); use a knot vector without such knots")
+            error = InputError(c0_refusal(basis, name, "the Kirchhoff–Love shell"))
+            error.key = "surface"  # type: ignore[attr-defined]
+            raise error
     G = metric.grid(surface, extra_points=1)
     q = (surface.basis_u.degree + 2, surface.basis_v.degree + 2)    # Gauss points per cell
     n_u, n_v = surface.basis_u.size, surface.basis_v.size

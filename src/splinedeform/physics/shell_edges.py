@@ -131,7 +131,8 @@ def end_map(basis: Basis, start: tuple[int, ...], end: tuple[int, ...]
         R = np.setdiff1d(support, E)
         if np.linalg.cond(C[:, E]) > 1e12 or np.intersect1d(E, list(eliminated)).size:
             raise InputError(f"cannot impose these edge conditions with degree "
-                             f"{basis.degree} and {basis.cells} cell(s); use more cells")
+                             f"{basis.degree} and {basis.cells} cell(s); use more cells "
+                             "(a CAD surface: insert knots, surface.refine)")
         coupling = -np.linalg.solve(C[:, E], C[:, R])
         for row, e in enumerate(E):
             full = np.zeros(size)
@@ -142,7 +143,8 @@ def end_map(basis: Basis, start: tuple[int, ...], end: tuple[int, ...]
     T[kept, np.arange(kept.size)] = 1.0
     for e, row in eliminated.items():
         if np.any(row[list(eliminated)] != 0):
-            raise InputError("the edge conditions of the two ends overlap; use more cells")
+            raise InputError("the edge conditions of the two ends overlap; use more cells (a CAD "
+                             "surface: insert knots, surface.refine)")
         T[e] = row[kept]
     return sp.csr_matrix(T), kept
 

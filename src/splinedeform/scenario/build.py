@@ -52,9 +52,22 @@ def surface_and_units(scenario: Scenario) -> tuple[Any, str | None]:
     """The initial surface (see :func:`build_surface`) and its length unit: a CAD file's
     (or ``surface.units``), None for other surfaces."""
     spec = scenario.surface
-    if spec.shape == "cad":
-        return _surface_from_cad(scenario)
-    return _surface_of_shape(scenario), None
+    surface, units = (_surface_from_cad(scenario) if spec.shape == "cad"
+                      else (_surface_of_shape(scenario), None))
+    return _refined(scenario, surface), units
+
+
+def _refined(scenario: Scenario, surface: Any) -> Any:
+    """``surface`` elevated by ``surface.elevate`` degrees, then with ``surface.refine``
+    knots inserted per span (:func:`splinedeform.refine.refine_surface`; same geometry)."""
+    spec = scenario.surface
+    if spec.refine == (0, 0) and spec.elevate == (0, 0):
+        return surface
+    from ..refine import refine_surface
+
+    key = "surface.elevate" if spec.elevate != (0, 0) else "surface.refine"
+    with _located(scenario, key):
+        return refine_surface(surface, spec.elevate, spec.refine)
 
 
 def _surface_of_shape(scenario: Scenario) -> Any:

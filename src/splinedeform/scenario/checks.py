@@ -73,6 +73,10 @@ def allowed(schema: dict[str, Any], title: str = "") -> str:
             ("" if not parts else " " + " and ".join(parts))
     if kind == "string":
         return "a string"
+    if kind == "object":
+        names = schema.get("propertyNames", {}).get("enum", [])
+        return "an inline table" + (" {" + ", ".join(f"{k} = …" for k in names) + "}"
+                                    if names else "")
     if kind == "array" and "prefixItems" in schema:
         items = schema["prefixItems"]
         return f"an array of {len(items)} {_plural(allowed(items[0]))}" + \

@@ -80,7 +80,30 @@ class _Table(BaseModel):
 
 
 # -- [surface] ---------------------------------------------------------------------------------
-class _Fitted(_Table):
+Inserted = Annotated[int, Strict(), Field(ge=0, le=64)]
+Added = Annotated[int, Strict(), Field(ge=0, le=6)]
+#: one count for both directions, ``[k_u, k_v]`` or ``{u = k_u, v = k_v}`` (a missing one is 0)
+Insertions = Union[Inserted, tuple[Inserted, Inserted], dict[Literal["u", "v"], Inserted]]
+Elevations = Union[Added, tuple[Added, Added], dict[Literal["u", "v"], Added]]
+
+
+class _Refined(_Table):
+    refine: Optional[Insertions] = Field(
+        None, title="[k_u, k_v]", description=(
+            "knots inserted at equal distances into every knot span of the built or read "
+            "surface (`{u = k, v = k}`, `[k_u, k_v]` or one `k` for both; Boehm's algorithm, "
+            "rational surfaces in homogeneous coordinates): the geometry does not move, every "
+            "span becomes `k + 1`"),
+        json_schema_extra={"doc_default": "0"})
+    elevate: Optional[Elevations] = Field(
+        None, title="[p_u, p_v]", description=(
+            "degrees added to the built or read surface before `refine` (exact degree "
+            "elevation: same geometry, same continuity at every knot); not in a periodic "
+            "direction"),
+        json_schema_extra={"doc_default": "0"})
+
+
+class _Fitted(_Refined):
     cells: Optional[Union[Cells, tuple[Cells, Cells]]] = Field(
         None, title="[m_u, m_v]", description=(
             "knot spans per direction (the net has `cells + degree` control points per "
@@ -156,7 +179,7 @@ class FromFile(_Fitted):
             "which frame of a control net file (negative counts from the end)"))
 
 
-class FromCad(_Table):
+class FromCad(_Refined):
     shape: Literal["cad"]
     path: Text = Field(
         description=(

@@ -26,6 +26,24 @@ class SurfaceSpec:
     path: Path | None = None
     frame: int = -1
     parameters: dict[str, Any] = field(default_factory=dict)
+    #: knots inserted per span and degrees added, ``(u, v)`` (``surface.refine``, ``.elevate``)
+    refine: tuple[int, int] = (0, 0)
+    elevate: tuple[int, int] = (0, 0)
+
+    def __post_init__(self) -> None:
+        for name in ("refine", "elevate"):
+            object.__setattr__(self, name, per_direction(getattr(self, name)))
+
+
+def per_direction(value: Any) -> tuple[int, int]:
+    """``(u, v)`` counts from one count, a pair or ``{u = …, v = …}`` (None and missing: 0)."""
+    if value is None:
+        return (0, 0)
+    if isinstance(value, dict):
+        return (int(value.get("u", 0)), int(value.get("v", 0)))
+    if isinstance(value, (tuple, list)):
+        return (int(value[0]), int(value[1]))
+    return (int(value), int(value))
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,158 @@
+"""The faces of a CAD file, listed (``splinedeform faces FILE``).
+
+Every object of a ``.3dm``, STEP or IGES file that holds surfaces (a Brep, a plain surface,
+an extrusion read as its Brep: wall and caps) and each of its faces, numbered as
+``shape = "cad"``'s ``face`` counts them, with what decides how it can be deformed: its
+degrees and net size, its weights (``1``, a product ``a_i b_j`` or general), whether it is
+trimmed and closed or periodic in the file, its ``C^0`` knots (an interior knot repeated
+``n`` times), its degenerate edges (a row of the net that is one point, a pole) and the
+area of its untrimmed surface,
+
+.. math:: A = \\int\\!\\!\\int |S_u \\times S_v| \\, du\\, dv,
+          \\quad S_u = (N_u - S\\, W_u) / W,
+
+by Gauss–Legendre quadrature with :data:`AREA_POINTS` points per knot span and direction
+(``N = Σ w P N_i N_j``, ``W = Σ w N_i N_j``). The files are read in the reader child
+(:mod:`splinedeform.cad_child`).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .cad import CAD_SUFFIXES, SEAM_TOL, WEIGHT_TOL, weight_factors
+from .cad_child import read_in_child
+from .errors import InputError
+from .knots import KnotVectorBasis
+from .quadrature import gauss_points
+
+#: Gauss points per knot span and direction for the area (a rational integrand: not exact;
+#: 16 points give round-off on conics, see tests/test_cad_faces.py)
+AREA_POINTS = 16
+#: a STEP / IGES face whose own area (inside its loops) is smaller than its surface's by
+#: more than this fraction is trimmed
+TRIM_AREA_TOL = 1e-6
+
+
+def read_faces(path: str | os.PathLike) -> dict[str, Any]:
+    """``{"file", "units", "faces": [...]}``: every face of a CAD file (see the module
+    docstring); one dict per face with ``face``, ``object``, ``name``, ``layer``, ``kind``,
+    ``degrees``, ``net``, ``weights``, ``trimmed``, ``closed``, ``periodic``, ``c0_knots``,
+    ``degenerate``, ``area`` (of the untrimmed surface) and ``trimmed_area`` (inside the
+    face's loops, by OpenCASCADE; None for ``.3dm``), or ``error`` for a face that cannot
+    be read. Knot values are the file's parameters."""
+    path = Path(path)
+    kind = CAD_SUFFIXES.get(path.suffix.lower())
+    if kind is None:
+        raise InputError(f"{path}: not a CAD file (expected one of "
+                         f"{', '.join(CAD_SUFFIXES)}), got suffix {path.suffix or 'none'!r}")
+    if not path.is_file():
+        raise InputError(f"{path}: no such file")
+    if kind == "openNURBS":
+        from .cad_3dm_read import _rhino3dm, list_3dm_arrays
+
+        _rhino3dm()
+        data = read_in_child(list_3dm_arrays, path, library="openNURBS (rhino3dm)")
+    else:
+        import importlib.util
+
+        from .cad_step_read import MISSING, list_step_arrays
+
+        if importlib.util.find_spec("OCP") is None:  # pragma: no cover - the installation
+            raise InputError(MISSING)
+        data = read_in_child(list_step_arrays, path, library="OpenCASCADE")
+    faces = [_describe(number, entry) for number, entry in enumerate(data["faces"])]
+    return {"file": str(path), "units": data["units"], "faces": faces}
+
+
+def _describe(number: int, entry: dict[str, Any]) -> dict[str, Any]:
+    out: dict[str, Any] = {"face": number, **{k: entry.get(k) for k in
+                                               ("object", "name", "layer", "kind")}}
+    if "error" in entry:
+        return {**out, "error": entry["error"]}
+    degrees = tuple(int(n) for n in entry["degrees"])
+    bases = [KnotVectorBasis(n, np.asarray(t, dtype=float))
+             for n, t in zip(degrees, (entry["knots_u"], entry["knots_v"]))]
+    points, w = np.asarray(entry["points"], float), np.asarray(entry["weights"], float)
+    whole = area(bases, points, w)
+    inside = entry.get("trimmed_area")
+    trimmed = bool(entry["trimmed"]) or (inside is not None and
+                                         abs(inside) < whole * (1 - TRIM_AREA_TOL))
+    return {**out, "degrees": list(degrees), "net": list(w.shape), "weights": _weights(w),
+            "trimmed": trimmed, "closed": [bool(c) for c in entry["closed"]],
+            "periodic": [bool(c) for c in entry["periodic"]],
+            "c0_knots": {d: [float(x) for x in b.c0_knots] for d, b in zip("uv", bases)},
+            "degenerate": degenerate_edges(points), "area": whole,
+            "trimmed_area": None if inside is None else abs(float(inside))}
+
+
+def _weights(w: NDArray[np.float64]) -> str:
+    """``"1"`` (polynomial), ``"product"`` (``a_i b_j``) or ``"general"``."""
+    if np.ptp(w) <= WEIGHT_TOL * w.max():
+        return "1"
+    try:
+        weight_factors(w)
+    except InputError:
+        return "general"
+    return "product"
+
+
+def degenerate_edges(points: NDArray[np.float64]) -> list[str]:
+    """Edges ``u0``, ``u1``, ``v0``, ``v1`` of the net whose row of control points is one
+    point within :data:`~splinedeform.cad.SEAM_TOL` of the net's size (a pole)."""
+    size = max(float(np.ptp(points.reshape(-1, 3), axis=0).max()), 1e-300)
+    rows = {"u0": points[0], "u1": points[-1], "v0": points[:, 0], "v1": points[:, -1]}
+    return [name for name, row in rows.items()
+            if np.ptp(row, axis=0).max() <= SEAM_TOL * size]
+
+
+def area(bases: list[KnotVectorBasis], points: NDArray[np.float64],
+         weights: NDArray[np.float64]) -> float:
+    """Area of the rational surface ``S = N / W`` (see the module docstring)."""
+    (xu, au), (xv, av) = (gauss_points(b, AREA_POINTS) for b in bases)
+    (Bu, Du), (Bv, Dv) = ((b(x), b(x, 1)) for b, x in zip(bases, (xu, xv)))
+    hom = np.concatenate([points * weights[..., None], weights[..., None]], axis=-1)
+    grid = lambda A, B: np.einsum("ai,ijc,bj->abc", A, hom, B)  # noqa: E731
+    H, Hu, Hv = grid(Bu, Bv), grid(Du, Bv), grid(Bu, Dv)
+    W = H[..., 3:]
+    S = H[..., :3] / W
+    Su, Sv = (Hu[..., :3] - S * Hu[..., 3:]) / W, (Hv[..., :3] - S * Hv[..., 3:]) / W
+    return float(np.einsum("a,b,ab->", au, av, np.linalg.norm(np.cross(Su, Sv), axis=-1)))
+
+
+def faces_text(listing: dict[str, Any]) -> str:
+    """The listing as a table, one line per face."""
+    head = ("face", "object", "name", "layer", "kind", "degree", "net", "weights", "trimmed",
+            "closed", "periodic", "C0 knots", "poles", "area")
+    rows = []
+    for f in listing["faces"]:
+        if "error" in f:
+            rows.append((str(f["face"]), str(f["object"]), f["name"] or "-", f["layer"] or "-",
+                         f["kind"], "unreadable: " + f["error"]))
+            continue
+        uv = lambda pair: "".join(d for d, c in zip("uv", pair) if c) or "-"  # noqa: E731
+        c0 = ", ".join(f"{d}={x:.6g}" for d, xs in f["c0_knots"].items() for x in xs) or "-"
+        rows.append((str(f["face"]), str(f["object"]), f["name"] or "-", f["layer"] or "-",
+                     f["kind"], "x".join(map(str, f["degrees"])), "x".join(map(str, f["net"])),
+                     f["weights"], "yes" if f["trimmed"] else "no", uv(f["closed"]),
+                     uv(f["periodic"]), c0, ",".join(f["degenerate"]) or "-",
+                     f"{f['area']:.6g}"))
+    widths = [max([len(head[k])] + [len(r[k]) for r in rows if len(r) > k])
+              for k in range(len(head))]
+    widths[5] = max([len(head[5])] + [len(r[5]) for r in rows if len(r) > 6])
+    lines = [f"{listing['file']}: {len(listing['faces'])} face(s), units "
+             f"{listing['units'] or 'not declared'}",
+             "  ".join(h.ljust(wd) for h, wd in zip(head, widths)).rstrip()]
+    lines += ["  ".join(c.ljust(wd) for c, wd in zip(r, widths)).rstrip() for r in rows]
+    return "\n".join(lines) + "\n"
+
+
+def faces_json(listing: dict[str, Any]) -> str:
+    """The listing as JSON."""
+    return json.dumps(listing, indent=2) + "\n"
