@@ -245,11 +245,15 @@ def validate_command(scenario: Path = SCENARIO_ARG, allow_outside_paths: bool = 
 
 
 @app.command("schema")
-def schema_command() -> None:
+def schema_command(sweep: bool = typer.Option(False, "--sweep", help="The schema of sweep "
+                                              "files (docs/sweep.md) instead.")) -> None:
     """Print the JSON Schema of scenario files (for editors: see docs/scenario.md)."""
     import json
 
-    from .scenario.schema import json_schema
+    if sweep:
+        from .study.schema import json_schema
+    else:
+        from .scenario.schema import json_schema
 
     sys.stdout.write(json.dumps(json_schema(), indent=2, ensure_ascii=False) + "\n")
 
@@ -344,6 +348,16 @@ def _register_sculpt() -> None:
 
 
 _register_sculpt()
+
+
+def _register_sweep() -> None:
+    """Add ``splinedeform sweep`` (it runs on Dask: the extra 'sweep')."""
+    from .study.command import register
+
+    register(app)
+
+
+_register_sweep()
 
 
 def main() -> None:
