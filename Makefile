@@ -5,7 +5,7 @@ BIN    := $(VENV)/bin
 # make demo installs what the demo needs (extra: tool); make test what the suite needs: every
 # extra but render3d (VTK; matplotlib is the fallback) and cad-step (about 400 MB).
 DEMO_EXTRAS := tool
-TEST_EXTRAS := tool,video,cad,sculpt,test
+TEST_EXTRAS := tool,video,cad,sculpt,sweep,test
 
 .PHONY: demo test bench clean
 

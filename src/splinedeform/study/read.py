@@ -118,8 +118,9 @@ def parse_sweep(content: str, source: str = "<sweep>", directory: Path | None = 
                                  "of the axes' values); give each axis values or count")
     if kind != "grid" and "n" not in raw.get("design", {}):
         problems.add("design.n", f"missing: a {kind} design draws n cases")
+    given = _axes(raw.get("axis"), kind, problems)
     base = _base_scenario(top.get("scenario"), directory, problems)
-    axes = _axes(raw.get("axis"), kind, base, problems)
+    axes = _axis_keys(given, base, problems)
     problems.raise_if_any()
     assert base is not None
     return Sweep(base=base, axes=tuple(axes), design=kind, n=design.get("n"),
@@ -140,7 +141,8 @@ def _base_scenario(name: str | None, directory: Path, problems: _Problems) -> Sc
     return load_scenario(path)       # the base scenario's problems are located in its file
 
 
-def _axes(raw: Any, kind: str, base: Scenario | None, problems: _Problems) -> list[AxisSpec]:
+def _axes(raw: Any, kind: str, problems: _Problems) -> list[tuple[str, dict[str, Any]]]:
+    """The checked values of each ``[[axis]]`` table, with its key path (``axis[i]``)."""
     if raw is None:
         problems.add("axis", "missing: a sweep needs at least one [[axis]] table "
                              "(key = \"material.w20\", values = [...])")
@@ -148,7 +150,7 @@ def _axes(raw: Any, kind: str, base: Scenario | None, problems: _Problems) -> li
     if not isinstance(raw, list):
         problems.add("axis", "expected [[axis]] tables (an array of tables)")
         return []
-    axes, seen = [], {}
+    axes = []
     for i, table in enumerate(raw, start=1):
         where = f"axis[{i}]"
         values = _check_table(table, AXIS_KEYS, where, problems, "axis")
@@ -178,6 +180,16 @@ def _axes(raw: Any, kind: str, base: Scenario | None, problems: _Problems) -> li
             if kind != "grid" and "count" in table:
                 problems.add(f"{where}.count", f"does not apply to a {kind} design (it draws "
                                                "design.n values)")
+        axes.append((where, values))
+    return axes
+
+
+def _axis_keys(given: list[tuple[str, dict[str, Any]]], base: Scenario | None,
+               problems: _Problems) -> list[AxisSpec]:
+    """Each axis whose key the base scenario's schema knows; the others refused by name."""
+    axes: list[AxisSpec] = []
+    seen: dict[str, str] = {}
+    for where, values in given:
         key = values.get("key")
         if key is None or base is None:
             continue
@@ -191,7 +203,7 @@ def _axes(raw: Any, kind: str, base: Scenario | None, problems: _Problems) -> li
             continue
         seen[path.path] = where
         axes.append(AxisSpec(key=path.path, path=path, values=values.get("values"),
-                             range=low_high, count=values.get("count"),
+                             range=values.get("range"), count=values.get("count"),
                              scale=values.get("scale", "linear"),
                              integer=values.get("integer", False)))
     return axes

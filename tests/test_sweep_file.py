@@ -1,0 +1,222 @@
+"""Sweep files: reading and located errors, the designs, the cases and their hashes, one task.
+
+Nothing here starts a Dask cluster (tests/test_sweep_dask.py does): the task of one model
+group, :func:`splinedeform.study.solve.solve_group`, runs in this process.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from splinedeform import ScenarioError
+from splinedeform.study import load_sweep
+from splinedeform.study.cases import plan_cases
+from splinedeform.study.design import design_points
+from splinedeform.study.solve import solve_group
+from splinedeform.study.store import case_file, write_tables
+
+from sweep_files import write
+
+AXES = """\
+scenario = "base.toml"
+
+[[axis]]
+key = "material.damping"
+values = [0.5, 2.0]
+
+[[axis]]
+key = "load[1].at"
+values = [[0.5, 0.5], [0.3, 0.6], [0.7, 0.2]]
+"""
+
+
+def error_of(tmp_path, text: str) -> str:
+    with pytest.raises(ScenarioError) as info:
+        load_sweep(write(tmp_path, text))
+    return str(info.value)
+
+
+def line_of(text: str, start: str) -> int:
+    return next(i for i, line in enumerate(text.splitlines(), 1) if line.startswith(start))
+
+
+def test_an_unknown_axis_key_is_refused_naming_the_axis_and_its_line(tmp_path):
+    text = AXES.replace('key = "material.damping"', 'key = "material.stiffness"')
+    message = error_of(tmp_path, text)
+    line = line_of(text, 'key = "material.stiffness')
+    assert f"study.toml:{line}: axis[1].key" in message
+    assert "axis 'material.stiffness' is refused" in message and "w20" in message
+
+
+@pytest.mark.parametrize("key, says", [
+    ("load[2].at", "has 1 [[load]] table"),
+    ("load.0.at", "has 1 [[load]] table"),
+    ("load[1].position", "is not a key of [load]"),
+    ("solid.E", "no table [solid]"),
+    ("w20", "names its table"),
+])
+def test_keys_the_base_scenario_does_not_have_are_refused(tmp_path, key, says):
+    message = error_of(tmp_path, AXES.replace('"load[1].at"', f'"{key}"'))
+    assert "axis[2].key" in message and says in message, message
+
+
+def test_every_problem_of_a_sweep_file_is_reported_at_its_line(tmp_path):
+    text = """\
+scenario = "base.toml"
+colour = "red"
+
+[design]
+kind = "random"
+
+[[axis]]
+key = "material.w10"
+range = [2.0, 1.0]
+scale = "log"
+
+[[axis]]
+key = "material.w01"
+values = [1.0]
+count = 3
+"""
+    message = error_of(tmp_path, text)
+    assert "4 problems in the sweep file" in message, message
+    assert "study.toml:2: colour: unknown key" in message
+    assert "study.toml:4: design.n: missing: a random design draws n cases" in message
+    assert "study.toml:9: axis[1].range: expected low < high, got [2, 1]" in message
+    assert "study.toml:15: axis[2].count: applies to range only" in message
+
+
+def test_a_missing_base_scenario_names_the_scenario_key(tmp_path):
+    message = error_of(tmp_path, AXES.replace('"base.toml"', '"nowhere.toml"'))
+    assert "study.toml:1: scenario: the base scenario" in message and "nowhere.toml" in message
+
+
+def test_a_grid_is_every_combination_first_axis_slowest(tmp_path):
+    sweep = load_sweep(write(tmp_path, AXES))
+    points = design_points(sweep)
+    assert [(p["material.damping"], p["load[1].at"]) for p in points] == [
+        (0.5, [0.5, 0.5]), (0.5, [0.3, 0.6]), (0.5, [0.7, 0.2]),
+        (2.0, [0.5, 0.5]), (2.0, [0.3, 0.6]), (2.0, [0.7, 0.2])]
+
+
+def test_a_log_range_is_a_geometric_sequence(tmp_path):
+    text = 'scenario = "base.toml"\n[[axis]]\nkey = "material.w10"\nrange = [0.01, 100.0]\n' \
+           'count = 5\nscale = "log"\n'
+    values = [p["material.w10"] for p in design_points(load_sweep(write(tmp_path, text)))]
+    # 0.01 · 10^(2i): exact in exp/log up to a few ulps, hence 1e-12 relative
+    np.testing.assert_allclose(values, [0.01, 0.1, 1.0, 10.0, 100.0], rtol=1e-12)
+
+
+def test_a_latin_hypercube_puts_one_point_in_each_stratum_of_each_axis(tmp_path):
+    text = """\
+scenario = "base.toml"
+[design]
+kind = "latin-hypercube"
+n = 20
+seed = 7
+[[axis]]
+key = "material.w10"
+range = [1.0, 3.0]
+[[axis]]
+key = "material.damping"
+range = [0.1, 10.0]
+scale = "log"
+"""
+    points = design_points(load_sweep(write(tmp_path, text)))
+    w10 = np.array([p["material.w10"] for p in points])
+    damping = np.array([p["material.damping"] for p in points])
+    # stratum k of n of [1, 3] is [1 + 2k/n, 1 + 2(k+1)/n): each holds exactly one point
+    assert sorted(np.floor((w10 - 1.0) / 2.0 * 20).astype(int)) == list(range(20))
+    assert sorted(np.floor(np.log(damping / 0.1) / np.log(100.0) * 20).astype(int)) == \
+        list(range(20))
+    again = design_points(load_sweep(write(tmp_path / "again", text)))
+    assert again == points      # the seed fixes the draw
+
+
+def test_cases_differing_only_in_loads_share_a_model_and_every_case_has_its_own_hash(tmp_path):
+    cases = plan_cases(load_sweep(write(tmp_path, AXES)))
+    assert len(cases) == 6 and len({c.hash for c in cases}) == 6
+    assert len({c.model for c in cases}) == 2       # two dampings; the load places share
+    assert [c.index for c in cases] == [1, 2, 3, 4, 5, 6]
+
+
+def test_a_value_the_key_does_not_allow_fails_its_case_with_the_readers_message(tmp_path):
+    text = AXES.replace("values = [0.5, 2.0]", "values = [0.5, -1.0]")
+    cases = plan_cases(load_sweep(write(tmp_path, text)))
+    refused = [c for c in cases if c.error is not None]
+    assert [c.index for c in refused] == [4, 5, 6]
+    assert "(axis material.damping = -1.0): material.damping: expected a number >= 0" in \
+        refused[0].error, refused[0].error
+
+
+def test_one_task_solves_its_cases_on_one_model_and_skips_those_stored(tmp_path):
+    cases = plan_cases(load_sweep(write(tmp_path, AXES)))
+    group = [c for c in cases if c.model == cases[0].model]
+    out = tmp_path / "out"
+    rows = solve_group(group, str(out))
+    assert [r["status"] for r in rows] == ["ok"] * 3
+    assert all(case_file(out, c.hash).is_file() for c in group)
+    # the probe at the load's point moves most when the load is there: p1 sits at (0.5, 0.5)
+    assert rows[0]["p1_max"] > rows[1]["p1_max"] and rows[0]["p1_max"] > rows[2]["p1_max"]
+    inodes = [case_file(out, c.hash).stat().st_ino for c in group]
+    again = solve_group(group, str(out))
+    assert again == rows
+    assert [case_file(out, c.hash).stat().st_ino for c in group] == inodes
+
+
+def test_a_case_that_raises_gets_its_error_in_its_row_and_the_others_go_on(tmp_path):
+    static = """\
+[surface]
+shape = "plane"
+cells = 3
+
+[material]
+w10 = 1.0
+w01 = 1.0
+
+[boundary]
+u0 = "clamped"
+
+[[load]]
+kind = "uniform"
+force = [0.0, 0.0, -1.0]
+
+[solve]
+kind = "static"
+frames = 2
+
+[output]
+formats = []
+"""
+    text = 'scenario = "base.toml"\n[[axis]]\nkey = "boundary.u0"\nvalues = ["free", "clamped"]\n'
+    cases = plan_cases(load_sweep(write(tmp_path, text, scenario=static)))
+    rows = [row for c in cases for row in solve_group([c], str(tmp_path / "out"))]
+    assert "unconstrained surface" in rows[0]["status"] and "base.toml" in rows[0]["status"]
+    assert rows[1]["status"] == "ok" and rows[1]["max_displacement"] > 0
+
+
+def test_tables_hold_one_row_per_case_with_list_values_as_columns(tmp_path):
+    pa = pytest.importorskip("pyarrow.parquet")
+    rows = [{"case": 1, "values": {"load[1].at": [0.5, 0.25]}, "status": "ok", "x": 1.5},
+            {"case": 2, "values": {"load[1].at": [0.3, 0.6]}, "status": "bad: no", "x": None}]
+    csv_path, parquet_path = write_tables(tmp_path, rows)
+    table = pa.read_table(parquet_path).to_pylist()
+    assert [r["load[1].at[2]"] for r in table] == [0.25, 0.6]
+    assert table[0]["x"] == 1.5 and math.isnan(table[1]["x"])
+    assert csv_path.read_text().splitlines()[0] == "case,load[1].at[1],load[1].at[2],status,x"
+
+
+def test_the_sweep_schema_is_json_schema_of_the_example():
+    jsonschema = pytest.importorskip("jsonschema")
+    import tomllib
+    from pathlib import Path
+
+    from splinedeform.study.schema import json_schema
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "sweeps" / "plate_stiffness.toml"
+    jsonschema.validate(tomllib.loads(example.read_text()), json_schema())
+    json.dumps(json_schema())
