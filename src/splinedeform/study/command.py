@@ -75,6 +75,7 @@ def register(app: typer.Typer) -> None:
             quiet: bool = QUIET_OPT, debug: bool = DEBUG_OPT) -> None:
         """Run a design study: every case of a sweep file on Dask, tables and report in OUT."""
         from .run import sweep
+        from .store import stored_cases
 
         out, err = _consoles()
         with _reported_errors(debug):
@@ -83,7 +84,7 @@ def register(app: typer.Typer) -> None:
                     result = sweep(sweep_file, outdir, workers=workers, scheduler=scheduler,
                                    memory_limit=memory_limit, progress=bar)
             except KeyboardInterrupt:
-                stored = len(list((outdir / "cases").glob("*.json")))
+                stored = len(stored_cases(outdir))
                 err.print(f"interrupted: {stored} case results are stored in "
                           f"{_escape(str(outdir))}; run the same command again to compute "
                           "the others", highlight=False, soft_wrap=True)
@@ -93,7 +94,8 @@ def register(app: typer.Typer) -> None:
                               f"failed {result.failed})"),
                     ("this run", f"{result.computed} cases computed on {result.models} "
                                  f"models, {result.reused} read back"),
-                    ("workers", str(result.workers)),
+                    ("workers", str(result.workers) if result.computed else
+                     "none started (every case was stored)"),
                     ("wall time", f"{result.wall_s:.1f} s"),
                     *((name, str(path)) for name, path in result.files.items()
                       if not name.startswith("plot"))]

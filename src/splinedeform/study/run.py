@@ -25,7 +25,7 @@ from .cases import Case, plan_cases
 from .cluster import dashboard, dask_client
 from .read import Sweep, load_sweep
 from .solve import solve_group
-from .store import case_file, stored, write_tables
+from .store import case_file, remove_partial, stored, write_tables
 
 #: ``progress(done, failed, running, total, dashboard)``, called about twice a second
 SweepProgress = Callable[[int, int, int, int, "str | None"], None]
@@ -79,6 +79,7 @@ def sweep(sweep_file_or_spec: str | Path | Sweep, out: str | Path, client: Any =
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise InputError(f"cannot create the output folder {folder}: {exc}") from None
+    remove_partial(folder)
     cases = plan_cases(spec)
     pending = [c for c in cases if c.scenario is not None and not case_file(folder, c.hash).exists()]
     groups: dict[str, list[Case]] = {}

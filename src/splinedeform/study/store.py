@@ -25,6 +25,17 @@ def case_file(folder: str | Path, digest: str) -> Path:
     return Path(folder) / CASES / f"{digest}.json"
 
 
+def stored_cases(folder: str | Path) -> list[Path]:
+    """The case result files in ``folder`` (not the temporary files of writes under way)."""
+    return [p for p in (Path(folder) / CASES).glob("*.json") if not p.name.startswith(".")]
+
+
+def remove_partial(folder: str | Path) -> None:
+    """Remove the temporary files a killed worker left mid-write (never a stored result)."""
+    for path in (Path(folder) / CASES).glob(".*.tmp.json"):
+        path.unlink(missing_ok=True)
+
+
 def stored(folder: str | Path, digest: str) -> dict[str, Any] | None:
     """The stored result of a case, or None when it has none (or an unreadable one)."""
     try:
