@@ -42,6 +42,8 @@ class RunResult:
     probe_points: dict[str, tuple[float, float]] = field(default_factory=dict)
     energy: dict[str, Any] | None = None
     max_displacement: float = 0.0
+    #: ``max_(u,v) |d_f(u, v)|`` on the output grid at each frame ``f``
+    displacement_per_frame: Any = None
     timings: dict[str, float] = field(default_factory=dict)
     outputs: list[tuple[str, Path]] = field(default_factory=list)
     report: dict[str, Any] = field(default_factory=dict)
@@ -275,7 +277,9 @@ def _measure(result: RunResult) -> None:
     Bu = surface.basis_u.matrix(uu).toarray()
     Bv = surface.basis_v.matrix(vv).toarray()
     grid = np.einsum("ik,fklc,jl->fijc", Bu, D, Bv, optimize=True)
-    result.max_displacement = float(np.linalg.norm(grid, axis=-1).max())
+    per_frame = np.linalg.norm(grid, axis=-1).reshape(len(grid), -1).max(axis=1)
+    result.displacement_per_frame = per_frame
+    result.max_displacement = float(result.displacement_per_frame.max())
     solution = result.solution
     if scenario.solve.kind == "dynamic":
         energy = solution.energy(result.times)

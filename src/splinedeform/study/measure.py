@@ -27,7 +27,7 @@ def figures(result: Any) -> dict[str, Any]:
     row: dict[str, Any] = {"max_displacement": (float(result.max_displacement)
                                                 if kind != "modes" else None)}
     if kind == "dynamic":
-        row["time_of_max"] = float(result.times[int(np.argmax(_largest_per_frame(result)))])
+        row["time_of_max"] = float(result.times[int(np.argmax(result.displacement_per_frame))])
     if result.omegas is not None:
         row.update({f"omega_{i}": float(w) for i, w in enumerate(result.omegas, start=1)})
     energy = result.energy or {}
@@ -43,14 +43,3 @@ def figures(result: Any) -> dict[str, Any]:
         row[f"p{i}_max"] = float(np.linalg.norm(history, axis=-1).max())
         row.update({f"p{i}_{c}": float(x) for c, x in zip("xyz", history[-1])})
     return row
-
-
-def _largest_per_frame(result: Any) -> np.ndarray:
-    """``max_(u,v) |d_f(u, v)|`` for each frame ``f``, on the output grid of the run."""
-    surface = result.built.surface
-    D = result.nets - surface.control_points
-    uu, vv = surface.sample_parameters(result.scenario.output.resolution)
-    Bu = surface.basis_u.matrix(uu).toarray()
-    Bv = surface.basis_v.matrix(vv).toarray()
-    grid = np.einsum("ik,fklc,jl->fijc", Bu, D, Bv, optimize=True)
-    return np.linalg.norm(grid, axis=-1).reshape(len(D), -1).max(axis=1)
