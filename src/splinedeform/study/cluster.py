@@ -9,6 +9,7 @@ shared among the workers).
 from __future__ import annotations
 
 import os
+from pathlib import Path
 from contextlib import contextmanager
 from typing import Any, Iterator
 
@@ -19,6 +20,9 @@ from ..errors import InputError
 def dask_client(workers: int | None = None, scheduler: str | None = None,
                 memory_limit: str | None = None) -> Iterator[Any]:
     """A ``distributed.Client``: to ``scheduler`` when given, else to a new local cluster.
+
+    ``scheduler`` is an address (``tcp://127.0.0.1:8786``) or the JSON file a scheduler
+    started with ``--scheduler-file`` writes.
 
     Raises
     ------
@@ -36,7 +40,10 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
             raise InputError("--workers and --memory-limit apply to a local cluster; the "
                              "workers of --scheduler are started with their own options")
         try:
-            client = Client(scheduler, timeout="10s")
+            if "://" not in scheduler and Path(scheduler).is_file():
+                client = Client(scheduler_file=scheduler, timeout="10s")
+            else:
+                client = Client(scheduler, timeout="10s")
         except (OSError, TimeoutError, ValueError) as exc:
             raise InputError(f"cannot reach the Dask scheduler {scheduler!r}: {exc}") from None
         try:
@@ -47,6 +54,14 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
     n = workers if workers is not None else (os.cpu_count() or 1)
     if n < 1:
         raise InputError(f"--workers must be at least 1, got {n}")
+    if memory_limit is not None:
+        from dask.utils import parse_bytes
+
+        try:
+            parse_bytes(memory_limit)
+        except (ValueError, TypeError):
+            raise InputError(f"--memory-limit takes a size such as 2GiB or 500MB, got "
+                             f"{memory_limit!r}") from None
     try:
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                host="127.0.0.1", dashboard_address="127.0.0.1:0",

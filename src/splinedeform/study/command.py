@@ -67,8 +67,9 @@ def register(app: typer.Typer) -> None:
                 None, "--workers", help="Worker processes of the local cluster. "
                                         "[default: one per core]"),
             scheduler: Optional[str] = typer.Option(
-                None, "--scheduler", help="Address of a running Dask scheduler "
-                                          "(tcp://host:port) instead of a local cluster."),
+                None, "--scheduler", help="A running Dask scheduler instead of a local "
+                                          "cluster: its address (tcp://host:port) or its "
+                                          "--scheduler-file."),
             memory_limit: Optional[str] = typer.Option(
                 None, "--memory-limit", help="Memory limit of each local worker, e.g. 2GiB. "
                                              "[default: the memory shared among the workers]"),
