@@ -220,3 +220,51 @@ def test_the_sweep_schema_is_json_schema_of_the_example():
     example = Path(__file__).resolve().parents[1] / "examples" / "sweeps" / "plate_stiffness.toml"
     jsonschema.validate(tomllib.loads(example.read_text()), json_schema())
     json.dumps(json_schema())
+
+
+ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
+
+
+def test_the_example_sweep_shows_linear_plate_theory_on_three_models(tmp_path):
+    """examples/sweeps/plate_stiffness.toml, its six cases solved in this process: twice the
+    load gives twice the deflection, a stiffer plate deflects less, and at w20 = 1 the
+    Navier value 0.00406235 q a⁴/D of the base scenario holds."""
+    cases = plan_cases(load_sweep(ROOT / "examples" / "sweeps" / "plate_stiffness.toml"))
+    assert len(cases) == 6 and len({c.model for c in cases}) == 3
+    out = tmp_path / "out"
+    rows = {(c.values["material.w20"], c.values["load[1].force"][2]): row
+            for model in dict.fromkeys(c.model for c in cases)
+            for c, row in zip([c for c in cases if c.model == model],
+                              solve_group([c for c in cases if c.model == model], str(out)))}
+    for w20 in (0.5, 1.0, 2.0):
+        # linear statics: the same factorisation, the load doubled; rounding only (1e-12)
+        assert rows[(w20, -2.0)]["p1_z"] == pytest.approx(2 * rows[(w20, -1.0)]["p1_z"],
+                                                          rel=1e-12)
+    assert -rows[(0.5, -1.0)]["p1_z"] > -rows[(1.0, -1.0)]["p1_z"] > -rows[(2.0, -1.0)]["p1_z"]
+    # the base scenario's own check (8 cubic cells): a fraction of a per cent of Navier
+    assert -rows[(1.0, -1.0)]["p1_z"] == pytest.approx(0.00406235, rel=5e-3)
+
+
+def _sweep_blocks() -> list[str]:
+    import re
+
+    text = (ROOT / "docs" / "sweep.md").read_text(encoding="utf-8")
+    return [b for b in re.findall(r"```toml\n(.*?)```", text, re.S) if "scenario =" in b]
+
+
+@pytest.mark.parametrize("block", _sweep_blocks(), ids=lambda b: b.splitlines()[0][:30])
+def test_the_sweep_files_of_the_docs_are_valid_beside_the_examples(block):
+    from splinedeform.study import parse_sweep
+
+    sweep = parse_sweep(block, source="docs/sweep.md", directory=ROOT / "examples" / "sweeps")
+    assert design_points(sweep)
+
+
+def test_the_docs_describe_every_key_of_sweep_files():
+    from splinedeform.study import schema as S
+
+    text = (ROOT / "docs" / "sweep.md").read_text(encoding="utf-8")
+    for table, model in (("design", S.Design), ("axis", S.Axis), ("output", S.SweepOutput)):
+        for name in model.model_fields:
+            assert f"`{table}.{name}`" in text, f"{table}.{name} missing from docs/sweep.md"
+    assert "`scenario`" in text and "`title`, `description`" in text
