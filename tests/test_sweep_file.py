@@ -268,3 +268,18 @@ def test_the_docs_describe_every_key_of_sweep_files():
         for name in model.model_fields:
             assert f"`{table}.{name}`" in text, f"{table}.{name} missing from docs/sweep.md"
     assert "`scenario`" in text and "`title`, `description`" in text
+
+
+def test_per_case_outputs_are_written_only_when_the_sweep_asks(tmp_path):
+    from sweep_files import MEMBRANE
+
+    scenario = MEMBRANE.replace("formats = []", 'formats = ["npz"]')
+    for asks in (False, True):
+        text = AXES + ("\n[output]\ncases = true\n" if asks else "")
+        folder = tmp_path / str(asks)
+        sweep = load_sweep(write(folder, text, scenario=scenario))
+        assert sweep.cases_output is asks
+        case = plan_cases(sweep)[0]
+        solve_group([case], str(folder / "out"), sweep.cases_output)
+        written = list((folder / "out" / "cases").glob(f"{case.hash}/*.npz"))
+        assert bool(written) is asks
