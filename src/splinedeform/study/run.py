@@ -81,7 +81,8 @@ def sweep(sweep_file_or_spec: str | Path | Sweep, out: str | Path, client: Any =
         raise InputError(f"cannot create the output folder {folder}: {exc}") from None
     remove_partial(folder)
     cases = plan_cases(spec)
-    pending = [c for c in cases if c.scenario is not None and not case_file(folder, c.hash).exists()]
+    pending = [c for c in cases
+               if c.scenario is not None and not case_file(folder, c.hash).exists()]
     groups: dict[str, list[Case]] = {}
     for case in pending:
         groups.setdefault(case.model, []).append(case)
