@@ -283,3 +283,13 @@ def test_per_case_outputs_are_written_only_when_the_sweep_asks(tmp_path):
         solve_group([case], str(folder / "out"), sweep.cases_output)
         written = list((folder / "out" / "cases").glob(f"{case.hash}/*.npz"))
         assert bool(written) is asks
+
+
+def test_a_load_off_the_surface_fails_its_case_not_the_others_of_its_model(tmp_path):
+    text = AXES.replace("values = [[0.5, 0.5], [0.3, 0.6], [0.7, 0.2]]",
+                        "values = [[1.5, 0.5], [0.3, 0.6]]").replace("[0.5, 2.0]", "[0.5]")
+    cases = plan_cases(load_sweep(write(tmp_path, text)))
+    assert len({c.model for c in cases}) == 1
+    rows = solve_group(cases, str(tmp_path / "out"))
+    assert "load[1].at: u = 1.5 is outside the parameter domain" in rows[0]["status"]
+    assert rows[1]["status"] == "ok"

@@ -224,22 +224,40 @@ def _check_parameters(scenario: Scenario, surface: Any) -> None:
 
 def build(scenario: Scenario) -> Built:
     """Surface, model and load of a scenario; library input errors name the scenario key."""
+    surface = build_surface(scenario)
+    _check_parameters(scenario, surface)
+    built = _model_on(scenario, surface)
+    built.load = build_load(scenario)
+    return built
+
+
+def build_model(scenario: Scenario) -> Built:
+    """Surface and model of a scenario without its loads (``load = None``).
+
+    What scenarios differing only in ``[[load]]``, ``[solve]`` and ``[output]`` share: each
+    then needs only :func:`check_parameters` and :func:`build_load` of its own.
+    """
+    return _model_on(scenario, build_surface(scenario))
+
+
+check_parameters = _check_parameters
+
+
+def _model_on(scenario: Scenario, surface: Any) -> Built:
     from ..material import Material
     from ..model import Model
 
-    surface = build_surface(scenario)
-    _check_parameters(scenario, surface)
     fixed = free_region_mask(scenario, surface)
     if scenario.material.physics == "shell":
         return Built(surface=surface, model=_shell_model(scenario, surface, fixed),
-                     load=build_load(scenario), fixed=fixed)
+                     load=None, fixed=fixed)
     with _located(scenario, "material"):
         material = Material(**scenario.material.weights())
     with _located(scenario, "boundary"):
         model = Model(surface, material, boundary=scenario.boundary.edges(), fixed=fixed,
                       mass_matrix=scenario.material.mass_matrix,
                       physics=scenario.material.physics)
-    return Built(surface=surface, model=model, load=build_load(scenario), fixed=fixed)
+    return Built(surface=surface, model=model, load=None, fixed=fixed)
 
 
 def _shell_model(scenario: Scenario, surface: Any, fixed: Any) -> Any:

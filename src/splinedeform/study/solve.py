@@ -18,8 +18,8 @@ from typing import Any
 from ..budget import check as check_budget
 from ..errors import InputError
 from ..pipeline import _prepare_outdir, _solve, _Stages, write_outputs
-from ..scenario import Built, build, build_load
-from ..scenario.build import _located
+from ..scenario import Built, build_load
+from ..scenario.build import _located, build_model, check_parameters
 from .cases import Case
 from .measure import figures
 from .store import CASES, store, stored
@@ -39,7 +39,7 @@ def solve_group(cases: list[Case], folder: str, case_outputs: bool = False
         start = time.perf_counter()
         if shared is None and model_error is None:
             try:
-                shared = build(case.scenario)
+                shared = build_model(case.scenario)
             except InputError as exc:
                 model_error = str(exc)
             except Exception as exc:  # noqa: BLE001  (the row says it; the sweep goes on)
@@ -61,6 +61,7 @@ def _solve_case(case: Case, shared: Built, folder: str, case_outputs: bool) -> d
     scenario = case.scenario
     assert scenario is not None
     try:
+        check_parameters(scenario, shared.surface)
         with _located(scenario, "load"):
             load = build_load(scenario)
         built = Built(surface=shared.surface, model=shared.model, load=load, fixed=shared.fixed)
