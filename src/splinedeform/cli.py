@@ -39,6 +39,8 @@ OPTIONAL = {
     "playwright": ("playwright", "viewer test in a headless browser"),
     "starlette": ("starlette", "sculpt server (extra: sculpt)"),
     "uvicorn": ("uvicorn", "sculpt server (extra: sculpt)"),
+    "distributed": ("distributed", "splinedeform sweep on Dask (extra: sweep)"),
+    "pyarrow": ("pyarrow", "Parquet tables of sweeps (extra: sweep)"),
 }
 
 
