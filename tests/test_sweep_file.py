@@ -293,3 +293,18 @@ def test_a_load_off_the_surface_fails_its_case_not_the_others_of_its_model(tmp_p
     rows = solve_group(cases, str(tmp_path / "out"))
     assert "load[1].at: u = 1.5 is outside the parameter domain" in rows[0]["status"]
     assert rows[1]["status"] == "ok"
+
+
+def test_the_command_line_prints_the_sweep_schema_and_refuses_a_bad_file_with_exit_2(tmp_path):
+    from typer.testing import CliRunner
+
+    from splinedeform.cli import app
+
+    runner = CliRunner()
+    shown = runner.invoke(app, ["schema", "--sweep"])
+    assert shown.exit_code == 0 and json.loads(shown.stdout)["title"] == "splinedeform sweep"
+    bad = write(tmp_path, AXES.replace('key = "material.damping"', 'key = "material.colour"'))
+    refused = runner.invoke(app, ["sweep", str(bad), "-o", str(tmp_path / "out")])
+    assert refused.exit_code == 2
+    assert "axis[1].key: axis 'material.colour' is refused" in refused.output
+    assert not (tmp_path / "out").exists()       # refused before anything is written
