@@ -154,12 +154,12 @@ def test_a_sweep_interrupted_by_sigint_resumes_with_the_cases_missing(tmp_path):
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
     process = subprocess.Popen(_sweep_command(str(path), "-o", str(out), "--workers", "1"),
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                               env=env)
+                               env=env, start_new_session=True)
     deadline = time.monotonic() + 120
     while len(stored(out)) < 2:
         assert process.poll() is None and time.monotonic() < deadline, process.communicate()
         time.sleep(0.02)
-    process.send_signal(signal.SIGINT)
+    os.killpg(process.pid, signal.SIGINT)     # as Ctrl-C: the command and its workers
     _, err = process.communicate(timeout=120)
     assert process.returncode == 130, err
     assert "interrupted" in err and "run the same command again" in err
