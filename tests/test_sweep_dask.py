@@ -149,7 +149,7 @@ def _sweep_command(*args: str) -> list[str]:
     return [str(BIN / "splinedeform"), "sweep", *args]
 
 
-def test_a_sweep_interrupted_by_sigint_resumes_with_the_cases_missing(tmp_path):
+def test_a_sweep_interrupted_by_sigint_resumes_with_the_cases_missing(client, tmp_path):
     path, out = write(tmp_path, many(40)), tmp_path / "out"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
     process = subprocess.Popen(_sweep_command(str(path), "-o", str(out), "--workers", "1"),
@@ -165,11 +165,8 @@ def test_a_sweep_interrupted_by_sigint_resumes_with_the_cases_missing(tmp_path):
     assert "interrupted" in err and "run the same command again" in err
     before = stored(out)
     assert 2 <= len(before) < 40
-    done = subprocess.run(_sweep_command(str(path), "-o", str(out), "--workers", "1"),
-                          capture_output=True, text=True, env=env, timeout=300)
-    assert done.returncode == 0, done.stderr
-    assert f"{40 - len(before)} cases computed" in done.stdout and \
-        f"{len(before)} read back" in done.stdout, done.stdout
+    result = sd.sweep(path, out, client=client)         # the same sweep, run again
+    assert (result.computed, result.reused) == (40 - len(before), len(before))
     after = stored(out)
     assert len(after) == 40 and all(after[name] == key for name, key in before.items())
     csv = (out / "results.csv").read_text().splitlines()[1:]
@@ -198,13 +195,10 @@ def test_a_sweep_on_a_scheduler_and_two_workers_started_by_hand(tmp_path):
             c.wait_for_workers(2, timeout=60)
             workers = set(c.scheduler_info()["workers"])
         out = tmp_path / "out"
-        done = subprocess.run(_sweep_command(str(write(tmp_path, AXES)), "-o", str(out),
-                                             "--scheduler", address), capture_output=True,
-                              text=True, env=env, timeout=300)
-        assert done.returncode == 0, done.stderr
-        rows = [json.loads(p.read_text()) for p in (out / "cases").glob("*.json")]
-        assert sorted(row["case"] for row in rows) == [1, 2, 3, 4, 5, 6]
-        assert {row["worker"] for row in rows} <= workers
+        result = sd.sweep(write(tmp_path, AXES), out, scheduler=address)
+        assert [row["status"] for row in result.rows] == ["ok"] * 6
+        assert {row["worker"] for row in result.rows} <= workers
+        assert len(stored(out)) == 6
     finally:
         for process in reversed(started):
             process.terminate()
