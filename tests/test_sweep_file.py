@@ -308,3 +308,18 @@ def test_the_command_line_prints_the_sweep_schema_and_refuses_a_bad_file_with_ex
     assert refused.exit_code == 2
     assert "axis[1].key: axis 'material.colour' is refused" in refused.output
     assert not (tmp_path / "out").exists()       # refused before anything is written
+
+
+def test_a_grid_extended_by_one_value_reuses_the_cases_computed(tmp_path):
+    """Results are stored by content: the first sweep's cases are found again by the second,
+    whose design puts them at other places."""
+    from splinedeform.study.run import _row
+
+    out = tmp_path / "out"
+    first = plan_cases(load_sweep(write(tmp_path / "a", AXES)))
+    solve_group([c for c in first if c.model == first[0].model], str(out))
+    wider = AXES.replace("values = [0.5, 2.0]", "values = [0.25, 0.5, 2.0]")
+    second = plan_cases(load_sweep(write(tmp_path / "a", wider)))
+    found = [c for c in second if case_file(out, c.hash).exists()]
+    assert [c.index for c in found] == [4, 5, 6]         # damping 0.5, now the second value
+    assert [_row(c, out)["case"] for c in found] == [4, 5, 6]

@@ -113,7 +113,9 @@ def _row(case: Case, folder: Path) -> dict[str, Any]:
     if row is None:     # the task's own rows are stored before it returns
         raise InputError(f"case {case.index}: its result {case_file(folder, case.hash)} is "
                          "missing or unreadable after the sweep")
-    return row
+    # a result is stored by content: a case equal to another (a value drawn twice), or one
+    # computed by an earlier sweep at another place of its design, shares the result
+    return {**row, "case": case.index, "values": case.values}
 
 
 def _run_groups(client: Any, spec: Sweep, folder: Path, cases: list[Case],
