@@ -27,6 +27,7 @@ from splinedeform.scenario import parse_scenario        # noqa: E402
 from sweep_files import MEMBRANE, write                 # noqa: E402
 
 BIN = Path(sys.executable).parent
+LOOPBACK = "127.0.0.1:0"        # the dashboard too listens on the loopback address only
 AXES = """\
 scenario = "base.toml"
 
@@ -49,7 +50,7 @@ def many(count: int) -> str:
 @pytest.fixture(scope="module")
 def client():
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  host="127.0.0.1", dashboard_address=None) as cluster, \
+                                  host="127.0.0.1", dashboard_address=LOOPBACK) as cluster, \
             distributed.Client(cluster) as c:
         yield c
 
@@ -131,7 +132,7 @@ def test_a_worker_killed_mid_sweep_loses_nothing_and_recomputes_nothing(tmp_path
     cloudpickle.register_pickle_by_value(sys.modules[__name__])
     out, marker = tmp_path / "out", tmp_path / "killed.json"
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  host="127.0.0.1", dashboard_address=None) as cluster, \
+                                  host="127.0.0.1", dashboard_address=LOOPBACK) as cluster, \
             distributed.Client(cluster) as c:
         c.register_plugin(KillOnSecondTask(str(marker), str(out)))
         result = sd.sweep(write(tmp_path, many(8)), out, client=c)
