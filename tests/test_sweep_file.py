@@ -323,3 +323,28 @@ def test_a_grid_extended_by_one_value_reuses_the_cases_computed(tmp_path):
     found = [c for c in second if case_file(out, c.hash).exists()]
     assert [c.index for c in found] == [4, 5, 6]         # damping 0.5, now the second value
     assert [_row(c, out)["case"] for c in found] == [4, 5, 6]
+
+
+def test_a_random_design_draws_log_uniformly_in_its_range_and_among_its_values(tmp_path):
+    text = """\
+scenario = "base.toml"
+[design]
+kind = "random"
+n = 200
+seed = 3
+[[axis]]
+key = "material.damping"
+range = [0.1, 10.0]
+scale = "log"
+[[axis]]
+key = "boundary.u0"
+values = ["clamped", "pinned"]
+"""
+    points = design_points(load_sweep(write(tmp_path, text)))
+    logs = np.log10([p["material.damping"] for p in points])
+    assert len(points) == 200 and logs.min() >= -1.0 and logs.max() <= 1.0
+    # log10 x uniform on [-1, 1]: mean 0, standard error 2/√12/√200 ≈ 0.041; 4 of them
+    assert abs(logs.mean()) < 0.17
+    presets = [p["boundary.u0"] for p in points]
+    # each preset with chance 1/2: 100 ± 7 (binomial standard deviation); 4 of them
+    assert abs(presets.count("clamped") - 100) < 28 and set(presets) == {"clamped", "pinned"}
