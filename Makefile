@@ -6,7 +6,7 @@ BIN    := $(VENV)/bin
 # extra but render3d (VTK; matplotlib is the fallback). cad-step (OpenCASCADE) is a 67 MB wheel,
 # 380 MB installed, about 5 s to install from PyPI.
 DEMO_EXTRAS := tool
-TEST_EXTRAS := tool,video,cad,cad-step,sculpt,test
+TEST_EXTRAS := tool,video,cad,cad-step,sculpt,sweep,test
 
 .PHONY: demo test bench clean
 

@@ -29,7 +29,7 @@ def installed_extras(target: str) -> list[str]:
 
 def test_make_demo_installs_the_tool_extra_and_make_test_what_the_suite_needs():
     assert installed_extras("demo") == ["tool"]
-    assert installed_extras("test") == ["tool,video,cad,cad-step,sculpt,test"]
+    assert installed_extras("test") == ["tool,video,cad,cad-step,sculpt,sweep,test"]
 
 
 #: extras make test leaves out, and why (their tests skip with the reason)

@@ -25,7 +25,16 @@ except ImportError:  # pragma: no cover - during development only
 
 __version__ = "0.1.0"
 
+
+def __getattr__(name: str) -> object:
+    """``splinedeform.sweep``: imported on first use (it needs pydantic; Dask to run)."""
+    if name == "sweep":
+        from .study import sweep
+
+        return sweep
+    raise AttributeError(f"module 'splinedeform' has no attribute {name!r}")
+
 __all__ = ["AreaForce", "ShellMaterial", "ShellModel", "BSplineBasis", "KnotVectorBasis", "RationalBasis", "Constant", "Energy", "Function", "Harmonic", "InputError",
            "Material", "Model", "Piecewise", "Point", "Pressure", "ScenarioError",
-           "SingularSystemError", "Solution", "StaticSolution", "Step", "Surface", "Uniform",
+           "SingularSystemError", "Solution", "StaticSolution", "Step", "Surface", "Uniform", "sweep",
            "loads", "shapes", "__version__"]

@@ -46,6 +46,8 @@ OPTIONAL = {
     "uvicorn": ("uvicorn", "sculpt server (extra: sculpt)"),
     "rhino3dm": ("rhino3dm", "openNURBS .3dm files (extra: cad)"),
     "OCP": ("cadquery-ocp-novtk", "STEP and IGES files, OpenCASCADE (extra: cad-step)"),
+    "distributed": ("distributed", "splinedeform sweep on Dask (extra: sweep)"),
+    "pyarrow": ("pyarrow", "Parquet tables of sweeps (extra: sweep)"),
 }
 
 
@@ -288,11 +290,15 @@ def faces_command(path: Path = typer.Argument(..., help="A .3dm, STEP or IGES fi
 
 
 @app.command("schema")
-def schema_command() -> None:
+def schema_command(sweep: bool = typer.Option(False, "--sweep", help="The schema of sweep "
+                                              "files (docs/sweep.md) instead.")) -> None:
     """Print the JSON Schema of scenario files (for editors: see docs/scenario.md)."""
     import json
 
-    from .scenario.schema import json_schema
+    if sweep:
+        from .study.schema import json_schema
+    else:
+        from .scenario.schema import json_schema
 
     sys.stdout.write(json.dumps(json_schema(), indent=2, ensure_ascii=False) + "\n")
 
@@ -391,6 +397,16 @@ def _register_sculpt() -> None:
 
 
 _register_sculpt()
+
+
+def _register_sweep() -> None:
+    """Add ``splinedeform sweep`` (it runs on Dask: the extra 'sweep')."""
+    from .study.command import register
+
+    register(app)
+
+
+_register_sweep()
 
 
 def main() -> None:

@@ -54,6 +54,8 @@ class RunResult:
     probe_points: dict[str, tuple[float, float]] = field(default_factory=dict)
     energy: dict[str, Any] | None = None
     max_displacement: float = 0.0
+    #: ``max_(u,v) |d_f(u, v)|`` on the output grid at each frame ``f``
+    displacement_per_frame: Any = None
     timings: dict[str, float] = field(default_factory=dict)
     outputs: list[tuple[str, Path]] = field(default_factory=list)
     report: dict[str, Any] = field(default_factory=dict)
@@ -333,9 +335,12 @@ def _measure(result: RunResult) -> None:
     Bu = surface.basis_u.matrix(uu).toarray()
     Bv = surface.basis_v.matrix(vv).toarray()
     grid = np.einsum("ik,fklc,jl->fijc", Bu, D, Bv, optimize=True)
-    size = float(np.abs(grid).max(initial=0.0))      # |d| of tiny d without squares underflowing
-    result.max_displacement = size * float(np.linalg.norm(grid / size, axis=-1).max()) \
-        if 0.0 < size < np.inf else size
+    # |d| per frame, scaled so that the squares of a tiny d do not underflow
+    size = float(np.abs(grid).max(initial=0.0))
+    scale = size if 0.0 < size < np.inf else 1.0
+    per_frame = scale * np.linalg.norm(grid / scale, axis=-1).reshape(len(grid), -1).max(axis=1)
+    result.displacement_per_frame = per_frame
+    result.max_displacement = float(per_frame.max(initial=0.0))
     solution = result.solution
     if scenario.solve.kind == "dynamic":
         energy = solution.energy(result.times)

@@ -262,9 +262,27 @@ def _check_parameters(scenario: Scenario, surface: Any) -> None:
 
 def build(scenario: Scenario) -> Built:
     """Surface, model and load of a scenario; library input errors name the scenario key."""
-    from ..material import Material
-    from ..model import Model
+    surface, units = _checked_surface(scenario)
+    _check_parameters(scenario, surface)
+    built = _model_on(scenario, surface, units)
+    built.load = build_load(scenario)
+    return built
 
+
+def build_model(scenario: Scenario) -> Built:
+    """Surface and model of a scenario without its loads (``load = None``).
+
+    What scenarios differing only in ``[[load]]``, ``[solve]`` and ``[output]`` share: each
+    then needs only :func:`check_parameters` and :func:`build_load` of its own.
+    """
+    return _model_on(scenario, *_checked_surface(scenario))
+
+
+check_parameters = _check_parameters
+
+
+def _checked_surface(scenario: Scenario) -> tuple[Any, str | None]:
+    """The surface and its unit (:func:`surface_and_units`), a file's lengths checked."""
     surface, units = surface_and_units(scenario)
     if scenario.surface.shape in ("file", "cad"):     # the built-in shapes' lengths are keys
         from .geometry import extent_problem
@@ -272,19 +290,24 @@ def build(scenario: Scenario) -> Built:
         problem = extent_problem(surface, scenario.material.thickness)
         if problem is not None:
             raise scenario.error("surface.path", problem)
-    _check_parameters(scenario, surface)
+    return surface, units
+
+
+def _model_on(scenario: Scenario, surface: Any, units: str | None) -> Built:
+    from ..material import Material
+    from ..model import Model
+
     fixed = free_region_mask(scenario, surface)
     if scenario.material.physics == "shell":
         return Built(surface=surface, model=_shell_model(scenario, surface, fixed),
-                     load=build_load(scenario), fixed=fixed, units=units)
+                     load=None, fixed=fixed, units=units)
     with _located(scenario, "material"):
         material = Material(**scenario.material.weights())
     with _located(scenario, "boundary"):
         model = Model(surface, material, boundary=scenario.boundary.edges(), fixed=fixed,
                       mass_matrix=scenario.material.mass_matrix,
                       physics=scenario.material.physics)
-    return Built(surface=surface, model=model, load=build_load(scenario), fixed=fixed,
-                 units=units)
+    return Built(surface=surface, model=model, load=None, fixed=fixed, units=units)
 
 
 def _shell_model(scenario: Scenario, surface: Any, fixed: Any) -> Any:

@@ -59,6 +59,24 @@ def parse_scenario(content: str, source: str = "<scenario>", directory: Path | N
     """Validate the TOML text of a scenario (see :func:`load_scenario`); a leading UTF-8
     byte order mark (as some editors write) is dropped."""
     content = content.removeprefix("\ufeff")
+    raw = read_toml(content, source)
+    lines = key_lines(content)
+    origins: dict[str, str] = {}
+    if overrides:
+        raw = _apply_overrides(raw, overrides)
+        origins = {key: origin for key in overrides}
+    return _validate(raw, source, lines, origins, directory or Path.cwd(), allow_outside_paths)
+
+
+def read_toml(content: str, source: str) -> dict[str, Any]:
+    """The tables of a TOML text; a syntax error (or too deep nesting) located at its line.
+
+    Raises
+    ------
+    ScenarioError
+        ``source:line: TOML syntax error (column c): reason``.
+    """
+    content = content.removeprefix("\ufeff")      # a UTF-8 byte order mark
     deep = nesting_too_deep(content)
     if deep is not None:
         raise ScenarioError(f"{source}:{deep}: arrays or inline tables nested more than "
@@ -73,12 +91,7 @@ def parse_scenario(content: str, source: str = "<scenario>", directory: Path | N
         where = f"{source}:{match.group(1)}" if match else source
         column = f" (column {match.group(2)})" if match else ""
         raise ScenarioError(f"{where}: TOML syntax error{column}: {reason}") from None
-    lines = key_lines(content)
-    origins: dict[str, str] = {}
-    if overrides:
-        raw = _apply_overrides(raw, overrides)
-        origins = {key: origin for key in overrides}
-    return _validate(raw, source, lines, origins, directory or Path.cwd(), allow_outside_paths)
+    return raw
 
 
 def with_overrides(scenario: Scenario, overrides: Mapping[str, Any],

@@ -1,0 +1,140 @@
+"""What a sweep saves: shared models, and cases spread over worker processes.
+
+Two ratios, each measured in one run (no timing is asserted anywhere):
+
+1. **Shared model.** 100 load cases (a point force at 100 places) on one clamped 32 × 32
+   cell plate under tension with twist (no separable factors: the modal basis is a dense
+   eigensolve), solved in closed form: ``splinedeform.sweep`` on one worker — the model and
+   its modal basis built once, cluster start and tables included — against 100 separate
+   runs of the same scenarios (``pipeline.run`` in this process, each building its model;
+   a separate ``splinedeform run`` would add the interpreter's start to each). Goal ≥ ×20.
+2. **Workers.** 200 independent cases (200 tension values, one model each, 10 × 10 cells):
+   the sweep on 2 worker processes against the same sweep on 1. Goal ≥ ×1.7 the
+   throughput; it needs two idle cores, so the load average is printed beside it.
+
+Run ``python benchmarks/bench_sweep.py [--cells 32] [--separate 100]``; ``--separate k``
+times only ``k`` of the separate runs and says so (the ratio then uses their mean).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import tempfile
+import time
+from pathlib import Path
+
+PLATE = """\
+[surface]
+shape = "plane"
+size = 1.0
+cells = {cells}
+
+[material]
+damping = 0.5
+w10 = {w10}
+w01 = 1.0
+w20 = 0.01
+w11 = 0.01
+w02 = 0.01
+
+[boundary]
+u0 = "clamped"
+u1 = "clamped"
+v0 = "clamped"
+v1 = "clamped"
+
+[[load]]
+kind = "point"
+at = [{u}, {v}]
+force = [0.0, 0.0, -1.0]
+profile = "step"
+
+[solve]
+kind = "dynamic"
+t_end = 2.0
+frames = 21
+modes = 6
+
+[output]
+formats = []
+resolution = 16
+"""
+
+
+def places(count: int) -> list[list[float]]:
+    """``count`` load places on a grid inside the plate."""
+    side = int(round(count ** 0.5))
+    ticks = [0.1 + 0.8 * i / (side - 1) for i in range(side)]
+    return [[round(u, 6), round(v, 6)] for u in ticks for v in ticks][:count]
+
+
+def shared_model(folder: Path, cells: int, cases: int, separate: int) -> dict[str, float]:
+    import splinedeform as sd
+    from splinedeform.pipeline import run
+    from splinedeform.scenario import parse_scenario
+
+    at = places(cases)
+    (folder / "plate.toml").write_text(PLATE.format(cells=cells, w10=1.0, u=0.5, v=0.5))
+    (folder / "loads.toml").write_text(
+        'scenario = "plate.toml"\n[[axis]]\nkey = "load[1].at"\nvalues = '
+        f"{at}\n")
+    start = time.perf_counter()
+    result = sd.sweep(folder / "loads.toml", folder / "out-loads", workers=1)
+    swept = time.perf_counter() - start
+    assert result.failed == 0 and result.models == 1, (result.failed, result.models)
+    start = time.perf_counter()
+    for u, v in at[:separate]:
+        run(parse_scenario(PLATE.format(cells=cells, w10=1.0, u=u, v=v)))
+    alone = (time.perf_counter() - start) / separate * cases
+    return {"sweep_s": swept, "separate_s": alone, "ratio": alone / swept,
+            "models": result.models, "cases": len(result.rows)}
+
+
+def workers(folder: Path, cases: int) -> dict[str, float]:
+    import splinedeform as sd
+
+    (folder / "small.toml").write_text(PLATE.format(cells=10, w10=1.0, u=0.5, v=0.5))
+    (folder / "tension.toml").write_text(
+        'scenario = "small.toml"\n[[axis]]\nkey = "material.w10"\nrange = [0.5, 5.0]\n'
+        f"count = {cases}\n")
+    seconds = {}
+    for n in (1, 2):
+        out = folder / f"out-{n}"
+        start = time.perf_counter()
+        result = sd.sweep(folder / "tension.toml", out, workers=n)
+        seconds[n] = time.perf_counter() - start
+        assert result.failed == 0 and result.computed == cases
+        shutil.rmtree(out)
+    return {"one_s": seconds[1], "two_s": seconds[2], "ratio": seconds[1] / seconds[2]}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--cells", type=int, default=32)
+    parser.add_argument("--load-cases", type=int, default=100)
+    parser.add_argument("--separate", type=int, default=None,
+                        help="separate runs timed (default: all of them)")
+    parser.add_argument("--independent", type=int, default=200)
+    args = parser.parse_args()
+    separate = args.separate or args.load_cases
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        load_before = os.getloadavg()
+        shared = shared_model(folder, args.cells, args.load_cases, separate)
+        spread = workers(folder, args.independent)
+        load_after = os.getloadavg()
+    print(f"# Sweep benchmark ({os.cpu_count()} cores; load average "
+          f"{load_before[0]:.1f} before, {load_after[0]:.1f} after)\n")
+    timed = "" if separate == args.load_cases else \
+        f" ({separate} of them timed, their mean × {args.load_cases})"
+    print(f"- {shared['cases']} load cases on one {args.cells}² model: sweep "
+          f"{shared['sweep_s']:.1f} s ({shared['models']} model), separate runs "
+          f"{shared['separate_s']:.1f} s{timed}: ×{shared['ratio']:.1f} (goal ≥ ×20)")
+    print(f"- {args.independent} independent cases: 1 worker {spread['one_s']:.1f} s, 2 workers "
+          f"{spread['two_s']:.1f} s: ×{spread['ratio']:.2f} the throughput (goal ≥ ×1.7)")
+
+
+if __name__ == "__main__":
+    main()
