@@ -48,9 +48,9 @@ class PolygonLoop:
         if np.any(np.hypot(edge[:, 0], edge[:, 1]) == 0):
             raise InputError("a polygon loop repeats a vertex (an edge of zero length)")
         object.__setattr__(self, "vertices", v)
+        _check_simple(self)
         if abs(self.signed_area) <= 1e-14 * np.ptp(v, axis=0).prod():
             raise InputError("a polygon loop encloses no area")
-        _check_simple(self)
 
     @property
     def signed_area(self) -> float:
