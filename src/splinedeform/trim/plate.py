@@ -68,9 +68,15 @@ def _values(bases: tuple[BSplineBasis, BSplineBasis], p: NDArray[np.float64]
 
 def assemble_plate(domain: TrimDomain, cells: int, degree: int, weight: DiscWeight,
                    rigidity: float = 1.0, poisson: float = 0.0, density: float = 1.0,
-                   pressure: float = 1.0, order: int | None = None) -> TrimmedPlate:
+                   pressure: float = 1.0, order: int | None = None,
+                   extended: bool = True) -> TrimmedPlate:
     """Kirchhoff plate over ``Ω`` on a ``cells × cells`` grid of ``[0, L]²`` (``L`` from
-    the domain's bounds rounded out to the unit square) in degree-``degree`` WEB-splines."""
+    the domain's bounds rounded out to the unit square) in degree-``degree`` WEB-splines.
+
+    ``extended=False`` keeps every B-spline whose support meets ``Ω`` instead, each times
+    ``W`` and without extension: the plain weighted basis, whose matrices degenerate as a
+    trim loop leaves a B-spline a sliver of its support (kept for comparison).
+    """
     if degree < 2:
         raise InputError(f"a plate needs B-splines of degree >= 2, got {degree}")
     if not -1.0 < poisson < 0.5:
@@ -84,6 +90,10 @@ def assemble_plate(domain: TrimDomain, cells: int, degree: int, weight: DiscWeig
     scale = normalisation(quad.classes, degree, weight(centres).reshape(quad.classes.shape),
                           web.inner)
     T = (web.extension @ sp.diags(scale)).tocsr()
+    if not extended:
+        kept = np.flatnonzero((web.inner | web.outer).ravel())
+        T = sp.csr_matrix((np.ones(kept.size), (kept, np.arange(kept.size))),
+                          shape=(web.inner.size, kept.size))
     p = np.clip(quad.points, 0.0, 1.0)
     b, bx, by, bxx, bxy, byy = _values(bases, p)
     W, Wx, Wy, Wxx, Wxy, Wyy = (sp.diags(f) for f in weight.derivatives(p))
