@@ -25,7 +25,8 @@ def test_point_in_domain_and_signed_distance_against_closed_forms():
     box = np.maximum(np.abs(p[:, 0] - 0.5), np.abs(p[:, 1] - 0.5))
     expected = (box < 0.4) & (r > 0.2)
     assert np.array_equal(d.contains(p), expected)
-    # inside points far from the corners: distance = min(0.4 - box, r - 0.2), closed form
+    # inside the convex square the distance to it is 0.4 - box, to the circle r - 0.2
+    # (closed forms); 1e-14 is round-off of coordinates of size 1
     sd = d.signed_distance(p)
     sel = expected
     assert np.allclose(sd[sel], np.minimum(0.4 - box[sel], r[sel] - 0.2), atol=1e-14)

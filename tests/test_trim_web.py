@@ -42,7 +42,9 @@ def test_index_sets_follow_the_cells():
 def test_lagrange_coefficients_are_a_partition_of_unity_and_interpolate():
     L = lagrange_coefficients(np.array([-2.0, 0.0, 1.0, 5.5]), 3)
     assert np.allclose(L.sum(axis=-1), 1.0, atol=1e-12)   # constants reproduced, round-off
-    assert np.allclose(L[1], [1, 0, 0, 0]) and np.allclose(L[2], [0, 1, 0, 0])
+    # at the nodes t = 0, 1 the coefficients are unit vectors: exact products, 1e-12 round-off
+    assert np.allclose(L[1], [1, 0, 0, 0], rtol=0, atol=1e-12)
+    assert np.allclose(L[2], [0, 1, 0, 0], rtol=0, atol=1e-12)
 
 
 def test_too_coarse_a_grid_is_refused():

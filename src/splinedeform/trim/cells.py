@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
-from .loops import CircleLoop, Loop, PolygonLoop, TrimDomain
+from .loops import CircleLoop, PolygonLoop, TrimDomain
 
 INSIDE, OUTSIDE, CUT = 1, 0, 2
 

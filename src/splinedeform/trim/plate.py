@@ -70,8 +70,8 @@ def assemble_plate(domain: TrimDomain, cells: int, degree: int, weight: DiscWeig
                    rigidity: float = 1.0, poisson: float = 0.0, density: float = 1.0,
                    pressure: float = 1.0, order: int | None = None,
                    extended: bool = True) -> TrimmedPlate:
-    """Kirchhoff plate over ``Ω`` on a ``cells × cells`` grid of ``[0, L]²`` (``L`` from
-    the domain's bounds rounded out to the unit square) in degree-``degree`` WEB-splines.
+    """Kirchhoff plate over ``Ω ⊂ [0, 1]²`` on a ``cells × cells`` grid of the unit square
+    in degree-``degree`` WEB-splines (uniform, Höllig, knots).
 
     ``extended=False`` keeps every B-spline whose support meets ``Ω`` instead, each times
     ``W`` and without extension: the plain weighted basis, whose matrices degenerate as a

@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from .cells import CUT, INSIDE, Grid, classify_cells, loop_pieces
-from .loops import CircleLoop, PolygonLoop, TrimDomain
+from .loops import CircleLoop, TrimDomain
 
 
 @dataclass(frozen=True)
@@ -117,6 +117,6 @@ def trim_quadrature(domain: TrimDomain, grid: Grid, order: int) -> TrimQuadratur
     p_cut = np.stack([s, np.broadcast_to(by[:, None], s.shape)], axis=-1).reshape(-1, 2)
     w_cut = ((bw * half)[:, None] * om).ravel()
     c_cut = np.repeat(bc, order, axis=0)
-    # points of the cut rule stay in their cell's closure (also outside Ω): clip round-off
+    # points of the cut rule lie in their cell's closure, possibly outside Ω
     return TrimQuadrature(np.concatenate([p_in, p_cut]), np.concatenate([w_in, w_cut]),
                           np.concatenate([c_in, c_cut]), classes)
