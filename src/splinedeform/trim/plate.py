@@ -24,10 +24,10 @@ from numpy.typing import NDArray
 from ..basis import BSplineBasis
 from ..errors import InputError
 from .cells import Grid
-from .loops import TrimDomain
+from .loops import PolygonLoop, TrimDomain
 from .quadrature import TrimQuadrature, trim_quadrature
 from .web import WebBasis, normalisation, web_basis
-from .weight import DiscWeight
+from .weight import DiscWeight, RvachevWeight
 
 
 @dataclass(frozen=True)
@@ -41,7 +41,7 @@ class TrimmedPlate:
     web_map: sp.csr_matrix
     web: WebBasis
     bases: tuple[BSplineBasis, BSplineBasis]
-    weight: DiscWeight
+    weight: DiscWeight | RvachevWeight
 
     def deflection(self, coefficients: NDArray[np.float64], p: NDArray[np.float64]
                    ) -> NDArray[np.float64]:
@@ -66,7 +66,8 @@ def _values(bases: tuple[BSplineBasis, BSplineBasis], p: NDArray[np.float64]
     return out
 
 
-def assemble_plate(domain: TrimDomain, cells: int, degree: int, weight: DiscWeight,
+def assemble_plate(domain: TrimDomain, cells: int, degree: int,
+                   weight: DiscWeight | RvachevWeight,
                    rigidity: float = 1.0, poisson: float = 0.0, density: float = 1.0,
                    pressure: float = 1.0, order: int | None = None,
                    extended: bool = True) -> TrimmedPlate:
@@ -79,6 +80,11 @@ def assemble_plate(domain: TrimDomain, cells: int, degree: int, weight: DiscWeig
     """
     if degree < 2:
         raise InputError(f"a plate needs B-splines of degree >= 2, got {degree}")
+    if isinstance(weight, RvachevWeight) and any(
+            isinstance(loop, PolygonLoop) for loop in weight.domain.loops):
+        raise InputError("the R-function weight of a polygon has second derivatives growing "
+                         "like 1/r at its corners, so the plate energy of w·B is infinite "
+                         "there; a plate needs circle loops (or a smooth weight) for now")
     if not -1.0 < poisson < 0.5:
         raise InputError(f"Poisson's ratio must lie in (-1, 0.5), got {poisson!r}")
     grid = Grid((cells, cells))
