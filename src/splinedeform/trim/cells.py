@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from .loops import CircleLoop, PolygonLoop, TrimDomain
+from .spline_loop import SplineLoop
 
 INSIDE, OUTSIDE, CUT = 1, 0, 2
 
@@ -38,7 +39,8 @@ class Pieces:
     """Pieces of trim loops, each in one cell: a curve ``γ(t)`` for ``t ∈ [lo, hi]``.
 
     ``kind`` 0 is a straight piece from ``start`` to ``end`` (``t ∈ [0, 1]``), 1 an arc of
-    the circle ``centre, radius`` with angles ``t``; ``cell`` the ``(i, j)`` of its cell.
+    the circle ``centre, radius`` with angles ``t``, 2 a span of a spline loop, the
+    polynomial ``Σ_e poly[e] t^e`` (``t ∈ [0, 1]``); ``cell`` the ``(i, j)`` of its cell.
     """
 
     kind: NDArray[np.int64]
@@ -49,6 +51,7 @@ class Pieces:
     centre: NDArray[np.float64]
     radius: NDArray[np.float64]
     cell: NDArray[np.int64]
+    poly: NDArray[np.float64]
 
     def evaluate(self, t: NDArray[np.float64]
                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -63,6 +66,14 @@ class Pieces:
         dp_arc = r * np.stack([-np.sin(ang), np.cos(ang)], axis=-1)
         point = np.where(line[..., None], p_line, p_arc)
         tangent = np.where(line[..., None], np.broadcast_to(d[:, None], p_line.shape), dp_arc)
+        spline = self.kind == 2
+        if np.any(spline):
+            e = np.arange(self.poly.shape[1])
+            tau = t[spline][..., None]
+            C = self.poly[spline]
+            point[spline] = np.einsum("pqe,pek->pqk", tau ** e, C)
+            tangent[spline] = np.einsum("pqe,pek->pqk",
+                                        e * tau ** np.maximum(e - 1, 0), C)
         return point, tangent
 
 
@@ -99,10 +110,44 @@ def _circle_pieces(loop: CircleLoop, grid: Grid) -> tuple[NDArray, NDArray]:
     return lo, hi
 
 
+def _spline_pieces(loop: SplineLoop, grid: Grid) -> tuple[NDArray, NDArray, NDArray]:
+    """Spans, local ``lo``, ``hi`` of the loop's pieces between grid-line crossings."""
+    spans, taus = [np.arange(loop.spans)], [np.zeros(loop.spans)]
+    for axis in (0, 1):
+        for value in grid.lines(axis):
+            s, t = loop.crossings(axis, value)
+            spans.append(s)
+            taus.append(t)
+    s, t = np.concatenate(spans), np.concatenate(taus)
+    order = np.lexsort((t, s))
+    s, t = s[order], t[order]
+    nxt_s = np.append(s[1:], s[-1] + 1)
+    nxt_t = np.where(nxt_s == s, np.append(t[1:], 1.0), 1.0)
+    keep = nxt_t > t + 1e-13
+    return s[keep], t[keep], nxt_t[keep]
+
+
 def loop_pieces(domain: TrimDomain, grid: Grid) -> Pieces:
     """Split every loop of ``domain`` at the grid lines, with the loop's orientation kept."""
     kinds, los, his, starts, ends, centres, radii = [], [], [], [], [], [], []
+    q = 1 + max([loop.degree for loop in domain.loops if isinstance(loop, SplineLoop)],
+                default=0)
+    polys = []
     for loop in domain.loops:
+        if isinstance(loop, SplineLoop):
+            span, lo, hi = _spline_pieces(loop, grid)
+            kinds.append(np.full(len(lo), 2))
+            starts.append(np.zeros((len(lo), 2)))
+            ends.append(np.zeros((len(lo), 2)))
+            centres.append(np.zeros((len(lo), 2)))
+            radii.append(np.zeros(len(lo)))
+            C = np.zeros((len(lo), q, 2))
+            C[:, :loop.degree + 1] = loop.power_form[span]
+            polys.append(C)
+            los.append(lo)
+            his.append(hi)
+            continue
+        polys.append(None)
         if isinstance(loop, PolygonLoop):
             a, b, lo, hi = _polygon_pieces(loop, grid)
             kinds.append(np.zeros(len(lo), int))
@@ -119,9 +164,10 @@ def loop_pieces(domain: TrimDomain, grid: Grid) -> Pieces:
             radii.append(np.full(len(lo), loop.radius))
         los.append(lo)
         his.append(hi)
+    polys = [np.zeros((len(k), q, 2)) if c is None else c for c, k in zip(polys, kinds)]
     pieces = Pieces(np.concatenate(kinds), np.concatenate(los), np.concatenate(his),
                     np.concatenate(starts), np.concatenate(ends), np.concatenate(centres),
-                    np.concatenate(radii), np.zeros((0, 2), int))
+                    np.concatenate(radii), np.zeros((0, 2), int), np.concatenate(polys))
     mid, _ = pieces.evaluate(0.5 * (pieces.lo + pieces.hi)[:, None])
     h = np.array(grid.h)
     cell = np.floor(mid[:, 0] / h).astype(int)
@@ -129,7 +175,7 @@ def loop_pieces(domain: TrimDomain, grid: Grid) -> Pieces:
         raise InputError("a trim loop leaves the parameter domain "
                          f"[0, {grid.lengths[0]:g}] × [0, {grid.lengths[1]:g}]")
     return Pieces(pieces.kind, pieces.lo, pieces.hi, pieces.start, pieces.end, pieces.centre,
-                  pieces.radius, cell)
+                  pieces.radius, cell, pieces.poly)
 
 
 def classify_cells(domain: TrimDomain, grid: Grid, pieces: Pieces | None = None

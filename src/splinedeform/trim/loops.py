@@ -1,4 +1,5 @@
-"""Trim loops in the parameter plane ``(u, v)``: closed polygons and exact circles.
+"""Trim loops in the parameter plane ``(u, v)``: closed polygons, exact circles and closed
+uniform B-spline curves (:mod:`splinedeform.trim.spline_loop`).
 
 A trimmed region ``Ω`` is the inside of one outer loop minus the insides of its holes.
 Orientation is normalised so that ``Ω`` always lies on the left of every loop: the outer
@@ -18,6 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
+from .spline_loop import SplineLoop
 
 
 def _points(p: ArrayLike) -> NDArray[np.float64]:
@@ -134,7 +136,7 @@ class CircleLoop:
         return c - self.radius, c + self.radius
 
 
-Loop = PolygonLoop | CircleLoop
+Loop = PolygonLoop | CircleLoop | SplineLoop
 
 
 def _orient(a: NDArray, b: NDArray, c: NDArray) -> NDArray[np.float64]:
@@ -167,7 +169,12 @@ def _check_simple(loop: PolygonLoop) -> None:
 
 
 def loops_cross(first: Loop, second: Loop) -> bool:
-    """Whether two loops' curves meet (cross or touch)."""
+    """Whether two loops' curves meet (cross or touch); a spline loop is taken as its
+    curve sampled at 64 points per span."""
+    if isinstance(first, SplineLoop):
+        first = PolygonLoop(first.sample(64))
+    if isinstance(second, SplineLoop):
+        second = PolygonLoop(second.sample(64))
     if isinstance(first, CircleLoop) and isinstance(second, CircleLoop):
         gap = np.hypot(first.centre[0] - second.centre[0], first.centre[1] - second.centre[1])
         return bool(abs(first.radius - second.radius) <= gap <= first.radius + second.radius)
@@ -185,6 +192,8 @@ def loops_cross(first: Loop, second: Loop) -> bool:
 def _sample_point(loop: Loop) -> NDArray[np.float64]:
     if isinstance(loop, CircleLoop):
         return np.array([loop.centre[0] + loop.radius, loop.centre[1]])
+    if isinstance(loop, SplineLoop):
+        return loop.sample(1)[0]
     return loop.vertices[0]
 
 
@@ -206,8 +215,10 @@ class TrimDomain:
     holes: tuple[Loop, ...] = ()
 
     def __post_init__(self) -> None:
-        if not isinstance(self.outer, (PolygonLoop, CircleLoop)):
-            raise InputError(f"the outer trim loop must be a polygon or a circle, got {self.outer!r}")
+        for loop in (self.outer, *self.holes):
+            if not isinstance(loop, (PolygonLoop, CircleLoop, SplineLoop)):
+                raise InputError("trim loops must be polygons, circles or spline loops, got "
+                                 f"{type(loop).__name__}")
         holes = tuple(self.holes)
         object.__setattr__(self, "outer", self.outer.oriented(True))
         object.__setattr__(self, "holes", tuple(h.oriented(False) for h in holes))

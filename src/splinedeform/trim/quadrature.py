@@ -27,6 +27,7 @@ from numpy.typing import NDArray
 from ..errors import InputError
 from .cells import CUT, INSIDE, Grid, classify_cells, loop_pieces
 from .loops import CircleLoop, TrimDomain
+from .spline_loop import SplineLoop
 
 
 @dataclass(frozen=True)
@@ -52,6 +53,9 @@ def _vertical_crossings(domain: TrimDomain, x: float) -> NDArray[np.float64]:
             if abs(s) < 1:
                 dy = loop.radius * np.sqrt(1 - s * s)
                 ys += [loop.centre[1] - dy, loop.centre[1] + dy]
+        elif isinstance(loop, SplineLoop):
+            span, tau = loop.crossings(0, x)
+            ys += list(loop.evaluate(span + tau)[0][:, 1])
         else:
             a, b = loop.segments()
             straddle = (a[:, 0] > x) != (b[:, 0] > x)

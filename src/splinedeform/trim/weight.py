@@ -95,6 +95,9 @@ class RvachevWeight:
         if self.power not in (1, 2):
             raise InputError(f"weight power must be 1 (held edge) or 2 (clamped), got {self.power!r}")
         for loop in self.domain.loops:
+            if not isinstance(loop, (PolygonLoop, CircleLoop)):
+                raise InputError("the Rvachev weight is written for polygon and circle loops, "
+                                 f"not for a {type(loop).__name__}")
             if isinstance(loop, PolygonLoop):
                 v = loop.vertices
                 e = np.roll(v, -1, axis=0) - v
