@@ -130,3 +130,19 @@ def test_a_named_pipe_beside_a_sculpt_save_is_not_the_same_file(tmp_path):
     source.write_bytes(b"\x93NUMPY")
     assert not _same_file(pipe(tmp_path, "copy.npy"), source)
     assert _same_file(source, source)
+
+
+def test_a_named_pipe_as_the_study_results_is_refused_by_bench_render(tmp_path):
+    from splinedeform import bench
+
+    pipe(tmp_path, "bench.json")
+    with pytest.raises(InputError, match="bench.json: .*is a named pipe, not a regular file"):
+        bench.render(tmp_path)
+
+
+def test_a_named_pipe_given_to_the_key_reference_writer_is_refused(tmp_path):
+    from splinedeform.scenario.reference import main
+
+    path = pipe(tmp_path, "scenario.md")
+    with pytest.raises(InputError, match="the Markdown file is a named pipe"):
+        main([str(path)])
