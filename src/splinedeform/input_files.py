@@ -2,9 +2,9 @@
 
 Every input file (the scenario, ``surface.path``, control nets, point grids, CAD files, a
 run folder's manifest) is opened by :func:`open_input` (or checked by :func:`check_input`
-where a native library opens it by name), which refuses what is not a regular file (a named pipe without a
-writer would block the reader forever, a device never ends) without blocking on it, and a
-file larger than the reader's cap. The sizes an array file declares are checked before
+where a native library opens it by name), which refuses what is not a regular file (a
+named pipe without a writer would block the reader forever, a device never ends) without
+blocking on it, and a file larger than the reader's cap. The sizes an array file declares are checked before
 anything is allocated (:func:`check_array_file`): a ``.npy`` header's ``shape × itemsize``
 and, in a ``.npz``, every member's declared size and header, against
 :data:`MAX_ARRAY_BYTES` (the default memory budget); JSON nested deeper than the parser's
