@@ -25,7 +25,12 @@ pictures (``images``)
     a 3-D panel of ``s²`` samples costs ``1.5·10⁸ + 1.5·10⁴ s²``; the probe picture's
     buffer ``800 · 250 P · 4`` bytes is held at once;
 animations (GIF, MP4)
-    one 3-D panel of ``r²`` samples per frame and format, plus ``10⁷`` to encode it;
+    one 3-D panel of ``r²`` samples per frame and format, plus ``10⁷`` to encode it; the
+    frames are written as they are drawn, so memory holds at most 6 images of
+    ``640 × 480`` (:func:`animation_memory`), not the film;
+per-mode files of a modes solve
+    the mode fields ``.vtu``, each mode's nets and each animated mode's film
+    (:func:`mode_terms`);
 viewer
     ``100`` operations per number written, ``(F r² + F G) 3`` numbers, and 1 MiB for the
     page and three.js;
@@ -36,7 +41,13 @@ CAD surfaces (``3dm``, ``step``, ``iges``), one NURBS surface per frame
     frame held until the file is written.
 
 The figures are upper-bound-minded orders of magnitude measured on a laptop core (the
-.3dm, picture and probe costs) or stated from the writers' structure (STEP, IGES).
+.3dm, picture and probe costs) or stated from the writers' structure (STEP, IGES). On a
+modes solve with its per-mode files (``benchmarks/bench_budget_modes.py``, one run under
+load 10-12 on 2 cores), the work at 1e9 operations a second was 3.4 and 6.0 times the
+processor time of runs animating 3 modes (9.7 s and 19.3 s estimated), and 0.95 times
+that of a run without animations (0.07 s, the interpreter's fixed costs): an upper bound
+within a factor 10 once the estimate is above a second. The wall clock on a busy machine
+is longer, by the machine's load, not the run's.
 """
 
 from __future__ import annotations
@@ -49,6 +60,13 @@ PANEL_WORK, PANEL_WORK_PER_SAMPLE = 1.5e8, 1.5e4
 PROBE_PANEL_WORK, PROBE_PANEL_PIXELS = 3e8, 800 * 250
 #: operations to encode one animation frame
 ENCODE_WORK = 1e7
+#: bytes of one animation frame on disk, per format
+ANIMATION_BYTES = {"gif": 65536.0, "mp4": 16384.0}
+#: animation images (width, height) and how many an animation holds at once: the GIF's
+#: palette samples (:data:`splinedeform.viz.animation.PALETTE_SAMPLES` and the peak frame);
+#: the frames themselves are drawn and written one at a time
+ANIMATION_PIXELS = (640, 480)
+ANIMATION_HELD_FRAMES = 6
 #: per CAD frame: (operations, operations per control point, bytes, bytes per control
 #: point, bytes held in memory, bytes held per control point)
 CAD_COSTS = {"3dm": (1e6, 2e4, 1024.0, 32.0, 1024.0, 64.0),
@@ -118,12 +136,12 @@ def output_terms(scenario: Any, model: Any, frames: int, frames_key: str
 
     animated = [f for f in ("gif", "mp4") if f in formats]
     if animated:
-        memory.append(Term(F * 640 * 480 * 3.0, f"{F} animation images of 640 x 480",
-                           (frames_key, fmt)))
+        memory.append(Term(animation_memory(F), f"animation images of 640 x 480 (at most "
+                           f"{min(F, ANIMATION_HELD_FRAMES)} held)", (frames_key, fmt)))
         work.append(Term(F * len(animated) * (panel_work(r) + ENCODE_WORK),
                          f"rendering {F} animation frames of {r}² samples "
                          f"({', '.join(animated)})", (frames_key, res, fmt)))
-    for ext, size in (("gif", 65536.0), ("mp4", 16384.0)):
+    for ext, size in ANIMATION_BYTES.items():
         if ext in formats:
             disk.append(Term(F * size, f"{F} {ext} frames", (frames_key, fmt)))
 
@@ -152,4 +170,79 @@ def output_terms(scenario: Any, model: Any, frames: int, frames_key: str
         + 3 * ("images" in formats) + 2 * ("report" in formats)
     if others:
         files.append(Term(float(others), "one file per other format", (fmt,)))
+    terms = {"memory": memory, "disk": disk, "files": files, "work": work}
+    if solve.kind == "modes":
+        for resource, more in mode_terms(scenario, model, F, frames_key).items():
+            terms[resource] += more
+    return terms
+
+
+def animation_memory(frames: int) -> float:
+    """Bytes an animation holds at once: :data:`ANIMATION_HELD_FRAMES` images of
+    ``640 × 480 × 3`` (the palette's sample frames), twice (their stack for the median
+    cut), the figure's RGBA canvas and its background, and the GIF's colour lookup table
+    of ``2²⁴`` 16-bit entries, and 8 MiB for matplotlib's figure and renderer:
+    ``2 min(F, 6) 640·480·3 + 2 · 640·480·4 + 2²⁵ + 2²³``."""
+    width, height = ANIMATION_PIXELS
+    return (2.0 * min(frames, ANIMATION_HELD_FRAMES) * width * height * 3
+            + 2.0 * width * height * 4 + 2.0**25 + 2.0**23)
+
+
+def mode_terms(scenario: Any, model: Any, frames: int, frames_key: str
+               ) -> dict[str, list[Any]]:
+    """Terms of the per-mode files of a modes solve of ``K`` modes (``solve.modes``),
+    ``A`` of them animated besides mode 1 (``output.animate_modes``), ``F`` frames:
+
+    ``<name>_modes.vtu`` (vtu)
+        ``K + 1`` nets sampled at ``r²`` points (``2 (K + 1) r² (p + 1)² 3`` operations),
+        written as ``2·10⁶ + 1.5·10³ r² (K + 1)`` operations and ``r² (104 + 32 K)``
+        bytes; ``(K + 1) r² 48`` bytes of samples held;
+    ``<name>_mode<k>_nets.json/.npz``
+        ``K`` files of ``F G 3`` numbers each (as the frames' nets), and the nets of one
+        mode over its frames held, ``F G 24`` bytes;
+    ``<name>_mode<k>.gif/.mp4``
+        ``A`` animations per format, each as the run's own animation: ``F`` frames
+        sampled and rendered, ``F (1.5·10⁸ + 1.5·10⁴ r² + 10⁷)`` operations.
+    """
+    from .budget import Term
+
+    output = scenario.output
+    formats = set(output.formats)
+    F, r = frames, output.resolution
+    r2 = r ** 2
+    n_u, n_v = model.surface.shape
+    G = n_u * n_v
+    p = max(model.surface.basis_u.degree, model.surface.basis_v.degree)
+    K = min(scenario.solve.modes, model.n_free)
+    res, fmt, modes_key = "output.resolution", "output.formats", "solve.modes"
+    memory: list[Term] = []
+    disk: list[Term] = []
+    files: list[Term] = []
+    work: list[Term] = []
+    if "vtu" in formats:
+        what = f"mode fields .vtu: {K} modes at {r}² points"
+        work.append(Term(2.0 * (K + 1) * r2 * (p + 1) ** 2 * 3 + 2e6 + 1.5e3 * r2 * (K + 1),
+                         what, (modes_key, res, fmt)))
+        disk.append(Term(r2 * (104.0 + 32.0 * K), what, (modes_key, res, fmt)))
+        memory.append(Term((K + 1) * r2 * 48.0, what, (modes_key, res, fmt)))
+        files.append(Term(1.0, "mode fields .vtu", (fmt,)))
+    for ext, size, ops in (("json", 25.0, 1.5e3), ("npz", 8.0, 300.0)):
+        if ext in formats:
+            what = f"{K} mode nets .{ext} of {F} frames"
+            disk.append(Term(K * F * G * 3 * size, what, (modes_key, frames_key, fmt)))
+            work.append(Term(K * F * G * 3 * ops, what, (modes_key, frames_key, fmt)))
+            files.append(Term(float(K), what, (modes_key, fmt)))
+    animated = [ext for ext in ("gif", "mp4") if ext in formats]
+    A = sum(1 for k in output.animate_modes or (1,) if k != 1)
+    if animated and A:
+        what = f"{A} mode animation(s) of {F} frames ({', '.join(animated)})"
+        keys = ("output.animate_modes", frames_key, res, fmt)
+        per = F * (panel_work(r) + ENCODE_WORK + 2.0 * r2 * (p + 1) ** 2 * 3)
+        work.append(Term(A * len(animated) * per, what, keys))
+        disk.append(Term(A * F * sum(ANIMATION_BYTES[e] for e in animated), what, keys))
+        files.append(Term(float(A * len(animated)), what, keys))
+        memory.append(Term(animation_memory(F) + F * r2 * 48.0, what, keys))
+    if (animated and A) or any(e in formats for e in ("json", "npz")):
+        memory.append(Term(F * G * 24.0, f"the nets of one mode over {F} frames",
+                           (frames_key, fmt)))
     return {"memory": memory, "disk": disk, "files": files, "work": work}

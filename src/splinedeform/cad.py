@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from .basis import BSplineBasis
 from .cad_3dm_read import _rhino3dm, read_3dm_arrays
-from .cad_child import read_in_child
+from .cad_child import check_cad_file, read_in_child
 from .cad_units import check_units, rhino_name
 from .errors import InputError, InputWarning
 from .export.atomic import atomic_path
@@ -278,10 +278,9 @@ def read_3dm(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
     underlying surface; a face that is really trimmed (its outer loop is not the
     surface's own boundary, or it has inner loops) is warned about, once.
     """
-    _rhino3dm()
     path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{path}: no such file")
+    check_cad_file(path)
+    _rhino3dm()
     if isinstance(face, bool) or not isinstance(face, int) or face < 0:
         raise InputError(f"{path}: face {face!r} out of range; faces are numbered from 0")
     data = read_in_child(read_3dm_arrays, path, face, library="openNURBS (rhino3dm)")

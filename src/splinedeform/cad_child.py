@@ -89,6 +89,17 @@ _child = _Child()
 atexit.register(_child.close)
 
 
+def check_cad_file(path: Path) -> None:
+    """Refuse ``path`` unless it is a regular file of at most
+    :data:`~splinedeform.input_files.MAX_ARRAY_BYTES` (``no such file``, or what it is:
+    a named pipe, a folder, a device), without blocking on it."""
+    from .input_files import MAX_ARRAY_BYTES, check_input
+
+    if not os.path.exists(path):
+        raise InputError(f"{path}: no such file")
+    check_input(path, "CAD file", MAX_ARRAY_BYTES)
+
+
 def read_in_child(reader: Callable[..., dict[str, Any]], path: Path, *args: Any,
                   library: str = "the CAD reader") -> dict[str, Any]:
     """``reader(path, *args)`` run in the reader child process; its result.
@@ -97,7 +108,9 @@ def read_in_child(reader: Callable[..., dict[str, Any]], path: Path, *args: Any,
     :class:`~splinedeform.errors.InputError` is raised again here with the same message,
     its warnings are issued again here (as :class:`~splinedeform.errors.InputWarning`),
     and any other exception or the death of the child (a signal, an exit) raises an
-    ``InputError`` that names ``path`` and ``library``.
+    ``InputError`` that names ``path`` and ``library``. The public readers check ``path``
+    with :func:`check_cad_file` first: the native readers open it by name and would wait
+    forever on a named pipe.
     """
     with _child.lock:
         try:

@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .cad import CAD_SUFFIXES, SEAM_TOL, WEIGHT_TOL, weight_factors
-from .cad_child import read_in_child
+from .cad_child import check_cad_file, read_in_child
 from .errors import InputError
 from .knots import KnotVectorBasis
 from .quadrature import gauss_points
@@ -52,8 +52,7 @@ def read_faces(path: str | os.PathLike) -> dict[str, Any]:
     if kind is None:
         raise InputError(f"{path}: not a CAD file (expected one of "
                          f"{', '.join(CAD_SUFFIXES)}), got suffix {path.suffix or 'none'!r}")
-    if not path.is_file():
-        raise InputError(f"{path}: no such file")
+    check_cad_file(path)
     if kind == "openNURBS":
         from .cad_3dm_read import _rhino3dm, list_3dm_arrays
 

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from .cad import NurbsPatch, frame_patches
-from .cad_child import read_in_child
+from .cad_child import check_cad_file, read_in_child
 from .cad_step_read import IGES_SUFFIXES, MISSING, STEP_SUFFIXES, ocp, read_arrays
 from .cad_units import millimetres, occt_name
 from .errors import InputError
@@ -143,10 +143,9 @@ def read_step(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
     surface, with a warning.
     """
     path = Path(path)
+    check_cad_file(path)
     if importlib.util.find_spec("OCP") is None:  # pragma: no cover - depends on the install
         raise InputError(MISSING)
-    if not path.is_file():
-        raise InputError(f"{path}: no such file")
     if isinstance(face, bool) or not isinstance(face, int) or face < 0:
         raise InputError(f"{path}: face {face!r} out of range; faces are numbered from 0")
     data = read_in_child(read_arrays, path, face, library="OpenCASCADE")

@@ -191,7 +191,10 @@ def iges_bad_weights(path: Path) -> dict[int, tuple[tuple[int, int], float]]:
     ``K1 + M1 + 2`` knots in u, ``K2 + M2 + 2`` in v, then ``(K1 + 1)(K2 + 1)`` weights
     with ``i`` running fastest. Entities with inconsistent counts are left to OpenCASCADE.
     """
-    lines = path.read_bytes().decode("latin-1").splitlines()
+    from .input_files import MAX_ARRAY_BYTES, open_input
+
+    with open_input(path, "IGES file", MAX_ARRAY_BYTES) as fh:
+        lines = fh.read().decode("latin-1").splitlines()
     glob = "".join(line[:72] for line in lines if line[72:73] == "G")
     delimiter = glob[2] if glob.startswith("1H") and len(glob) > 2 else ","
     records: dict[int, list[str]] = {}

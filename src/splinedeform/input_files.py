@@ -1,9 +1,10 @@
 """Opening the files a scenario names: regular files only, sizes known before reading.
 
-Every input file (the scenario, ``surface.path``, control nets, point grids) is opened by
-:func:`open_input`, which refuses what is not a regular file (a named pipe without a
-writer would block the reader forever, a device never ends) without blocking on it, and a
-file larger than the reader's cap. The sizes an array file declares are checked before
+Every input file (the scenario, ``surface.path``, control nets, point grids, CAD files, a
+run folder's manifest) is opened by :func:`open_input` (or checked by :func:`check_input`
+where a native library opens it by name), which refuses what is not a regular file (a
+named pipe without a writer would block the reader forever, a device never ends) without
+blocking on it, and a file larger than the reader's cap. The sizes an array file declares are checked before
 anything is allocated (:func:`check_array_file`): a ``.npy`` header's ``shape × itemsize``
 and, in a ``.npz``, every member's declared size and header, against
 :data:`MAX_ARRAY_BYTES` (the default memory budget); JSON nested deeper than the parser's
@@ -66,6 +67,15 @@ def open_input(path: str | os.PathLike[str], what: str = "input file",
     except BaseException:
         os.close(fd)
         raise
+
+
+def check_input(path: str | os.PathLike[str], what: str = "input file",
+                max_bytes: float = math.inf) -> Path:
+    """``path`` as a Path once :func:`open_input` accepted it (then closed again): for a
+    file a native library opens by name (openNURBS, OpenCASCADE), which would block on a
+    named pipe or read a device without end."""
+    open_input(path, what, max_bytes).close()
+    return Path(path)
 
 
 def _kind(mode: int) -> str:

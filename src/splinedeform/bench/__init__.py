@@ -29,6 +29,7 @@ from typing import Any
 
 from ..errors import InputError
 from ..export import write_text
+from ..input_files import load_json
 from . import regimes, sweep
 from .bookkeeping import Row, set_ratios
 from .cases import FAMILIES, Case, build_model, make_case, reference_t_end, study_load
@@ -116,11 +117,11 @@ def render(outdir: str | os.PathLike[str]) -> dict[str, Path]:
     """
     out = Path(outdir)
     try:
-        record = json.loads((out / "bench.json").read_text(encoding="utf-8"))
+        record = load_json(out / "bench.json", "study results file")
         study = from_record(record["study"])
         rows = [Row(**r) for r in record["rows"]]
         goals = [Goal(**g) for g in record["goals"]]
-    except (OSError, ValueError, KeyError, TypeError) as exc:
+    except (InputError, OSError, ValueError, KeyError, TypeError) as exc:
         raise InputError(f"cannot read the study results {out / 'bench.json'}: {exc}") from None
     text = markdown(rows, goals, study, record["seconds"], record.get("machine", "?"),
                     record.get("threads", "BLAS threads not recorded"),

@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import InputError
+from ..input_files import open_input, read_input_text
 from .atomic import _check_stem, write_text
 
 MANIFEST_FORMAT = "splinedeform-run-manifest"
@@ -51,21 +52,27 @@ def manifest_name(stem: str) -> str:
 
 
 def file_digest(path: Path) -> tuple[int, str]:
-    """Size in bytes and SHA-256 (hex) of a file, read in 1 MiB blocks."""
+    """Size in bytes and SHA-256 (hex) of a regular file, read in 1 MiB blocks (something
+    else put in its place, such as a named pipe, is an InputError naming it)."""
     digest = hashlib.sha256()
-    with open(path, "rb") as fh:
+    size = 0
+    with open_input(path, "output file") as fh:
         for block in iter(lambda: fh.read(1 << 20), b""):
             digest.update(block)
-    return path.stat().st_size, digest.hexdigest()
+            size += len(block)
+    return size, digest.hexdigest()
 
 
 def read_manifest(path: Path) -> dict[str, Any] | None:
-    """The manifest at ``path``, None if absent; a file that is not one is refused."""
+    """The manifest at ``path``, None if absent; a file that is not one is refused, and so
+    is anything but a regular file (:func:`~splinedeform.input_files.read_input_text`)."""
     if not path.exists():
         return None
     try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        doc = json.loads(read_input_text(path, "run manifest"))
+    except InputError as exc:
+        raise InputError(f"{exc}; move it away or choose another output folder") from None
+    except (RecursionError, json.JSONDecodeError) as exc:
         raise InputError(f"{path} is not a splinedeform run manifest ({exc}); move it away "
                          f"or choose another output folder") from None
     files = doc.get("files") if isinstance(doc, dict) else None

@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from ..input_files import read_input_text
 from .checks import Key
 from .keys import (BOUNDARY_KEYS, FREE_REGION_KEYS, LOAD_KEYS, MATERIAL_KEYS, OUTPUT_KEYS,
                    SHAPE_PARAMETERS, SOLVE_KEYS, SURFACE_KEYS, TOP_KEYS)
@@ -109,7 +110,7 @@ def main(argv: list[str] | None = None) -> int:
     """Rewrite the reference blocks of the given Markdown files in place."""
     for name in (argv if argv is not None else sys.argv[1:]) or ["docs/scenario.md"]:
         path = Path(name)
-        path.write_text(update(path.read_text(encoding="utf-8")), encoding="utf-8")
+        path.write_text(update(read_input_text(path, "Markdown file")), encoding="utf-8")
         print(f"wrote the key reference of {path}")
     return 0
 

@@ -374,6 +374,13 @@ def in_page_words(message: str, source: str) -> str:
 
 
 def _same_file(a: Path, b: Path) -> bool:
-    """Whether two files hold the same bytes."""
-    return a.stat().st_size == b.stat().st_size and a.read_bytes() == b.read_bytes()
+    """Whether two regular files hold the same bytes (anything else in their place, such as
+    a named pipe, is not the same file and is never read)."""
+    from ..input_files import MAX_TEXT_BYTES, open_input
+
+    if not (a.is_file() and b.is_file()) or a.stat().st_size != b.stat().st_size:
+        return False
+    with open_input(a, "file", MAX_TEXT_BYTES * 32) as fa, \
+            open_input(b, "file", MAX_TEXT_BYTES * 32) as fb:
+        return fa.read() == fb.read()
 
