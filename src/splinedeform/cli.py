@@ -16,7 +16,7 @@ import platform
 import sys
 import warnings
 from contextlib import contextmanager
-from importlib import metadata, resources
+from importlib import resources
 from pathlib import Path
 from typing import Any, Iterator, Optional
 
@@ -25,30 +25,13 @@ from typer.core import TyperCommand, TyperGroup
 
 from . import __version__
 from .errors import InputError
+from .extras import optional_rows
 
 EXIT_INPUT_ERROR = 2
 EXIT_INTERNAL_ERROR = 1
 #: exit status after Ctrl-C (128 + SIGINT), as shells report it
 EXIT_INTERRUPTED = 130
 
-#: optional modules reported by ``splinedeform info``: import name -> (distribution, use)
-OPTIONAL = {
-    "typer": ("typer", "command line"),
-    "rich": ("rich", "progress bars and tables"),
-    "meshio": ("meshio", "OBJ / STL / PLY / VTU meshes"),
-    "matplotlib": ("matplotlib", "pictures and GIF animation frames"),
-    "imageio": ("imageio", "GIF animation"),
-    "PIL": ("pillow", "GIF encoding"),
-    "imageio_ffmpeg": ("imageio-ffmpeg", "MP4 animation (extra: video)"),
-    "pyvista": ("pyvista", "offscreen 3-D rendering (extra: render3d)"),
-    "playwright": ("playwright", "viewer test in a headless browser"),
-    "starlette": ("starlette", "sculpt server (extra: sculpt)"),
-    "uvicorn": ("uvicorn", "sculpt server (extra: sculpt)"),
-    "rhino3dm": ("rhino3dm", "openNURBS .3dm files (extra: cad)"),
-    "OCP": ("cadquery-ocp-novtk", "STEP and IGES files, OpenCASCADE (extra: cad-step)"),
-    "distributed": ("distributed", "splinedeform sweep on Dask (extra: sweep)"),
-    "pyarrow": ("pyarrow", "Parquet tables of sweeps (extra: sweep)"),
-}
 
 
 
@@ -309,27 +292,6 @@ def examples_directory() -> Path | None:
     return candidate if candidate.is_dir() else None
 
 
-def _optional_rows() -> list[tuple[str, str]]:
-    """One row per optional package: its version if it imports, else why not."""
-    rows = []
-    for module, (dist, use) in OPTIONAL.items():
-        try:
-            importlib.import_module(module)
-        except ImportError:
-            rows.append((dist, f"not installed  ({use})"))
-            continue
-        except Exception as exc:  # noqa: BLE001  (installed but broken, e.g. a missing library)
-            rows.append((dist, f"installed but fails to import: {type(exc).__name__}: {exc}  "
-                               f"({use})"))
-            continue
-        try:
-            version = metadata.version(dist)
-        except metadata.PackageNotFoundError:
-            version = "?"
-        rows.append((dist, f"{version}  ({use})"))
-    return rows
-
-
 @app.command("info")
 def info_command() -> None:
     """Version, optional extras that import, and where the examples live."""
@@ -347,7 +309,7 @@ def info_command() -> None:
     if examples is not None:
         rows.append(("example files", ", ".join(sorted(p.name for p in examples.glob("*.toml")))))
     out.print(_table("splinedeform info", rows))
-    out.print(_table("optional packages", _optional_rows()))
+    out.print(_table("optional packages", optional_rows()))
 
 
 #: default folder of ``splinedeform bench`` (``out/`` is git-ignored in a source checkout)
