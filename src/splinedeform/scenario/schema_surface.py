@@ -1,0 +1,144 @@
+"""The ``[surface]`` table of a scenario: one pydantic model per ``surface.shape``
+(see :mod:`.schema`)."""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Any, Literal, Optional, Union
+
+from pydantic import BaseModel, ConfigDict, Field, Strict
+
+from ..basis import KNOT_KINDS
+from ..boundary import PRESETS
+from ..cad_units import UNITS
+from ..loads import OMEGA_MAX
+from ..model import METHODS, STEP_METHODS
+from ..shapes import FIT_METHODS
+from .schema_types import (PROFILES, IVP_METHODS, MASS_MATRICES, CAD_UNITS, PHYSICS,
+                           SHELL_EDGES, SHELL_KEYS, PLATE_KEYS, FORMATS, FORMAT_ALIASES,
+                           TIME_MAX, Real, Positive, NonNegative, Time, Integer, Text, Pair,
+                           Angle, NetIndex, Cells, Knots, Preset, _Table)  # noqa: F401
+
+# -- [surface] ---------------------------------------------------------------------------------
+Inserted = Annotated[int, Strict(), Field(ge=0, le=64)]
+Added = Annotated[int, Strict(), Field(ge=0, le=6)]
+#: one count for both directions, ``[k_u, k_v]`` or ``{u = k_u, v = k_v}`` (a missing one is 0)
+Insertions = Union[Inserted, tuple[Inserted, Inserted], dict[Literal["u", "v"], Inserted]]
+Elevations = Union[Added, tuple[Added, Added], dict[Literal["u", "v"], Added]]
+
+
+class _Refined(_Table):
+    refine: Optional[Insertions] = Field(
+        None, title="[k_u, k_v]", description=(
+            "knots inserted at equal distances into every knot span of the built or read "
+            "surface (`{u = k, v = k}`, `[k_u, k_v]` or one `k` for both; Boehm's algorithm, "
+            "rational surfaces in homogeneous coordinates): the geometry does not move, every "
+            "span becomes `k + 1`"),
+        json_schema_extra={"doc_default": "0"})
+    elevate: Optional[Elevations] = Field(
+        None, title="[p_u, p_v]", description=(
+            "degrees added to the built or read surface before `refine` (exact degree "
+            "elevation: same geometry, same continuity at every knot); not in a periodic "
+            "direction"),
+        json_schema_extra={"doc_default": "0"})
+
+
+class _Fitted(_Refined):
+    cells: Optional[Union[Cells, tuple[Cells, Cells]]] = Field(
+        None, title="[m_u, m_v]", description=(
+            "knot spans per direction (the net has `cells + degree` control points per "
+            "open/uniform direction, `cells` per periodic one)"),
+        json_schema_extra={"doc_default": "the shape's own (see below)"})
+    degree: Annotated[int, Strict(), Field(ge=1, le=7)] = Field(
+        3, description="polynomial degree of the B-splines (bending weights need ≥ 2)")
+    knots: Optional[Union[Knots, tuple[Knots, Knots]]] = Field(
+        None, title="[u, v]", description=(
+            "knot layout per direction, one for both or [u, v]; closed shapes are periodic "
+            "around"),
+        json_schema_extra={"doc_default": "the shape's own"})
+    method: Literal[FIT_METHODS] = Field(  # type: ignore[valid-type]
+        "interpolate", description=(
+            "how control points are fitted to the shape (collocation at Greville points, L2 "
+            "projection, local quasi-interpolant); a point grid allows `interpolate` and `l2`"))
+
+
+Size = Union[Positive, tuple[Positive, Positive]]
+SIZE_DOC = "side lengths [L_u, L_v] (or one for both); the domain is [0, L_u] × [0, L_v]"
+
+
+class Plane(_Fitted):
+    shape: Literal["plane"]
+    size: Size = Field(1.0, title="[L_u, L_v]", description=(
+            "side lengths; the domain is `[0, L_u] × [0, L_v]`"))
+
+
+class Tile(_Fitted):
+    shape: Literal["tile"]
+    radius: Positive = Field(1.0, description="radius")
+    angle: Annotated[float, Strict(), Field(gt=0, le=2 * math.pi, allow_inf_nan=False)] = Field(
+        math.pi / 2, description="opening angle of the arc (radians)",
+        json_schema_extra={"doc_default": 'π/2'})
+    length: Positive = Field(2.0, description="length along the axis")
+
+
+class HalfSphere(_Fitted):
+    shape: Literal["half_sphere"]
+    radius: Positive = Field(1.0, description="radius")
+
+
+class Cylinder(_Fitted):
+    shape: Literal["cylinder"]
+    radius: Positive = Field(1.0, description="radius")
+    height: Positive = Field(2.0, description="height along z")
+
+
+class Torus(_Fitted):
+    shape: Literal["torus"]
+    R: Positive = Field(1.0, description="radius of the centre line")
+    r: Positive = Field(0.4, description="tube radius (< R)")
+
+
+class Saddle(_Fitted):
+    shape: Literal["saddle"]
+    size: Size = Field(1.0, title="[L_u, L_v]", description=(
+            "side lengths; the domain is `[0, L_u] × [0, L_v]`"))
+    height: Real = Field(0.25, description=(
+            "`z = height (ξ² − η²)` with `ξ = 2u/L_u − 1`, `η = 2v/L_v − 1`"))
+
+
+class FromFile(_Fitted):
+    shape: Literal["file"]
+    path: Text = Field(
+        description=(
+            "`.json` / `.npz` control net written by `splinedeform` (`output.formats` "
+            "`json`/`npz`), or a point grid `(N_u, N_v, 3)` in `.npy` (or `.npz` with one array "
+            "or an array `points`); for `cad` a `.3dm`, STEP or IGES file; relative to the "
+            "scenario file, and inside its folder (see below)"),
+        json_schema_extra={"doc_default": "required for `file` and `cad`"})
+    frame: Integer = Field(-1, description=(
+            "which frame of a control net file (negative counts from the end)"))
+
+
+class FromCad(_Refined):
+    shape: Literal["cad"]
+    path: Text = Field(
+        description=(
+            "CAD file holding NURBS surfaces: openNURBS `.3dm` (the `cad` extra), STEP "
+            "`.stp`/`.step` or IGES `.igs`/`.iges` (the `cad-step` extra); relative to the "
+            "scenario file, and inside its folder (as for `file`)"),
+        json_schema_extra={"doc_default": "required for `cad`"})
+    face: Annotated[int, Strict(), Field(ge=0)] = Field(0, description=(
+            "which surface of the file, counting plain surfaces and Brep faces in file "
+            "order from 0; a trimmed face is taken untrimmed, with a warning"))
+    units: Optional[Literal[CAD_UNITS]] = Field(  # type: ignore[valid-type]
+        None, description=(
+            "length unit of the file's coordinates, overriding the unit the file declares "
+            "(the numbers are kept, only their unit changes); the run computes in it, "
+            "reports it and writes `3dm`, `step`, `iges` outputs in it"),
+        json_schema_extra={"doc_default": "the file's"})
+
+
+#: every ``surface.shape``; a new shape is one model here
+SHAPE_MODELS = (Plane, Tile, HalfSphere, Cylinder, Torus, Saddle, FromFile, FromCad)
+SHAPES = tuple(m.model_fields["shape"].annotation.__args__[0] for m in SHAPE_MODELS)
+Surface = Annotated[Union[SHAPE_MODELS], Field(discriminator="shape")]  # type: ignore[valid-type]
