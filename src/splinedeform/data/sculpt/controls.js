@@ -225,6 +225,7 @@
       if (d.baked) q.fill(0);          // the shape now is the rest shape: only the velocity goes on
     }
     corrections.clear();
+    lagged.clear();
     offlineFactor = null;
     t = 0; tEvent = 0; pushes = []; grab = null; controls.enabled = true; dirty = true;
     freeEdited = false;
@@ -271,7 +272,7 @@
     get grabbed() { return grab ? { index: grab.index, force: grab.force && grab.force.slice() } : null; },
     get pushes() { return pushes.map((p) => Object.assign({}, p)); },
     get errors() { return errors.slice(); },
-    get resting() { return !grab && !q.some((x) => x !== 0) && !v.some((x) => x !== 0); },
+    get resting() { return !grab && lagged.size === 0 && !q.some((x) => x !== 0) && !v.some((x) => x !== 0); },
     get corrections() { return Array.from(corrections.keys()).filter((k) => corrections.get(k)); },
     get freeMask() { return Array.from(freeMask); },
     correction(n) { requestCorrection(n); const c = corrections.get(n); return c ? Array.from(c) : null; },
@@ -289,7 +290,7 @@
     pick(x, y) { return pick(x, y); },
     frames() { return frameLog.slice(); },
     latencies() { return latencies.slice(); },
-    setPaused, reset, save, resolve, bake, undo, redo,
+    setPaused, reset, save, resolve, bake, undo, redo, hold, release() { release(null); },
     modalState() { return { q: Array.from(q), v: Array.from(v), f: Array.from(f), t, tEvent }; },
     get history() { return [undoStack.length, redoStack.length]; },
     setSpeed(s) { speed = s; speedBox.value = String(s); },

@@ -107,6 +107,7 @@
   // (Φ_s or the net's), float64 sums in the order i = 0 … K-1; two rows at a time, so that
   // each modal coordinate is loaded once for both (the loop is bound by its loads)
   let qx = null, qy = null, qz = null;
+  const lagZ = new Float64Array(3), lagV = new Float64Array(3);
   function superpose(A, rows, out) {
     let n = 0;
     for (; n + 1 < rows; n += 2) {
@@ -131,13 +132,16 @@
     if (!qx || qx.length !== K) { qx = new Float64Array(K); qy = new Float64Array(K); qz = new Float64Array(K); }
     for (let i = 0; i < K; i++) { qx[i] = qt[3 * i]; qy[i] = qt[3 * i + 1]; qz[i] = qt[3 * i + 2]; }
     superpose(phi, N, disp);
-    if (grab && grab.force) {
-      const col = corrections.get(grab.index), F = grab.force;
-      if (col) for (let n = 0; n < N; n++) {
+    lagged.forEach((entry, index) => {           // r_a ⊗ z_a(t), the correction reached so far
+      const col = corrections.get(index);
+      if (!col) return;
+      lagAdvance(entry, t - tEvent, lagZ, null);
+      const zx = lagZ[0], zy = lagZ[1], zz = lagZ[2];
+      for (let n = 0; n < N; n++) {
         const r = col[n];
-        disp[3 * n] += r * F[0]; disp[3 * n + 1] += r * F[1]; disp[3 * n + 2] += r * F[2];
+        disp[3 * n] += r * zx; disp[3 * n + 1] += r * zy; disp[3 * n + 2] += r * zz;
       }
-    }
+    });
     if (showNet.checked) superpose(phiNet, NN, netDisp);
   }
   // Released and rung down: once no mode can move any sample by more than 1e-6 of the
@@ -147,7 +151,8 @@
   // √(2E/λ_min), hence |d| ≤ √(2E/λ_min) Σ_i max_n |Φ_s[n, i]|.
   let phiPeak = -1;
   function settle() {
-    if (grab || paused || f.some((x) => x !== 0) || !(q.some((x) => x !== 0) || v.some((x) => x !== 0))) return;
+    const lagging = lagged.size > 0;
+    if (grab || paused || f.some((x) => x !== 0) || !(lagging || q.some((x) => x !== 0) || v.some((x) => x !== 0))) return;
     if (phiPeak < 0) {
       phiPeak = 0;
       const top = new Float64Array(K);
@@ -160,8 +165,18 @@
       lmin = Math.min(lmin, lam[i]);
       for (let j = 3 * i; j < 3 * i + 3; j++) energy += (eV[j] * eV[j] + lam[i] * qt[j] * qt[j]) / 2;
     }
-    if (Math.sqrt(2 * energy / lmin) * phiPeak < 1e-6 * radius) {
-      q.fill(0); v.fill(0); tEvent = t; dirty = true;
+    // the correction's follower: |r_a z_a| ≤ max |r_a| √(2 E_z / λ*), E_z = (z'² + λ* z²) / 2
+    let lagBound = 0;
+    lagged.forEach((entry, index) => {
+      const col = corrections.get(index);
+      lagAdvance(entry, t - tEvent, lagZ, lagV);
+      let e = 0, top = 0;
+      for (let j = 0; j < 3; j++) e += (lagV[j] * lagV[j] + lam[K - 1] * lagZ[j] * lagZ[j]) / 2;
+      if (col) for (let n = 0; n < N; n++) top = Math.max(top, Math.abs(col[n]));
+      lagBound += top * Math.sqrt(2 * e / lam[K - 1]);
+    });
+    if (Math.sqrt(2 * energy / lmin) * phiPeak + lagBound < 1e-6 * radius) {
+      q.fill(0); v.fill(0); lagged.clear(); tEvent = t; dirty = true;
     }
   }
   // normals of the sample grid: x_u × x_v by differences along the grid (one-sided at the

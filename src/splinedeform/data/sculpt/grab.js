@@ -142,6 +142,17 @@
     if (event) pendingInput.push(event.timeStamp);
     dirty = true;
   }
+  // a force held at a sample without a spring (for tests and scripts): a grab whose force
+  // stays what it is given until release
+  function hold(index, force) {
+    if (grab) release(null);
+    requestCorrection(index);
+    const F = force.slice();
+    grab = { index, force: F, push: { index, force: F.slice(), t_on: t, t_off: null }, depth: 0,
+             normal: vertexNormal(index) };
+    pushes.push(grab.push);
+    setForce(index, F);
+  }
   container.addEventListener("pointerup", release);
   container.addEventListener("pointercancel", release);
   // the spring (or the push along the normal) from the grabbed point to the pointer, held
@@ -149,10 +160,12 @@
   // The spring is implicit in the frame: the force F held over the coming step τ obeys
   // F = k (x_pointer - x_a(t + τ)) with x_a(t + τ) = x⁰_a(t + τ) + α(τ) F, where x⁰ is the
   // motion with no force from now and α(τ) = Σ_i φ_i(a)² g_i(τ) (+ r_a(a), the static
-  // correction) the point's answer to a unit force held from now (g_i: the step response).
+  // correction, reached at the pace of its follower mode) the point's answer to a unit force
+  // held from now (g_i: the step response).
   // So F = k (x_pointer - x⁰_a(t + τ)) / (1 + k α(τ)): stable for any spring and frame
   // time (the force computed from the displacement at t alone overshoots by k α each frame
   // and diverges once k α > 1: a stiff small free set at a low frame rate).
+  const gz = new Float64Array(3), gzv = new Float64Array(3);
   function grabPrediction(n, tau) {
     propagate(q, v, f, t - tEvent, gq, gv);              // the state now
     dampedCS(tau);
@@ -166,8 +179,22 @@
       }
       alpha += p * p * (1 - c - sigma * sn) / lam[i];
     }
+    // the correction's followers: free motion from now, and the grabbed point's own step
+    // response r_a(a) (1 - C* - σ* S*) (see the follower in the state part)
+    lagged.forEach((entry, index) => {
+      const col = corrections.get(index);
+      if (!col) return;
+      lagAdvance(entry, t - tEvent, gz, gzv);
+      followerCS(tau);
+      const sigma = damp[K - 1] / 2, c = lagCS[0], sn = lagCS[1], r = col[n];
+      for (let j = 0; j < 3; j++) x[j] += r * (gz[j] * c + (gzv[j] + sigma * gz[j]) * sn);
+    });
     const col = corrections.get(n);
-    return { x, alpha: alpha + (col ? col[n] : 0) };
+    if (col && !data.complete) {
+      followerCS(tau);
+      alpha += col[n] * (1 - lagCS[0] - damp[K - 1] / 2 * lagCS[1]);
+    }
+    return { x, alpha };
   }
   function updateGrab(interval) {
     if (!grab || !pointer) return;

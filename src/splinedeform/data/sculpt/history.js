@@ -10,7 +10,12 @@
     return { data, q: Float64Array.from(q), v: Float64Array.from(v), f: Float64Array.from(f),
              t, tEvent, pushes: pushes.map((p) => Object.assign({}, p, { force: p.force.slice() })),
              freeMask: freeMask.slice(), freeSource, freeEdited, carriedMotion,
-             corrections: new Map(corrections) };
+             corrections: new Map(corrections), lagged: copyLagged(lagged) };
+  }
+  function copyLagged(from) {
+    const out = new Map();
+    from.forEach((e, k) => out.set(k, { z: Float64Array.from(e.z), zv: Float64Array.from(e.zv), fz: Float64Array.from(e.fz) }));
+    return out;
   }
   function showHistory() {
     undoButton.disabled = !online || undoStack.length === 0;
@@ -35,6 +40,8 @@
     carriedMotion = state.carriedMotion;
     corrections.clear();
     state.corrections.forEach((c, k) => { if (c) corrections.set(k, c); });
+    lagged.clear();
+    copyLagged(state.lagged).forEach((e, k) => lagged.set(k, e));
     offlineFactor = null; grab = null; controls.enabled = true; lastSwitch = null;
     if (!sameGrid || !geometry) buildGeometry();
     buildForms();

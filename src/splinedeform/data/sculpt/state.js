@@ -82,6 +82,41 @@
     }
   }
 
+  // -- the static correction follows the dynamics ---------------------------------------------
+  // r_a ⊗ z_a, not r_a ⊗ P_a: the omitted modes reach their static part r_a P_a only as fast as
+  // their dynamics lets them, so z_a obeys z'' + c* z' + λ* z = λ* P_a(t) (static limit z = P,
+  // mode acceleration's exact static answer) with (λ*, c*) = (λ_K, c_K), the highest kept mode:
+  // no omitted mode is slower (λ_j ≥ λ_K; over-damped, a step reaches λ_j g_j(τ) ≥ λ_K g_K(τ)),
+  // so the correction never adds a static part the dynamics has not reached (damping 1e8: a
+  // held push dents the sheet at the pace of the modes, not at once). Kept per grabbed
+  // sample as (z, z', force λ* P) at tEvent, like the modes; dropped when the page settles.
+  const lagged = new Map();          // sample index -> {z, zv, fz: Float64Array(3)}
+  const lagCS = new Float64Array(2); // e^{-στ} C(τ), e^{-στ} S(τ) of the follower mode
+  function followerCS(tau) {
+    const l = lam[K - 1], sigma = damp[K - 1] / 2, s = sigma * sigma - l, x = s * tau * tau;
+    const decay = Math.exp(-sigma * tau);
+    if (Math.abs(x) < 1e-3) {
+      lagCS[0] = decay * (1 + x * (1 / 2 + x * (1 / 24 + x / 720)));
+      lagCS[1] = decay * tau * (1 + x * (1 / 6 + x * (1 / 120 + x / 5040)));
+    } else if (s < 0) {
+      const w = Math.sqrt(-s);
+      lagCS[0] = decay * Math.cos(w * tau); lagCS[1] = decay * Math.sin(w * tau) / w;
+    } else {
+      const d = Math.sqrt(s), grow = Math.exp((d - sigma) * tau), fall = Math.exp((-d - sigma) * tau);
+      lagCS[0] = (grow + fall) / 2; lagCS[1] = (grow - fall) / (2 * d);
+    }
+  }
+  // the follower's state of `entry` after tau (from tEvent) into (outZ, outV)
+  function lagAdvance(entry, tau, outZ, outV) {
+    followerCS(tau);
+    const l = lam[K - 1], sigma = damp[K - 1] / 2, c = lagCS[0], sn = lagCS[1];
+    for (let j = 0; j < 3; j++) {
+      const r = entry.fz[j] / l, a = entry.z[j] - r, b = entry.zv[j];
+      outZ[j] = r + a * c + (b + sigma * a) * sn;
+      if (outV) outV[j] = b * c - (l * a + sigma * b) * sn;
+    }
+  }
+
   // -- session: time, pushes, the held grab --------------------------------------------------
   let t = 0, tEvent = 0, paused = false, speed = 1;
   let pushes = [];           // {index, force: [3], t_on, t_off|null}: what "Save" sends
@@ -90,9 +125,15 @@
   // a change of the held force at the current time: carry the state to t, then switch
   function setForce(index, force) {
     propagate(q, v, f, t - tEvent, q, v);
+    lagged.forEach((entry) => { lagAdvance(entry, t - tEvent, entry.z, entry.zv); entry.fz.fill(0); });
     tEvent = t;
     dirty = true;                      // redraw even when paused (the static part changes)
     f.fill(0);
+    if (force && !data.complete) {
+      if (!lagged.has(index)) lagged.set(index, { z: new Float64Array(3), zv: new Float64Array(3), fz: new Float64Array(3) });
+      const fz = lagged.get(index).fz, l = lam[K - 1];
+      fz[0] = l * force[0]; fz[1] = l * force[1]; fz[2] = l * force[2];
+    }
     if (force) {
       const base = index * K;
       for (let i = 0; i < K; i++) {
@@ -103,6 +144,7 @@
   }
   function reset() {
     q.fill(0); v.fill(0); f.fill(0); t = 0; tEvent = 0; pushes = []; grab = null; carriedMotion = false;
+    lagged.clear();
     controls.enabled = true;
     dirty = true;
   }
