@@ -5,6 +5,8 @@ page shows it):
 
 - ``GET /``: the page, with the current modal basis inside (it keeps working offline);
 - ``GET /api/basis``: the current modal data (after a re-solve);
+- ``GET /api/page``: the page for the current basis without the session token, to be kept
+  as a file ("Save offline page");
 - ``GET /api/status``: progress of a re-solve ``{busy, stage, elapsed, error, version}``;
 - ``POST /api/resolve``: ``{material, boundary, free_region | free_points}`` → new modes,
   answered with the new data and ``carry``, the map of the old modal state onto the new
@@ -102,6 +104,13 @@ def create_app(session: Session, guard: Guard) -> ASGIApp:
         html = await run_in_threadpool(sculpt_page, data, guard.token)
         return HTMLResponse(html, headers={"Cache-Control": "no-store"})
 
+    async def offline_page(request: Request) -> Response:
+        # "Save offline page": the page for the current basis, carrying what a page on its
+        # own needs, without the session token
+        data = await run_in_threadpool(session.page_payload)
+        html = await run_in_threadpool(sculpt_page, data, "")
+        return HTMLResponse(html, headers={"Cache-Control": "no-store"})
+
     async def basis(request: Request) -> Response:
         return JSONResponse(await run_in_threadpool(session.payload))
 
@@ -161,6 +170,7 @@ def create_app(session: Session, guard: Guard) -> ASGIApp:
         return Response(status_code=204)
 
     routes = [Route("/", _guarded(page)), Route("/favicon.ico", no_icon), Route("/api/basis", _guarded(basis)),
+              Route("/api/page", _guarded(offline_page)),
               Route("/api/status", _guarded(status)),
               Route("/api/resolve", _guarded(resolve), methods=["POST"]),
               Route("/api/correction", _guarded(correction), methods=["POST"]),

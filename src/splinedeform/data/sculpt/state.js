@@ -1,5 +1,15 @@
 // sculpt page, part state: the modal data, the modal state (q, q', f) per mode carried in closed form from event to event, the session (time, pushes, the held grab).
 // The parts are concatenated in order inside one function scope (see sculpt/page.py).
+  // Start-up is idempotent: a page saved from the browser ("Webpage, Complete", or the DOM as
+  // it is) carries the canvas of its last run, its banners and status lines; they go, and the
+  // page is drawn afresh. What is left then is the page as served, kept for "Save offline page".
+  document.querySelectorAll("#view > *").forEach((node) => node.remove());
+  for (const id of ["message", "hud", "progress", "saved", "paint-info"]) {
+    const node = document.getElementById(id);
+    if (node) node.textContent = "";
+  }
+  document.getElementById("message").style.display = "none";
+  const pristinePage = document.documentElement.cloneNode(true);
   let data = JSON.parse(document.getElementById("splinedeform-data").textContent);
   const online = location.protocol === "http:" || location.protocol === "https:";
   // the session token of the server that served this page: sent with every API call
