@@ -164,7 +164,15 @@ class Session:
             baked, path = baked_scenario(scenario, basis, net, folder,
                                          f"{self.save_path.stem}-baked-{self._versions + 1}")
             try:
+                if message.free_points is not None:   # a pin: the set less the pinned point
+                    baked = with_overrides(baked, {
+                        "boundary.free_region": None,
+                        "boundary.free_points": [list(p) for p in message.free_points]},
+                        origin="sculpt page")
                 self._solve(baked)
+            except ScenarioError as exc:
+                path.unlink(missing_ok=True)
+                raise InputError(in_page_words(str(exc), scenario.source)) from None
             except Exception:
                 path.unlink(missing_ok=True)        # refused: no file of a shape never used
                 raise

@@ -113,10 +113,12 @@
   let pendingInput = [];    // event timestamps not yet shown in a frame
   let pointer = null;       // last pointer position while grabbing
   container.addEventListener("pointerdown", (event) => {
-    if (event.button !== 0 || grab || paintBox.checked) return;
+    const pinning = event.altKey || grabMode.value === "pin";
+    if (event.button !== 0 || (grab && !pinning) || paintBox.checked) return;
     const index = pick(event.clientX, event.clientY);
     if (index < 0) return;                       // background: OrbitControls rotates
     event.stopPropagation();
+    if (pinning) { pin(index); return; }         // pin (a bake: it ends a held grab), no grab
     controls.enabled = false;
     container.setPointerCapture && container.setPointerCapture(event.pointerId);
     requestCorrection(index);

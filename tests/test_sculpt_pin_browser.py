@@ -1,0 +1,77 @@
+"""Pinning on the sculpting page, in Debian's Chromium (skipped with the reason when
+Chromium or Playwright is missing): an alt-click on a pulled sheet pins the control point
+nearest to the clicked point where it is now (a bake with that point taken out of the free
+set), and it stays there while another point is pulled."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+# skips this module, saying why, without Chromium or Playwright
+from chromium import sculpt_page, sculpt_server  # noqa: E402
+
+SHEET = """
+title = "pin sheet"
+[surface]
+shape = "plane"
+cells = 5
+[material]
+damping = 1.0
+w10 = 1.0
+w01 = 1.0
+[boundary]
+u0 = "clamped"
+u1 = "clamped"
+[solve]
+kind = "modes"
+"""
+R = 11
+
+
+@pytest.fixture(scope="module")
+def page(tmp_path_factory, browser):
+    folder = tmp_path_factory.mktemp("pin")
+    with sculpt_server(folder, "sheet.toml", SHEET, "--resolution", str(R),
+                       "--save", "saved.toml") as url:
+        page = sculpt_page(browser, url)
+        yield page
+        page.close()
+
+
+def test_a_pinned_point_stays_where_it_was_while_another_is_pulled(page):
+    page.click("#show-net")                       # the net's displacement is computed
+    centre, other = (R // 2) * R + R // 2, 3 * R + 8
+    page.evaluate(f"sculptState.hold({centre}, [0, 0, -2])")
+    page.wait_for_timeout(500)
+    page.evaluate("sculptState.setPaused(true)")  # the shape holds still for the pin
+    k = page.evaluate(f"sculptState.nearestNet({centre})")
+    before = np.array(page.evaluate(f"sculptState.netPosition({k})"))
+    rest = np.array(page.evaluate(f"sculptState.netPosition({k}) && sculptState.netDisplacement()")
+                    ).reshape(-1, 3)[k]
+    assert abs(rest[2]) > 1e-3                    # pulled well away from its rest place
+    at = page.evaluate(f"sculptState.screen({centre})")
+    page.keyboard.down("Alt")
+    page.mouse.click(at["x"], at["y"])
+    page.keyboard.up("Alt")
+    page.wait_for_function("sculptState.version === 2", timeout=30000)
+    assert "pinned control point" in page.evaluate("sculptState.progress")
+    assert page.evaluate("sculptState.grabbed") is None          # a pin grabs nothing
+    assert page.evaluate("sculptState.freeMask")[k] == 0
+    page.evaluate("sculptState.setPaused(false)")
+    page.evaluate(f"sculptState.hold({other}, [0, 0.5, -3])")
+    moved, neighbour = [], []
+    for _ in range(6):
+        page.wait_for_timeout(100)
+        net = np.array(page.evaluate("sculptState.netDisplacement()")).reshape(-1, 3)
+        moved.append(np.abs(net[k]).max())
+        neighbour.append(np.abs(net[k + 1]).max())
+        position = np.array(page.evaluate(f"sculptState.netPosition({k})"))
+    page.evaluate("sculptState.release()")
+    # held: no free coordinate maps to it (an empty row of T), so 0 up to 1e-9
+    assert max(moved) <= 1e-9
+    assert max(neighbour) > 1e-3                  # its neighbour is free and pulled along
+    # where it was: the baked net (float64 on the server) against the page's float32 net
+    # and Φ_net before the pin: 2^-24 of |x| ~ 1 plus that of |d|, 1e-6
+    assert np.max(np.abs(position - before)) <= 1e-6
+    assert not page.problems and page.evaluate("sculptState.errors") == []
