@@ -318,3 +318,38 @@ def test_a_released_surface_comes_to_rest_and_is_no_longer_drawn(page):
     finally:
         page.evaluate("sculptState.setSpeed(1)")
     assert not page.problems
+
+
+def test_the_grab_is_seen_and_named_in_words(page, server):
+    """While a point is pulled the page draws a marker at it and the spring to the pointer,
+    and the status line names the point by its parameters (u, v)."""
+    import re
+
+    page.evaluate("sculptState.reset()")
+    sample = (R // 2) * R + 5
+    start = page.evaluate(f"sculptState.screen({sample})")
+    index = grab_and_pull(page, sample, 40)          # the pointer ends 40 px below the start
+    page.evaluate("sculptState.setPaused(true)")
+    page.wait_for_timeout(400)                       # a frame drawn and the status line redone
+    view = page.evaluate("sculptState.grabView")
+    rest = np.array(page.evaluate(f"sculptState.rest({index})"))
+    disp = np.array(page.evaluate(f"sculptState.displacement({index})"))
+    end = np.array(page.evaluate(f"sculptState.pointerWorld({start['x']}, {start['y'] + 40})"))
+    hud = page.evaluate("sculptState.hud")
+    u, v = page.evaluate(f"sculptState.uv({index})")
+    page.mouse.up()
+    page.evaluate("sculptState.setPaused(false)")
+    assert view["marker"] and view["spring"]
+    # the marker is the drawn point x0 + d: the same float64 sums (1e-12 of |x| ~ 1)
+    assert np.max(np.abs(np.array(view["point"]) - (rest + disp))) <= 1e-12
+    # the spring ends at the pointer: the mouse position passes through the browser's event
+    # coordinates (observed 1e-8 off, about 1e-5 px; 1 px is ~3e-3 here): 1e-6
+    assert np.max(np.abs(np.array(view["pointer"]) - end)) <= 1e-6
+    assert np.linalg.norm(end - view["point"]) > 1e-3
+    words = re.search(r"pulling the point at u = ([0-9.e-]+), v = ([0-9.e-]+)", hud)
+    assert words, hud
+    # three significant digits of the sample's parameters in [0, 1]: 5e-3
+    assert abs(float(words.group(1)) - u) <= 5e-3 and abs(float(words.group(2)) - v) <= 5e-3
+    assert "sample" not in hud.split("\n")[-1]      # the grab line: no sample number
+    page.wait_for_timeout(100)
+    assert page.evaluate("sculptState.grabView") is None       # released: nothing drawn

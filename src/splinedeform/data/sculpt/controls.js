@@ -45,9 +45,16 @@
       "   " + (mean > 0 ? (1000 / mean).toFixed(0) : "-") + " fps, " + work.toFixed(1) + " ms per frame" +
       "\n" + K + (data.complete ? " modes (all)" : " of " + data.n_free + " modes" +
       (online || data.offline ? " + static correction" : "")) + ", " + ru + "×" + rv + " samples, max |d| = " + (dmax > 0 ? dmax.toPrecision(3) : "0") +
-      (grab ? "\ngrabbed sample " + grab.index : "");
+      (grab ? "\n" + grabWords() : "");
   }
 
+  // the grab in words: where on the surface (its parameters) and the force held there
+  function grabWords() {
+    const n = grab.index, u = data.u[Math.floor(n / rv)], v = data.v[n % rv], F = grab.force;
+    const how = !pointer ? "holding" : grabMode.value === "normal" ? "pushing" : "pulling";
+    return how + " the point at u = " + u.toPrecision(3) + ", v = " + v.toPrecision(3) +
+      (F ? " with |F| = " + Math.hypot(F[0], F[1], F[2]).toPrecision(3) : "");
+  }
   // -- controls ---------------------------------------------------------------------------------
   const pauseButton = document.getElementById("pause");
   const speedBox = document.getElementById("speed"), springBox = document.getElementById("spring");
@@ -292,7 +299,12 @@
     latencies() { return latencies.slice(); },
     setPaused, reset, save, resolve, bake() { return bake(); }, pin, undo, redo, hold, release() { release(null); },
     netPosition(k) { return [netRest[3 * k] + netDisp[3 * k], netRest[3 * k + 1] + netDisp[3 * k + 1], netRest[3 * k + 2] + netDisp[3 * k + 2]]; },
+    uv(n) { return [data.u[Math.floor(n / rv)], data.v[n % rv]]; },
     nearestNet(n) { return nearestNetPoint(data.u[Math.floor(n / rv)], data.v[n % rv]); },
+    get grabView() { return grabEnds && { point: grabEnds.point.slice(), pointer: grabEnds.pointer && grabEnds.pointer.slice(),
+                                          marker: grabMarker.visible, spring: springLine.visible }; },
+    get hud() { return hudBox.textContent; },
+    pointerWorld(x, y) { const p = pointerWorld(x, y, grab ? grab.depth : 0.5); return [p.x, p.y, p.z]; },
     get progress() { return document.getElementById("progress").textContent; },
     modalState() { return { q: Array.from(q), v: Array.from(v), f: Array.from(f), t, tEvent }; },
     get history() { return [undoStack.length, redoStack.length]; },

@@ -101,6 +101,37 @@
     paintNet();
   }
 
+  // -- the grab, seen: a marker at the grabbed point and the spring drawn to the pointer -----
+  const GRAB_COLOUR = 0xd0302a;
+  const markerPositions = new THREE.BufferAttribute(new Float32Array(3), 3);
+  const springPositions = new THREE.BufferAttribute(new Float32Array(6), 3);
+  const markerGeometry = new THREE.BufferGeometry(), springGeometry = new THREE.BufferGeometry();
+  markerGeometry.setAttribute("position", markerPositions);
+  springGeometry.setAttribute("position", springPositions);
+  const grabMarker = new THREE.Points(markerGeometry, new THREE.PointsMaterial(
+    { color: GRAB_COLOUR, size: 11, sizeAttenuation: false, depthTest: false }));
+  const springLine = new THREE.LineSegments(springGeometry, new THREE.LineBasicMaterial(
+    { color: GRAB_COLOUR, depthTest: false }));
+  for (const o of [grabMarker, springLine]) { o.frustumCulled = false; o.visible = false; o.renderOrder = 10; scene.add(o); }
+  // where the grabbed point is drawn and where its spring ends (null: no spring, e.g. a held force)
+  let grabEnds = null;
+  function showGrab() {
+    grabEnds = null;
+    grabMarker.visible = springLine.visible = false;
+    if (!grab) return;
+    const n = grab.index, at = [rest[3 * n] + disp[3 * n], rest[3 * n + 1] + disp[3 * n + 1], rest[3 * n + 2] + disp[3 * n + 2]];
+    markerPositions.array.set(at); markerPositions.needsUpdate = true;
+    grabMarker.visible = true;
+    let end = null;
+    if (pointer) {
+      const p = pointerWorld(pointer.x, pointer.y, grab.depth);
+      end = [p.x, p.y, p.z];
+      springPositions.array.set(at); springPositions.array.set(end, 3); springPositions.needsUpdate = true;
+      springLine.visible = true;
+    }
+    grabEnds = { point: at, pointer: end };
+  }
+
   // -- per frame: x = x0 + Φ_s q(t) (+ r_a ⊗ P held) ---------------------------------------------
   let vmax = 0, dmax = 0, dirty = true;   // colour scale (never 0), largest |d| drawn
   // out[3n + c] = Σ_i A[n K + i] q_c,i for the rows n of a (rows × K) float32 matrix A
@@ -273,6 +304,7 @@
       for (let k = 0; k < NN * 3; k++) np[k] = netRest[k] + netDisp[k];
       netPositions.needsUpdate = true;
     }
+    showGrab();
     renderer.render(scene, camera);
   }
 

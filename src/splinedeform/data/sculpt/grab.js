@@ -132,6 +132,7 @@
     if (!grab) return;
     pointer = { x: event.clientX, y: event.clientY };
     pendingInput.push(event.timeStamp);
+    dirty = true;                        // the spring drawn follows the pointer, paused too
   });
   function release(event) {
     if (!grab) return;
