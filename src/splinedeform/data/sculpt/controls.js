@@ -123,6 +123,7 @@
       document.getElementById("region-" + key + "0").value = String(Number(a.toPrecision(6)));
       document.getElementById("region-" + key + "1").value = String(Number(b.toPrecision(6)));
     });
+    applyTips();                          // the help part's tooltips on the new fields
   }
   const regionOn = () => document.getElementById("region-on");
   function freeRegion() {
