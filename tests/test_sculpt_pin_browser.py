@@ -1,7 +1,8 @@
 """Pinning on the sculpting page, in Debian's Chromium (skipped with the reason when
 Chromium or Playwright is missing): an alt-click on a pulled sheet pins the control point
 nearest to the clicked point where it is now (a bake with that point taken out of the free
-set), and it stays there while another point is pulled."""
+set), and it stays there while another point is pulled; the export buttons download the
+shape shown."""
 
 from __future__ import annotations
 
@@ -74,4 +75,39 @@ def test_a_pinned_point_stays_where_it_was_while_another_is_pulled(page):
     # where it was: the baked net (float64 on the server) against the page's float32 net
     # and Φ_net before the pin: 2^-24 of |x| ~ 1 plus that of |d|, 1e-6
     assert np.max(np.abs(position - before)) <= 1e-6
+    assert not page.problems and page.evaluate("sculptState.errors") == []
+
+
+def test_export_buttons_download_the_shape_shown(page, tmp_path):
+    """The .3dm the page downloads holds the net drawn (float32 on the page: 1e-5) and the
+    same net, to 1e-12, as the net file downloaded at the same paused moment."""
+    rhino3dm = pytest.importorskip("rhino3dm", reason="the .3dm export needs the extra 'cad'")
+    from splinedeform.export.nets import read_control_net
+
+    if not page.evaluate("document.getElementById('show-net').checked"):
+        page.click("#show-net")                   # the net's displacement is computed
+    page.evaluate(f"sculptState.hold({(R // 2) * R + 3}, [0, 0, -2])")
+    page.wait_for_timeout(400)
+    page.evaluate("sculptState.setPaused(true)")
+    files = {}
+    for fmt in ("3dm", "json", "obj"):
+        with page.expect_download() as info:
+            page.click(f"#export-{fmt}")
+        files[fmt] = tmp_path / info.value.suggested_filename
+        info.value.save_as(files[fmt])
+    drawn = np.array(page.evaluate("Array.from({length: sculptState.freeMask.length}, "
+                                   "(_, k) => sculptState.netPosition(k))"))
+    page.evaluate("sculptState.release()")
+    page.evaluate("sculptState.setPaused(false)")
+    assert files["3dm"].name == "pin_sheet-shape.3dm"
+    srf = rhino3dm.File3dm.Read(str(files["3dm"])).Objects[0].Geometry
+    got = np.array([[srf.Points[i, j].X, srf.Points[i, j].Y, srf.Points[i, j].Z]
+                    for i in range(srf.Points.CountU) for j in range(srf.Points.CountV)])
+    net = read_control_net(files["json"]).control_points.reshape(-1, 3)
+    assert np.abs(net[:, 2]).max() > 1e-3                      # pulled: the shape moved
+    # one net through two writers (openNURBS doubles, repr floats): 1e-12
+    assert np.max(np.abs(got - net)) <= 1e-12 * np.abs(net).max()
+    # the net drawn: float32 rest net and Φ_net on the page, 1e-5 of the size
+    assert np.max(np.abs(drawn - net)) <= 1e-5 * np.abs(net).max()
+    assert files["obj"].read_text().startswith("# splinedeform surface mesh")
     assert not page.problems and page.evaluate("sculptState.errors") == []

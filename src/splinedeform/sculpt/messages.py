@@ -144,6 +144,15 @@ class BakeMessage(_Message):
                            Field(max_length=MAX_NET_POINTS)] | None = None
 
 
+class ExportMessage(_Message):
+    """Download the shape of modal state ``q`` on basis ``version`` as ``format``."""
+
+    version: Annotated[Count, Field(ge=0)]
+    q: Annotated[list[Annotated[Real, Field(ge=-1e12, le=1e12)]],
+                 Field(min_length=3, max_length=3 * MAX_NET_POINTS)]
+    format: Literal["3dm", "obj", "json"]
+
+
 class HistoryMessage(_Message):
     """Undo or redo from basis ``version`` (the one the page shows)."""
 

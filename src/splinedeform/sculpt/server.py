@@ -13,6 +13,8 @@ page shows it):
   modes (:mod:`.carry`);
 - ``POST /api/correction``: ``{version, index}`` → the static correction column of a sample;
 - ``POST /api/save``: ``{version, t_end, pushes}`` → the scenario written to the save path;
+- ``POST /api/export``: ``{version, q, format}`` → the shape of modal state ``q`` as a
+  ``.3dm``, OBJ or net JSON file (:mod:`.shape_files`);
 - ``POST /api/bake``: ``{version, q}`` → the shape of modal state ``q`` becomes the rest
   shape, modes solved again (answered like a re-solve, with ``baked: true``);
 - ``POST /api/undo``, ``POST /api/redo``: ``{version}`` → back to the basis before, or
@@ -40,8 +42,8 @@ from starlette.routing import Route
 from ..errors import InputError
 from .export import _b64
 from .guard import ASGIApp, Guard, guarded
-from .messages import (MAX_BODY, BakeMessage, CorrectionMessage, HistoryMessage,
-                       ResolveMessage, SaveMessage, describe_error)
+from .messages import (MAX_BODY, BakeMessage, CorrectionMessage, ExportMessage,
+                       HistoryMessage, ResolveMessage, SaveMessage, describe_error)
 from .page import sculpt_page
 from .session import Busy, Session
 
@@ -166,6 +168,16 @@ def create_app(session: Session, guard: Guard) -> ASGIApp:
               file=sys.stderr)
         return JSONResponse({"path": str(path), "loads": loads, "steps": len(message.pushes)})
 
+    async def export(request: Request) -> Response:
+        message = await _message(request, ExportMessage)
+        if isinstance(message, JSONResponse):
+            return message
+        assert isinstance(message, ExportMessage)
+        content, name, media = await run_in_threadpool(session.export, message)
+        return Response(content, media_type=media,
+                        headers={"Content-Disposition": f'attachment; filename="{name}"',
+                                 "Cache-Control": "no-store"})
+
     async def no_icon(request: Request) -> Response:
         return Response(status_code=204)
 
@@ -175,6 +187,7 @@ def create_app(session: Session, guard: Guard) -> ASGIApp:
               Route("/api/resolve", _guarded(resolve), methods=["POST"]),
               Route("/api/correction", _guarded(correction), methods=["POST"]),
               Route("/api/save", _guarded(save), methods=["POST"]),
+              Route("/api/export", _guarded(export), methods=["POST"]),
               Route("/api/bake", _guarded(bake), methods=["POST"]),
               Route("/api/undo", _guarded(history("undo")), methods=["POST"]),
               Route("/api/redo", _guarded(history("redo")), methods=["POST"])]

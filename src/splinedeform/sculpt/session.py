@@ -28,7 +28,7 @@ from .correction import StaticCorrection, offline_data, static_correction
 from .export import _b64, payload
 from .grabs import chain_tables, grab_chains
 from .history import BasisState, History, baked_net, baked_scenario
-from .messages import BakeMessage, PushMessage, ResolveMessage, SaveMessage
+from .messages import BakeMessage, ExportMessage, PushMessage, ResolveMessage, SaveMessage
 from .modal import SculptBasis, sculpt_basis
 
 MATERIAL_FIELDS = ("mass", "damping", "rayleigh", "w10", "w01", "w20", "w11", "w02")
@@ -182,6 +182,15 @@ class Session:
         finally:
             self.progress["busy"] = False
             self._lock.release()
+
+    def export(self, message: ExportMessage) -> tuple[bytes, str, str]:
+        """The shape of ``message.q`` as a file (:func:`.shape_files.shape_file`)."""
+        from .shape_files import shape_file
+
+        with self._state_lock:
+            self._check_version(message.version)
+            basis, title = self.basis, self.scenario.title or self.scenario.name
+        return shape_file(basis, np.asarray(message.q, dtype=float), message.format, title)
 
     def undo(self, version: int) -> None:
         """Back to the basis before the current one (exactly: kept, not solved again)."""

@@ -1,4 +1,4 @@
-// sculpt page, part files: what the page writes as files (the offline page).
+// sculpt page, part files: what the page writes as files (the offline page, the shape).
 // The parts are concatenated in order inside one function scope (see sculpt/page.py).
   function download(name, content, type) {
     const url = URL.createObjectURL(new Blob([content], { type }));
@@ -43,3 +43,37 @@
   }
   document.getElementById("save-page").addEventListener("click", () => saveOfflinePage());
   window.sculptState.saveOfflinePage = saveOfflinePage;
+
+  // the modal state now (what a bake or an export sends): q(t) of every mode, mode-major
+  function currentQ() {
+    const now = new Float64Array(K * 3);
+    propagate(q, v, f, t - tEvent, now, null);
+    return now;
+  }
+  // "Export": the shape now, x = P + T Φ_net q(t), as .3dm, OBJ or the net file, written by
+  // the server's writers (POST api/export: splinedeform/sculpt/shape_files.py)
+  async function exportShape(format) {
+    if (!online) { showMessage("export needs the server (this is an offline copy): run splinedeform sculpt"); return null; }
+    try {
+      const response = await fetch("api/export", { method: "POST",
+        headers: Object.assign({ "Content-Type": "application/json" }, apiHeaders),
+        body: JSON.stringify({ version: data.version, q: Array.from(currentQ()), format }) });
+      if (!response.ok) {
+        let reply;
+        try { reply = await response.json(); } catch (err) { reply = {}; }
+        throw new Error(reply.error || ("HTTP " + response.status));
+      }
+      const named = /filename="([^"]+)"/.exec(response.headers.get("Content-Disposition") || "");
+      const name = named ? named[1] : fileStem() + "-shape." + format;
+      download(name, await response.blob(), response.headers.get("Content-Type") || "application/octet-stream");
+      showMessage("wrote " + name + (grab && !data.complete ? " (the modes' shape: the static correction of the held grab is not in it)" : ""), true);
+      return name;
+    } catch (err) {
+      showMessage("export refused: " + err.message);
+      return null;
+    }
+  }
+  for (const format of ["3dm", "obj", "json"]) {
+    document.getElementById("export-" + format).addEventListener("click", () => exportShape(format));
+  }
+  window.sculptState.currentQ = () => Array.from(currentQ());

@@ -38,6 +38,9 @@
       "redo": "forward again (Ctrl-Y or Ctrl-Shift-Z)",
       "save": "write the pushes of this session as a scenario file that splinedeform run replays",
       "save-page": "download this page with the current surface: it opens from a file and runs without the server",
+      "export-3dm": "download the shape now as a NURBS surface in a Rhino .3dm file (the model's knots, the current control net)",
+      "export-obj": "download the shape now as a triangle mesh (Wavefront OBJ, vertex normals) on the page's sample grid",
+      "export-json": "download the current control net as the project's net file (JSON; shape = \"file\" in a scenario reads it)",
       "help-button": "keys and what the page computes (?)",
     };
   }
