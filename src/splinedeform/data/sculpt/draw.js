@@ -102,9 +102,9 @@
   }
 
   // -- the grab, seen: a marker at the grabbed point and the spring drawn to the pointer -----
-  const GRAB_COLOUR = 0xd0302a;
-  const markerPositions = new THREE.BufferAttribute(new Float32Array(3), 3);
-  const springPositions = new THREE.BufferAttribute(new Float32Array(6), 3);
+  const GRAB_COLOUR = 0xd0302a, MAX_SHOWN = 16;
+  const markerPositions = new THREE.BufferAttribute(new Float32Array(3 * MAX_SHOWN), 3);
+  const springPositions = new THREE.BufferAttribute(new Float32Array(6 * MAX_SHOWN), 3);
   const markerGeometry = new THREE.BufferGeometry(), springGeometry = new THREE.BufferGeometry();
   markerGeometry.setAttribute("position", markerPositions);
   springGeometry.setAttribute("position", springPositions);
@@ -113,23 +113,28 @@
   const springLine = new THREE.LineSegments(springGeometry, new THREE.LineBasicMaterial(
     { color: GRAB_COLOUR, depthTest: false }));
   for (const o of [grabMarker, springLine]) { o.frustumCulled = false; o.visible = false; o.renderOrder = 10; scene.add(o); }
-  // where the grabbed point is drawn and where its spring ends (null: no spring, e.g. a held force)
+  // where the main grab's point is drawn and where its spring ends (null: no spring, e.g. a
+  // held force); every grab held gets its marker and its spring (to its pointer or anchor)
   let grabEnds = null;
   function showGrab() {
     grabEnds = null;
-    grabMarker.visible = springLine.visible = false;
-    if (!grab) return;
-    const n = grab.index, at = [rest[3 * n] + disp[3 * n], rest[3 * n + 1] + disp[3 * n + 1], rest[3 * n + 2] + disp[3 * n + 2]];
-    markerPositions.array.set(at); markerPositions.needsUpdate = true;
-    grabMarker.visible = true;
-    let end = null;
-    if (pointer) {
-      const p = pointerWorld(pointer.x, pointer.y, grab.depth);
-      end = [p.x, p.y, p.z];
-      springPositions.array.set(at); springPositions.array.set(end, 3); springPositions.needsUpdate = true;
-      springLine.visible = true;
+    const shown = allGrabs().slice(0, MAX_SHOWN);
+    let points = 0, lines = 0;
+    for (const g of shown) {
+      const n = g.index, at = [rest[3 * n] + disp[3 * n], rest[3 * n + 1] + disp[3 * n + 1], rest[3 * n + 2] + disp[3 * n + 2]];
+      markerPositions.array.set(at, 3 * points++);
+      let end = null;
+      if (g === grab ? pointer : (g.pointer || g.anchor)) {
+        const p = springTarget(g);
+        end = [p.x, p.y, p.z];
+        springPositions.array.set(at, 6 * lines); springPositions.array.set(end, 6 * lines + 3);
+        lines++;
+      }
+      if (g === grab) grabEnds = { point: at, pointer: end };
     }
-    grabEnds = { point: at, pointer: end };
+    markerGeometry.setDrawRange(0, points); springGeometry.setDrawRange(0, 2 * lines);
+    markerPositions.needsUpdate = springPositions.needsUpdate = true;
+    grabMarker.visible = points > 0; springLine.visible = lines > 0;
   }
 
   // -- per frame: x = x0 + Φ_s q(t) (+ r_a ⊗ P held) ---------------------------------------------
@@ -183,7 +188,7 @@
   let phiPeak = -1;
   function settle() {
     const lagging = lagged.size > 0;
-    if (grab || paused || f.some((x) => x !== 0) || !(lagging || q.some((x) => x !== 0) || v.some((x) => x !== 0))) return;
+    if (grab || extra.length || paused || f.some((x) => x !== 0) || !(lagging || q.some((x) => x !== 0) || v.some((x) => x !== 0))) return;
     if (phiPeak < 0) {
       phiPeak = 0;
       const top = new Float64Array(K);

@@ -66,7 +66,7 @@
       const named = /filename="([^"]+)"/.exec(response.headers.get("Content-Disposition") || "");
       const name = named ? named[1] : fileStem() + "-shape." + format;
       download(name, await response.blob(), response.headers.get("Content-Type") || "application/octet-stream");
-      showMessage("wrote " + name + (grab && !data.complete ? " (the modes' shape: the static correction of the held grab is not in it)" : ""), true);
+      showMessage("wrote " + name + ((grab || extra.length) && !data.complete ? " (the modes' shape: the static correction of the held grab is not in it)" : ""), true);
       return name;
     } catch (err) {
       showMessage("export refused: " + err.message);

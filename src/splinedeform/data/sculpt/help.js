@@ -71,7 +71,7 @@
     else if (ctrl && (key === "y" || key === "Y" || (event.shiftKey && (key === "z" || key === "Z")))) redo();
     else if (ctrl || event.altKey) done = false;
     else if (key === " ") setPaused(!paused);
-    else if (key === "Escape") { if (helpOverlay.style.display === "block") toggleHelp(false); else if (grab) release(null); }
+    else if (key === "Escape") { if (helpOverlay.style.display === "block") toggleHelp(false); else releaseAll(); }
     else if (key === "b" || key === "B") bake();
     else if (key === "?") toggleHelp();
     else done = false;

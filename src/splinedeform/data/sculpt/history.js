@@ -28,7 +28,7 @@
     showHistory();
   }
   function restore(state) {
-    if (grab) release(null);
+    releaseAll();
     const sameGrid = state.data.grid[0] === ru && state.data.grid[1] === rv;
     data = state.data;
     unpack(data);
@@ -42,7 +42,7 @@
     state.corrections.forEach((c, k) => { if (c) corrections.set(k, c); });
     lagged.clear();
     copyLagged(state.lagged).forEach((e, k) => lagged.set(k, e));
-    offlineFactor = null; grab = null; controls.enabled = true; lastSwitch = null;
+    offlineFactor = null; grab = null; extra = []; controls.enabled = true; lastSwitch = null;
     if (!sameGrid || !geometry) buildGeometry();
     buildForms();
     paintNet();
@@ -93,7 +93,7 @@
     const wasPaused = paused;
     setPaused(true);                  // the shape sent is the shape when the new modes arrive
     try {
-      if (grab) release(null);
+      releaseAll();
       const earlier = pageState();
       const now = new Float64Array(K * 3);
       propagate(q, v, f, t - tEvent, now, null);   // the shape now: x = x0 + Φ q(t)

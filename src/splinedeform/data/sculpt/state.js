@@ -130,30 +130,39 @@
   // -- session: time, pushes, the held grab --------------------------------------------------
   let t = 0, tEvent = 0, paused = false, speed = 1;
   let pushes = [];           // {index, force: [3], t_on, t_off|null}: what "Save" sends
-  let grab = null;           // {index, force: [3], push, flex, normal, depth, pointer}
+  let grab = null;           // the grab of the main pointer: {index, force: [3], push, normal, depth, pointerId}
+  // the other grabs held at once: a second finger's ({pointerId, pointer}), a grab released
+  // with shift that stays held by its spring to where the pointer was ({anchor}), or a force
+  // held without a spring ({fixed}); the forces of all superpose
+  let extra = [];
   const corrections = new Map();   // sample index -> Float32Array(N) static correction column
-  // a change of the held force at the current time: carry the state to t, then switch
-  function setForce(index, force) {
+  function allGrabs() { return (grab ? [grab] : []).concat(extra); }
+  // a change of the held forces at the current time: carry the state to t, then switch to
+  // f = Σ_g φ(a_g) F_g (and the followers of the static correction to λ* Σ F at each point)
+  function setForce() {
     propagate(q, v, f, t - tEvent, q, v);
     lagged.forEach((entry) => { lagAdvance(entry, t - tEvent, entry.z, entry.zv); entry.fz.fill(0); });
     tEvent = t;
     dirty = true;                      // redraw even when paused (the static part changes)
     f.fill(0);
-    if (force && !data.complete) {
-      if (!lagged.has(index)) lagged.set(index, { z: new Float64Array(3), zv: new Float64Array(3), fz: new Float64Array(3) });
-      const fz = lagged.get(index).fz, l = lam[K - 1];
-      fz[0] = l * force[0]; fz[1] = l * force[1]; fz[2] = l * force[2];
-    }
-    if (force) {
-      const base = index * K;
+    const l = lam[K - 1];
+    for (const g of allGrabs()) {
+      const force = g.force;
+      if (!force) continue;
+      if (!data.complete) {
+        if (!lagged.has(g.index)) lagged.set(g.index, { z: new Float64Array(3), zv: new Float64Array(3), fz: new Float64Array(3) });
+        const fz = lagged.get(g.index).fz;
+        fz[0] += l * force[0]; fz[1] += l * force[1]; fz[2] += l * force[2];
+      }
+      const base = g.index * K;
       for (let i = 0; i < K; i++) {
         const p = phi[base + i];
-        f[3 * i] = p * force[0]; f[3 * i + 1] = p * force[1]; f[3 * i + 2] = p * force[2];
+        f[3 * i] += p * force[0]; f[3 * i + 1] += p * force[1]; f[3 * i + 2] += p * force[2];
       }
     }
   }
   function reset() {
-    q.fill(0); v.fill(0); f.fill(0); t = 0; tEvent = 0; pushes = []; grab = null; carriedMotion = false;
+    q.fill(0); v.fill(0); f.fill(0); t = 0; tEvent = 0; pushes = []; grab = null; extra = []; carriedMotion = false;
     lagged.clear();
     controls.enabled = true;
     dirty = true;
