@@ -111,3 +111,57 @@ def test_export_buttons_download_the_shape_shown(page, tmp_path):
     assert np.max(np.abs(drawn - net)) <= 1e-5 * np.abs(net).max()
     assert files["obj"].read_text().startswith("# splinedeform surface mesh")
     assert not page.problems and page.evaluate("sculptState.errors") == []
+
+
+def test_two_grabs_held_at_once_superpose(page):
+    """A grab released with shift stays held by its spring; a second grab pulls beside it.
+    With both held the page's displacement is the sum of its own closed-form responses to
+    each grab's force history alone (linearity), to 1e-6 of the largest."""
+    page.evaluate("sculptState.reset()")
+    a, b = 3 * R + 4, 6 * R + 5
+    first = page.evaluate(f"sculptState.screen({a})")
+    page.mouse.move(first["x"], first["y"])
+    page.mouse.down()
+    for step in range(1, 5):
+        page.mouse.move(first["x"], first["y"] + 10 * step)
+        page.wait_for_timeout(40)
+    page.keyboard.down("Shift")
+    page.mouse.up()                               # shift: the grab stays held
+    page.keyboard.up("Shift")
+    grabs = page.evaluate("sculptState.grabs")
+    assert len(grabs) == 1 and grabs[0]["held"]
+    a = grabs[0]["index"]                         # the sample picked under the pointer
+    second = page.evaluate(f"sculptState.screen({b})")
+    page.mouse.move(second["x"], second["y"])
+    page.mouse.down()
+    for step in range(1, 5):
+        page.mouse.move(second["x"] + 8 * step, second["y"] - 6 * step)
+        page.wait_for_timeout(40)
+    page.wait_for_timeout(300)
+    page.evaluate("sculptState.setPaused(true)")
+    grabs = page.evaluate("sculptState.grabs")
+    snap = page.evaluate("sculptState.snapshot()")
+    hud = page.evaluate("sculptState.hud")
+    page.mouse.up()
+    page.keyboard.press("Escape")                 # lets go of the held one too
+    assert page.evaluate("sculptState.grabs") == []
+    page.evaluate("sculptState.setPaused(false)")
+    held = [g for g in grabs if g["held"]]
+    assert len(grabs) == 2 and len(held) == 1 and held[0]["index"] == a
+    b = next(g["index"] for g in grabs if not g["held"])
+    assert b != a
+    # both pull (forces of the order of the spring times the pointer's offset, < 10)
+    assert all(g["force"] and 0 < np.linalg.norm(g["force"]) < 10 for g in grabs)
+    assert "1 more held" in hud
+    alone = []
+    for index in (a, b):
+        pushes = [p for p in snap["pushes"] if p["index"] == index]
+        assert pushes and pushes[-1]["t_off"] is None          # still held at the snapshot
+        alone.append(np.array(page.evaluate("sculptState.simulate(%s, [%r])[0]" % (
+            str(pushes).replace("None", "null").replace("'", '"'), snap["time"]))))
+    both = np.asarray(snap["displacement"])
+    scale = np.abs(both).max()
+    assert np.abs(alone[0]).max() > 1e-3 * scale and np.abs(alone[1]).max() > 1e-3 * scale
+    # every mode kept (no correction): the same closed form summed in another order, 1e-6
+    assert np.max(np.abs(both - alone[0] - alone[1])) <= 1e-6 * scale
+    assert not page.problems and page.evaluate("sculptState.errors") == []

@@ -246,13 +246,17 @@
       if (col) A[r][h] += col[springs[r].index] * lagStep;
     }
     // (A_ss + diag(1/k)) F = x_pointer - x⁰ - A_sf F_fixed, by Gaussian elimination
+    // a point that cannot move (held by an edge: no mode moves it) takes no force
+    const still = springs.map((g) => !(flexibility(g.index) > 0));
     const M = springs.map((g, r) => {
       const row = Array.from(A[r].subarray(0, m));
-      const k = Number(springBox.value) / Math.max(flexibility(g.index), 1e-300);
+      if (still[r]) return row.map((_, h) => (h === r ? 1 : 0));
+      const k = Number(springBox.value) / flexibility(g.index);
       row[r] = Math.max(row[r], 0) + 1 / k;
       return row;
     });
     const b = springs.map((g, r) => {
+      if (still[r]) return [0, 0, 0];
       const target = springTarget(g), x = free[r], rhs = [target.x - rest[3 * g.index] - x[0],
         target.y - rest[3 * g.index + 1] - x[1], target.z - rest[3 * g.index + 2] - x[2]];
       for (let h = m; h < n; h++) for (let j = 0; j < 3; j++) rhs[j] -= A[r][h] * all[h].force[j];
