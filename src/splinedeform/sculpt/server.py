@@ -15,6 +15,9 @@ page shows it):
 - ``POST /api/save``: ``{version, t_end, pushes}`` → the scenario written to the save path;
 - ``POST /api/export``: ``{version, q, format}`` → the shape of modal state ``q`` as a
   ``.3dm``, OBJ or net JSON file (:mod:`.shape_files`);
+- ``POST /api/load``: the bytes of a ``.3dm``, net or scenario file (its name in the
+  header ``X-Sculpt-File-Name``, at most 16 MiB) → a new surface, answered like a
+  re-solve without ``carry`` (:mod:`.upload`);
 - ``POST /api/bake``: ``{version, q}`` → the shape of modal state ``q`` becomes the rest
   shape, modes solved again (answered like a re-solve, with ``baked: true``);
 - ``POST /api/undo``, ``POST /api/redo``: ``{version}`` → back to the basis before, or
@@ -178,6 +181,28 @@ def create_app(session: Session, guard: Guard) -> ASGIApp:
                         headers={"Content-Disposition": f'attachment; filename="{name}"',
                                  "Cache-Control": "no-store"})
 
+    async def load(request: Request) -> Response:
+        from urllib.parse import unquote
+
+        from .upload import MAX_UPLOAD, loadable
+
+        name = unquote(request.headers.get("x-sculpt-file-name", ""))
+        if not name or "/" in name or "\\" in name or len(name) > 255:
+            return _error("a loaded file needs its name (header X-Sculpt-File-Name, no folders)")
+        loadable(name)
+        declared = request.headers.get("content-length")
+        if declared is not None and (not declared.isdigit() or int(declared) > MAX_UPLOAD):
+            return _error(f"{name}: too large (at most {MAX_UPLOAD} bytes)", 413)
+        body = b""
+        async for chunk in request.stream():
+            body += chunk
+            if len(body) > MAX_UPLOAD:
+                return _error(f"{name}: too large (at most {MAX_UPLOAD} bytes)", 413)
+        await run_in_threadpool(session.load, name, body)
+        data = await run_in_threadpool(session.page_payload)
+        data.pop("offline", None)
+        return JSONResponse({**data, "loaded": name})
+
     async def no_icon(request: Request) -> Response:
         return Response(status_code=204)
 
@@ -188,6 +213,7 @@ def create_app(session: Session, guard: Guard) -> ASGIApp:
               Route("/api/correction", _guarded(correction), methods=["POST"]),
               Route("/api/save", _guarded(save), methods=["POST"]),
               Route("/api/export", _guarded(export), methods=["POST"]),
+              Route("/api/load", _guarded(load), methods=["POST"]),
               Route("/api/bake", _guarded(bake), methods=["POST"]),
               Route("/api/undo", _guarded(history("undo")), methods=["POST"]),
               Route("/api/redo", _guarded(history("redo")), methods=["POST"])]

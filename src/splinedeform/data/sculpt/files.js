@@ -1,4 +1,5 @@
-// sculpt page, part files: what the page writes as files (the offline page, the shape).
+// sculpt page, part files: what the page writes as files (the offline page, the shape) and
+// the surface it loads from one.
 // The parts are concatenated in order inside one function scope (see sculpt/page.py).
   function download(name, content, type) {
     const url = URL.createObjectURL(new Blob([content], { type }));
@@ -77,3 +78,40 @@
     document.getElementById("export-" + format).addEventListener("click", () => exportShape(format));
   }
   window.sculptState.currentQ = () => Array.from(currentQ());
+
+  // "Load surface": a .3dm, a net file (.json) or a scenario (.toml) sent to the server
+  // (POST api/load, at most 16 MiB: splinedeform/sculpt/upload.py); the new surface's modes
+  // replace the page's (undo goes back), nothing carried over
+  const MAX_UPLOAD = 16 * 2 ** 20;
+  async function loadFile(file) {
+    if (!online) { showMessage("loading a surface needs the server (this is an offline copy)"); return false; }
+    if (!/\.(3dm|stp|step|igs|iges|json|toml)$/i.test(file.name)) { showMessage(file.name + ": the page loads .3dm (or STEP, IGES), .json (a net file) or .toml (a scenario)"); return false; }
+    if (file.size > MAX_UPLOAD) { showMessage(file.name + ": " + file.size + " bytes, more than the " + MAX_UPLOAD + " the page may load"); return false; }
+    if (solving) return false;
+    solving = true;
+    progressBox.textContent = "loading " + file.name + "…";
+    try {
+      releaseAll();
+      const earlier = pageState();
+      const response = await fetch("api/load", { method: "POST", body: await file.arrayBuffer(),
+        headers: Object.assign({ "Content-Type": "application/octet-stream", "X-Sculpt-File-Name": encodeURIComponent(file.name) }, apiHeaders) });
+      let reply;
+      try { reply = await response.json(); } catch (err) { reply = { error: "no JSON answer (" + response.status + ")" }; }
+      if (!response.ok) throw new Error(reply.error || ("HTTP " + response.status));
+      remember(earlier);
+      load(reply);
+      frameCamera();
+      progressBox.textContent = "loaded " + reply.loaded + ": " + K + " modes in " + reply.solve_seconds + " s";
+      return true;
+    } catch (err) {
+      progressBox.textContent = "";
+      showMessage("load refused: " + err.message);
+      return false;
+    } finally {
+      solving = false;
+      showHistory();
+    }
+  }
+  const loadInput = document.getElementById("load-file");
+  loadInput.addEventListener("change", () => { if (loadInput.files.length) loadFile(loadInput.files[0]).then(() => { loadInput.value = ""; }); });
+  document.getElementById("load").addEventListener("click", () => loadInput.click());

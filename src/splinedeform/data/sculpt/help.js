@@ -41,6 +41,8 @@
       "export-3dm": "download the shape now as a NURBS surface in a Rhino .3dm file (the model's knots, the current control net)",
       "export-obj": "download the shape now as a triangle mesh (Wavefront OBJ, vertex normals) on the page's sample grid",
       "export-json": "download the current control net as the project's net file (JSON; shape = \"file\" in a scenario reads it)",
+      "load": "load a surface from a file: a Rhino .3dm, the project's net file (.json) or a whole scenario (.toml); the modes are solved for it (Undo goes back)",
+      "load-file": "a .3dm, .json (net) or .toml (scenario) file",
       "help-button": "keys and what the page computes (?)",
     };
   }
