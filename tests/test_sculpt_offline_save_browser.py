@@ -96,3 +96,37 @@ def test_save_offline_page_writes_a_page_that_runs_alone(server, browser, tmp_pa
     page = _opened(browser, second)
     _runs_alone(page)
     page.close()
+
+
+def test_load_surface_from_the_page(server, browser, tmp_path):
+    """Load surface… with a net file: the page shows the new surface (its grid of samples
+    from the new net), a bad file is refused by name, and Undo goes back."""
+    import numpy as np
+
+    import splinedeform as sd
+    from splinedeform.export.nets import write_control_nets
+
+    surf = sd.shapes.plane(size=(2.0, 1.0), cells=(5, 3))
+    P = surf.control_points.copy()
+    P[..., 2] = 0.2 * P[..., 0] * (2.0 - P[..., 0])          # an arch
+    path, = write_control_nets(tmp_path, "arch", surf, [0.0], P[None], formats=("json",))
+    live = sculpt_page(browser, server[0])
+    start = live.evaluate("sculptState.version")
+    live.set_input_files("#load-file", str(path))
+    live.wait_for_function(f"sculptState.version > {start}", timeout=60000)
+    assert "loaded arch.json" in live.evaluate("sculptState.progress")
+    # the rest samples are the arch's surface at their parameters: float32 samples, 1e-6
+    rest = np.array(live.evaluate(f"Array.from({{length: {R * R}}}, (_, n) => sculptState.rest(n))"))
+    uv = np.array(live.evaluate(f"Array.from({{length: {R * R}}}, (_, n) => sculptState.uv(n))"))
+    arch = surf.with_control_points(P).evaluate(uv[:, 0], uv[:, 1])
+    assert np.max(np.abs(rest - arch)) <= 1e-6
+    assert rest[:, 0].max() > 1.99 and rest[:, 2].max() > 0.1  # 2 long and arched: the new surface
+    bad = tmp_path / "notes.txt"
+    bad.write_text("hello")
+    live.set_input_files("#load-file", str(bad))
+    live.wait_for_function("sculptState.errors.length > 0")
+    assert "notes.txt" in live.evaluate("sculptState.errors")[-1]
+    live.evaluate("sculptState.undo()")
+    live.wait_for_function(f"sculptState.version === {start}", timeout=30000)
+    assert not live.problems
+    live.close()
