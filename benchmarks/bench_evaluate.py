@@ -1,17 +1,23 @@
-"""Cost of evaluating a spline surface on a grid: ours against a scipy reference.
+"""Cost of evaluating a spline surface: ours against scipy, as a user calls it.
 
-A cubic net of 64 × 64 cells (open knots, 67 × 67 control points) is evaluated on a
-200 × 200 parameter grid three ways:
+A cubic net of 64 × 64 cells (open knots, 67 × 67 control points) is evaluated
 
-* ``Surface.evaluate_grid`` — two sparse 1-D collocation matrices ``B_u``, ``B_v`` and
-  the products ``B_u P B_vᵀ``;
-* ``Surface.evaluate`` pointwise on the 40 000 flattened parameter pairs (one sparse
-  row of ``n+1 × n+1`` products per point);
-* the reference: ``scipy.interpolate.BSpline.design_matrix`` in both directions, then the
-  same two products.
+* on a 200 × 200 parameter grid: ``Surface.evaluate_grid`` against the same products
+  ``B_u P B_vᵀ`` with the collocation matrices of ``scipy.interpolate.BSpline.design_matrix``;
+* at the 40 000 flattened grid points and at 1 000 random points: ``Surface.evaluate``
+  against ``scipy.interpolate.NdBSpline`` on the same points (and ``∂x/∂u`` by
+  ``Surface.derivative(u, v, 1, 0)`` against ``NdBSpline(..., nu=(1, 0))``);
+* at one point given as two Python floats, ``surface.evaluate(u, v)`` as the README calls
+  it, against ``NdBSpline`` called on that point;
+* the first call of ``evaluate`` on a new surface against constructing an ``NdBSpline`` and
+  calling it, for one point (the README's ``sol.surface(t).evaluate(u, v)``: no patches
+  are built) and for the 40 000 points (which build the surface's Bézier patches).
 
-All three must agree to 1e-12. Times are the best of several repeats measured in the same
-run, and ``ratio = reference / ours`` (above 1: ours is faster).
+All must agree with scipy to 1e-12 (relative to the largest coordinate). Times are the
+best of several repeats, ours and scipy's taken in turn in the same run (so that a load
+from other work hits both alike), and ``ratio = reference / ours`` (above 1: ours is
+faster). A pointwise evaluation is not compared with the grid products: on a grid the
+tensor structure saves a factor ``(n+1)`` per point that scattered points cannot have.
 
 Run ``python benchmarks/bench_evaluate.py [--quick]``; ``run(quick)`` returns the rows
 for the benchmark table.
@@ -25,7 +31,7 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from scipy.interpolate import BSpline
+from scipy.interpolate import BSpline, NdBSpline
 
 from splinedeform.basis import BSplineBasis
 from splinedeform.surface import Surface
@@ -36,14 +42,19 @@ SAMPLES = 200
 TOLERANCE = 1e-12
 
 
-def best_time(call: Callable[[], Any], repeats: int) -> tuple[float, Any]:
-    """Smallest wall time of ``repeats`` calls, and the last result."""
-    best, result = np.inf, None
+def best_times(ours: Callable[[], Any], reference: Callable[[], Any], repeats: int
+               ) -> tuple[float, Any, float, Any]:
+    """Smallest wall times of ``repeats`` calls of each, taken in turn, and the last results."""
+    best_ours = best_reference = np.inf
+    mine = theirs = None
     for _ in range(repeats):
         start = time.perf_counter()
-        result = call()
-        best = min(best, time.perf_counter() - start)
-    return best, result
+        theirs = reference()
+        best_reference = min(best_reference, time.perf_counter() - start)
+        start = time.perf_counter()
+        mine = ours()
+        best_ours = min(best_ours, time.perf_counter() - start)
+    return best_ours, mine, best_reference, theirs
 
 
 def reference_grid(surface: Surface, u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -65,39 +76,66 @@ def make_surface(cells: int = CELLS, degree: int = DEGREE, seed: int = 0) -> Sur
     return Surface(P, basis, basis, name="random")
 
 
-def run(quick: bool = False) -> list[dict]:
-    """Time the three evaluations; rows ``name, ours_s, reference_s, ratio``.
+def reference_spline(surface: Surface) -> NdBSpline:
+    """The surface as a scipy ``NdBSpline`` (the same knots, degrees and control net)."""
+    bu, bv = surface.basis_u, surface.basis_v
+    return NdBSpline((bu.knots, bv.knots), surface.control_points, (bu.degree, bv.degree))
 
-    Raises ``AssertionError`` if any evaluation differs from the reference by more than
-    1e-12 (relative to the largest coordinate).
+
+def run(quick: bool = False) -> list[dict]:
+    """Time the evaluations; rows ``name, ours_s, reference_s, ratio``.
+
+    Raises ``AssertionError`` if any evaluation differs from scipy's by more than 1e-12
+    (relative to the largest coordinate).
     """
-    repeats = 3 if quick else 7
+    repeats = 5 if quick else 15
     surface = make_surface()
+    spline = reference_spline(surface)
     u = v = np.linspace(0.0, 1.0, SAMPLES)
     U, V = np.meshgrid(u, v, indexing="ij")
-    reference_s, reference = best_time(lambda: reference_grid(surface, u, v), repeats)
-    grid_s, grid = best_time(lambda: surface.evaluate_grid(u, v), repeats)
-    point_s, points = best_time(lambda: surface.evaluate(U, V), max(1, repeats // 2))
-    scale = float(np.abs(reference).max())
-    for name, value in (("evaluate_grid", grid), ("evaluate", points)):
-        error = float(np.abs(value - reference).max()) / scale
-        assert error < TOLERANCE, f"{name} differs from the scipy reference by {error:.2e}"
-    label = f"{SAMPLES}x{SAMPLES} samples, {CELLS}x{CELLS}-cell cubic"
-    return [
-        {"name": f"evaluate_grid ({label})", "ours_s": grid_s, "reference_s": reference_s,
-         "ratio": reference_s / grid_s},
-        {"name": f"evaluate pointwise ({label})", "ours_s": point_s,
-         "reference_s": reference_s, "ratio": reference_s / point_s},
+    grid_points = np.stack([U.ravel(), V.ravel()], axis=-1)
+    scattered = np.random.default_rng(1).random((1000, 2))
+    su, sv = scattered[:, 0].copy(), scattered[:, 1].copy()
+    label = f"{CELLS}x{CELLS}-cell cubic"
+    cases: list[tuple[str, Callable[[], Any], Callable[[], Any], int]] = [
+        (f"evaluate_grid ({SAMPLES}x{SAMPLES} samples, {label}) vs design_matrix products",
+         lambda: surface.evaluate_grid(u, v), lambda: reference_grid(surface, u, v), repeats),
+        (f"evaluate pointwise ({SAMPLES * SAMPLES} grid points, {label}) vs NdBSpline",
+         lambda: surface.evaluate(U, V).reshape(-1, 3), lambda: spline(grid_points), repeats),
+        (f"evaluate pointwise (1000 random points, {label}) vs NdBSpline",
+         lambda: surface.evaluate(su, sv), lambda: spline(scattered), 5 * repeats),
+        (f"derivative du=1 pointwise ({SAMPLES * SAMPLES} grid points) vs NdBSpline nu=(1,0)",
+         lambda: surface.derivative(U, V, 1, 0).reshape(-1, 3),
+         lambda: spline(grid_points, nu=(1, 0)), repeats),
+        (f"evaluate one point (two floats, {label}) vs NdBSpline",
+         lambda: surface.evaluate(0.3, 0.7), lambda: spline([0.3, 0.7]), 200 * repeats),
+        ("one point on a new surface (sol.surface(t).evaluate(u, v)) vs NdBSpline built and "
+         "called",
+         lambda: surface.with_control_points(surface.control_points).evaluate(0.3, 0.7),
+         lambda: reference_spline(surface)([0.3, 0.7]), 20 * repeats),
+        (f"first evaluate on a new surface ({SAMPLES * SAMPLES} points) vs NdBSpline built "
+         "and called",
+         lambda: surface.with_control_points(surface.control_points).evaluate(U, V).reshape(-1, 3),
+         lambda: reference_spline(surface)(grid_points), repeats),
     ]
+    rows = []
+    for name, ours, reference, count in cases:
+        ours_s, mine, reference_s, theirs = best_times(ours, reference, count)
+        theirs = np.asarray(theirs)
+        error = float(np.abs(np.asarray(mine) - theirs).max()) / float(np.abs(theirs).max())
+        assert error < TOLERANCE, f"{name}: differs from scipy by {error:.2e}"
+        rows.append({"name": name, "ours_s": ours_s, "reference_s": reference_s,
+                     "ratio": reference_s / ours_s})
+    return rows
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer repeats")
     rows = run(parser.parse_args().quick)
-    print(f"{'benchmark':<58} {'ours [s]':>10} {'scipy [s]':>10} {'scipy/ours':>11}")
+    print(f"{'benchmark':<92} {'ours [s]':>10} {'scipy [s]':>10} {'scipy/ours':>11}")
     for row in rows:
-        print(f"{row['name']:<58} {row['ours_s']:>10.4f} {row['reference_s']:>10.4f} "
+        print(f"{row['name']:<92} {row['ours_s']:>10.3g} {row['reference_s']:>10.3g} "
               f"{row['ratio']:>11.2f}")
     print(f"all agree with the scipy reference to {TOLERANCE:g}")
 

@@ -9,11 +9,22 @@ complete analytic dynamic solution (every mode by dense ``eigh``) read at 200 fr
 Times are single calls in one run (BLAS on one thread when threadpoolctl is present).
 
 Run ``python benchmarks/bench_shell.py [--cells 8 16 24]``; it prints a markdown table.
+``--goals`` measures the shell at the sizes engineers use instead, each case in a fresh
+process (its own peak memory, ``ru_maxrss``): the full pinched cylinder (radius 300,
+length 600, thickness 3, E = 3e6, ν = 0.3, rigid diaphragms, two opposite unit loads;
+``w = 1.8248e-5`` under each) on 128 × 64 cubic cells, the assembly of the roof on 64²
+cubic cells and its lowest 20 modes, against the goals 10 s and 1.5 GB, 1 s and 10 s.
+The machine's load average is printed beside the figures.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import os
+import resource
+import subprocess
+import sys
 import time
 from contextlib import nullcontext
 from math import pi
@@ -79,10 +90,72 @@ def table(rows: list[dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
+#: goal name → (seconds, peak GiB or None)
+GOALS = {"pinched cylinder 128×64 static": (10.0, 1.5), "roof 64² assembly": (1.0, None),
+         "roof 64² lowest 20 modes": (10.0, None)}
+
+
+def goal_case(name: str) -> dict[str, Any]:
+    """Run one goal case in this process; seconds, peak memory and a check figure."""
+    if name.startswith("pinched"):
+        R, L = 300.0, 600.0
+        surface = sd.shapes.cylinder(radius=R, height=L, cells=(128, 64))
+        start = time.perf_counter()
+        model = ShellModel(surface, ShellMaterial(3e6, 0.3, 3.0),
+                           {"v0": "diaphragm", "v1": "diaphragm"})
+        assembled = time.perf_counter()
+        load = (sd.loads.Point(0.0, L / 2, (-1.0, 0.0, 0.0))
+                + sd.loads.Point(pi * R, L / 2, (1.0, 0.0, 0.0)))
+        w = -model.static(load).displacement(0.0, L / 2)[0]
+        seconds = time.perf_counter() - start
+        detail = (f"assembly {assembled - start:.2f} s, static {seconds - assembled + start:.2f}"
+                  f" s; {model.n_free} unknowns; w / 1.8248e-5 = {w / 1.8248e-5:.4f}")
+    else:
+        surface = roof(64)
+        start = time.perf_counter()
+        model = ShellModel(surface, ShellMaterial(E=4.32e8, nu=0.0, thickness=0.25),
+                           {"v0": "diaphragm", "v1": "diaphragm"})
+        seconds = time.perf_counter() - start
+        detail = f"{model.n_free} unknowns"
+        if name.endswith("modes"):
+            start = time.perf_counter()
+            omega = model.frequencies(20)
+            seconds = time.perf_counter() - start
+            detail += f"; ω_1 = {omega[0]:.5g}, ω_20 = {omega[-1]:.5g}"
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2 ** 20     # KiB → GiB
+    return {"seconds": seconds, "peak GiB": peak, "detail": detail}
+
+
+def goals() -> str:
+    """Each goal case in its own process; a markdown table with measured / goal."""
+    lines = [f"load average before: {os.getloadavg()[0]:.2f}", "",
+             "| case | seconds | goal | ratio | peak memory | goal | detail |",
+             "|---|---:|---:|---:|---:|---:|---|"]
+    for name, (seconds, memory) in GOALS.items():
+        out = subprocess.run([sys.executable, __file__, "--goal", name], capture_output=True,
+                             text=True, check=True).stdout.strip().splitlines()[-1]
+        r = json.loads(out)
+        limit = f"{memory:g} GiB" if memory else "-"
+        lines.append(f"| {name} | {r['seconds']:.2f} | {seconds:g} | "
+                     f"{r['seconds'] / seconds:.2f} | {r['peak GiB']:.2f} GiB | {limit} | "
+                     f"{r['detail']} |")
+    lines += ["", f"load average after: {os.getloadavg()[0]:.2f}"]
+    return "\n".join(lines)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cells", type=int, nargs="+", default=[8, 16, 24])
+    parser.add_argument("--goals", action="store_true",
+                        help="the sizes engineers use, against the goals")
+    parser.add_argument("--goal", choices=list(GOALS), help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.goal:
+        print(json.dumps(goal_case(args.goal)))
+        return
+    if args.goals:
+        print(goals())
+        return
     try:
         from threadpoolctl import threadpool_limits
         limit: Any = threadpool_limits(1, "blas")

@@ -5,7 +5,7 @@
     python benchmarks/run.py --sizes 8,16,32 --no-regimes
     python benchmarks/run.py --render-only   # rewrite the reports from the last bench.json
 
-Runs :func:`splinedeform.bench.main` (BLAS on one thread; its own files go to
+Runs :func:`splinedeform.bench.main` (BLAS threads not pinned: the library as it ships; its own files go to
 ``benchmarks/out/…``), then ``benchmarks/bench_evaluate.py``'s ``run(quick)`` when that file
 exists, prints each line's fastest method and the goals, and writes the results with a note
 on the machine.

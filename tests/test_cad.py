@@ -66,3 +66,37 @@ def test_bad_files_are_refused(tmp_path):
     with pytest.raises(InputError, match="degree"):
         NurbsPatch((0, 1), np.array([0, 1.0]), np.array([0, 0, 1, 1.0]),
                    np.zeros((1, 2, 3)), np.ones((1, 2)))
+
+
+def test_only_really_trimmed_brep_faces_are_warned_about(tmp_path):
+    import warnings
+
+    from splinedeform.errors import InputWarning
+
+    model = r3.File3dm()            # a capped cylinder: a whole side, two disc-trimmed caps
+    model.Objects.AddBrep(r3.Brep.CreateFromCylinder(r3.Cylinder(r3.Circle(2.0), 3.0),
+                                                     True, True))
+    model.Write(str(tmp_path / "can.3dm"), 7)
+    messages = []
+    for face in range(3):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            patch = read_3dm(tmp_path / "can.3dm", face)
+        assert all(issubclass(w.category, InputWarning) for w in caught)
+        messages.append([str(w.message) for w in caught])
+        assert patch.points.shape[-1] == 3
+    assert messages == [[], *([f"{tmp_path / 'can.3dm'} face {k} is a trimmed Brep face; its "
+                               "whole underlying surface is used"] for k in (1, 2))]
+
+
+def test_non_positive_3dm_weight_is_refused(tmp_path):
+    srf = r3.NurbsSurface.Create(3, True, 2, 2, 2, 2)       # bilinear, 2 x 2 poles
+    for i, j in np.ndindex(2, 2):
+        w = -1.0 if (i, j) == (1, 1) else 1.0
+        srf.Points[i, j] = r3.Point4d(w * i, w * j, 0.0, w)   # homogeneous (w x, w y, w z, w)
+    model = r3.File3dm()
+    model.Objects.AddSurface(srf)
+    model.Write(str(tmp_path / "odd.3dm"), 7)
+    with pytest.raises(InputError, match=r"odd.3dm face 0: weight w\[1, 1\] = -1; NURBS "
+                                         "weights must be > 0"):
+        read_3dm(tmp_path / "odd.3dm")

@@ -41,9 +41,9 @@ def _occt_surface(path, face):
     from OCP.BRep import BRep_Tool
     from OCP.GeomConvert import GeomConvert
 
-    from splinedeform.cad_step import _faces
+    from splinedeform.cad_step_read import read_faces
 
-    return GeomConvert.SurfaceToBSplineSurface_s(BRep_Tool.Surface_s(_faces(path)[face]))
+    return GeomConvert.SurfaceToBSplineSurface_s(BRep_Tool.Surface_s(read_faces(path)[1][face]))
 
 
 @pytest.mark.parametrize("suffix", [".step", ".igs"])

@@ -171,7 +171,8 @@ def test_info_names_version_extras_and_examples():
     result = runner.invoke(cli.app, ["info"])
     assert result.exit_code == 0
     assert __version__ in result.stdout
-    for dist in ("meshio", "matplotlib", "imageio-ffmpeg", "pyvista"):
+    for dist in ("meshio", "matplotlib", "imageio-ffmpeg", "pyvista", "rhino3dm",
+                 "cadquery-ocp-novtk"):
         assert dist in result.stdout
     examples = cli.examples_directory()
     assert examples is not None and _unwrapped(str(examples)) in _unwrapped(result.stdout)
@@ -228,6 +229,12 @@ def test_bench_is_forwarded_when_the_module_exists(monkeypatch, tmp_path):
                                            str(tmp_path), "--quiet"])
         assert result.exit_code == 0, result.output
         assert calls == [([4, 8], True, tmp_path, True)]
+        plain = runner.invoke(fresh.app, ["bench", "--quick"])
+        assert plain.exit_code == 0, plain.output
+        assert "BLAS threads" not in plain.output              # bench.main says it, once
+        assert calls[-1][2] == fresh.BENCH_OUTDIR == Path("out", "bench")
+        ignored = (Path(__file__).resolve().parents[1] / ".gitignore").read_text().split()
+        assert "out/" in ignored                     # the default folder is git-ignored
         bad = runner.invoke(fresh.app, ["bench", "--sizes", "4,x"])
         assert bad.exit_code == 2 and "--sizes must be comma-separated integers" in bad.stderr
     finally:
@@ -256,7 +263,7 @@ def test_info_reports_a_missing_extra(monkeypatch):
     result = runner.invoke(cli.app, ["info"])
     assert result.exit_code == 0
     row = next(line for line in result.stdout.splitlines() if "pyvista" in line)
-    assert "missing" in row
+    assert "not installed" in row
 
 
 def test_physics_option_selects_the_energy_and_names_a_bad_value(scenario, tmp_path):

@@ -316,3 +316,36 @@ def test_example_shows_its_physical_fact(name, results):
     result = results(name)
     assert "report.json" in {Path(path).name for _, path in result.outputs}
     FACTS[name](result)
+
+
+def test_the_nurbs_tile_script_rewrites_its_file_only_when_the_tile_changed(tmp_path):
+    """openNURBS stamps a write time and random object ids into every file: the script
+    leaves a file holding the same tile alone, so the tracked file stays as committed."""
+    import importlib.util
+
+    pytest.importorskip("rhino3dm", reason="the 'cad' extra (rhino3dm) is not installed")
+    from splinedeform.cad import write_3dm
+
+    spec = importlib.util.spec_from_file_location("make_nurbs_tile",
+                                                  EXAMPLES / "make_nurbs_tile.py")
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    assert script.is_current(EXAMPLES / "nurbs_tile.3dm", script.nurbs_tile())
+    target = tmp_path / "tile.3dm"
+    assert script.main(target) == (target, True)
+    written = target.read_bytes(), target.stat().st_mtime_ns
+    assert script.main(target) == (target, False)
+    assert (target.read_bytes(), target.stat().st_mtime_ns) == written      # not rewritten
+    write_3dm(target, [script.nurbs_tile(spans=4)], names=[script.NAME])     # another net
+    assert script.main(target) == (target, True)
+    assert script.is_current(target, script.nurbs_tile())
+
+
+def test_the_free_region_of_the_tile_is_symmetric_about_its_crest():
+    """The header says u in [0.4, π/2 − 0.4]: the region is mirrored about the crest π/4."""
+    import tomllib
+
+    region = tomllib.loads((EXAMPLES / "tile_gravity_free_region.toml").read_text())[
+        "boundary"]["free_region"]
+    # the file writes π/2 − 0.4 to 17 digits
+    assert region["u"][0] + region["u"][1] == pytest.approx(math.pi / 2, rel=1e-15)

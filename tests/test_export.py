@@ -140,6 +140,20 @@ def test_time_series_lists_every_frame_with_its_time_and_displacement(tmp_path):
     assert hidden_files(tmp_path) == []
 
 
+def test_time_series_creates_its_folder_and_names_one_it_cannot_create(tmp_path):
+    s = make_surface()
+    times, nets = make_motion(s, 3)
+    pvd = export.write_time_series(tmp_path / "new" / "series", "m", s, s.control_points,
+                                   times, nets, resolution=4)
+    assert pvd == tmp_path / "new" / "series" / "m.pvd" and pvd.is_file()
+    assert sorted(p.name for p in pvd.parent.iterdir()) == [
+        "m.pvd", "m_0000.vtu", "m_0001.vtu", "m_0002.vtu"]
+    (tmp_path / "file").write_text("not a folder")
+    with pytest.raises(InputError, match=r"cannot create the output folder .*file"):
+        export.write_time_series(tmp_path / "file" / "series", "m", s, s.control_points,
+                                 times, nets, resolution=4)
+
+
 def test_time_series_rejects_mismatched_frames(tmp_path):
     s = make_surface()
     times, nets = make_motion(s, 3)
@@ -151,6 +165,8 @@ def test_time_series_rejects_mismatched_frames(tmp_path):
         export.write_time_series(tmp_path, "m", s, s.control_points[:-1], times, nets)
     with pytest.raises(InputError, match="stem"):
         export.write_time_series(tmp_path, "a/b", s, s.control_points, times, nets)
+    with pytest.raises(InputError, match="non-decreasing"):         # checked before creating
+        export.write_time_series(tmp_path / "new", "m", s, s.control_points, times[::-1], nets)
     assert list(tmp_path.iterdir()) == []
 
 

@@ -91,6 +91,8 @@ VALUES = {
                                max_size=4, unique=True),
     "output.resolution": SMALL_INT, "output.probes": st.lists(PAIR, max_size=2),
     "output.time": NUMBER,
+    "output.warp": NUMBER | st.sampled_from(["auto", "big", ""]), "output.camera": PAIR,
+    "output.fps": NUMBER, "output.animate_modes": st.lists(SMALL_INT, max_size=3),
 }
 PATHS = sorted(VALUES)
 #: values each key takes in real scenarios, so that many mutants get past reading and run

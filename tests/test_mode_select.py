@@ -1,7 +1,7 @@
 """The fewest modes for a requested accuracy (solvers/mode_select.py).
 
-The error is measured as the bound states it: the M-norm of the displacement difference
-over all coordinates, relative to the largest static displacement ``max_t ‖K⁻¹F(t)‖_M``.
+The error is measured as the bound states it: the largest control-point coordinate
+difference, relative to the largest static displacement ``max_t ‖K⁻¹F(t)‖_∞``.
 References: the same model with all modes (dense, exact to round-off) on a small net; a
 Radau IIA-7 run with many steps per frame on a medium net, an independent computation
 whose own error (order 13) is far below the tolerances compared.
@@ -13,22 +13,25 @@ import pytest
 import splinedeform as sd
 from splinedeform.solvers import mode_count, mode_select
 
+@pytest.fixture(autouse=True)
+def sparse_path_on_small_nets(monkeypatch):
+    """These nets (361 to 841 free coordinates) are below the size where the automatic
+    mode count starts its sparse path; lowered, they exercise it in a fraction of the time."""
+    from splinedeform import modal_solve
+    monkeypatch.setattr(modal_solve, "DENSE_BELOW", 256)
+
+
 PLATE = sd.Material(mass=1.0, damping=0.8, rayleigh=5e-4, w10=10.0, w01=10.0, w20=1.0,
                     w11=1.0, w02=1.0)
 LOAD = sd.Point(0.4, 0.3, (0, 0, -1), profile=sd.Step(0.0, 2.0))
 
 
-def m_norm(M, d):
-    return float(np.sqrt(sum(d[:, c] @ (M @ d[:, c]) for c in range(d.shape[1]))))
-
-
 def relative_errors(model, a, b, times, load):
-    M = model.matrices()[0]
-    idx = model.constraints.free_index
-    a = a.reshape(times.size, -1, 3)[:, idx]
-    b = b.reshape(times.size, -1, 3)[:, idx]
-    scale = max(m_norm(M, model.static(load, t=t).d_free) for t in (1.0, 3.0))
-    return np.array([m_norm(M, a[f] - b[f]) / scale for f in range(times.size)])
+    """Per frame: the largest control-point coordinate difference over the largest static
+    displacement (the bound's measure; the load is on over [0, 2))."""
+    rest = model.surface.control_points
+    scale = np.abs(model.static(load, t=1.0).control_points() - rest).max()
+    return np.abs(np.asarray(a) - np.asarray(b)).reshape(times.size, -1).max(axis=1) / scale
 
 
 @pytest.mark.parametrize("t", [0.05, 1.3, 2.02, 3.7])
@@ -39,7 +42,7 @@ def test_one_state_meets_the_tolerance_with_the_fewest_modes_for_its_time(t):
     tol = 1e-6
     model = sd.Model(surf, PLATE, boundary="clamped")
     one = model.dynamic(LOAD, 4.0, tolerance=tol, times=[t])
-    full = sd.Model(surf, PLATE, boundary="clamped").dynamic(LOAD, 4.0)
+    full = sd.Model(surf, PLATE, boundary="clamped").dynamic(LOAD, 4.0, modes="all")
     times = np.array([t])
     err = relative_errors(model, one.control_points(times), full.control_points(times),
                           times, LOAD)
@@ -111,7 +114,7 @@ def test_a_small_net_takes_all_modes_without_starting_the_sparse_path():
     sol = model.dynamic(LOAD, 4.0, tolerance=1e-6, times=times)
     assert sol.basis.complete and sol.basis.lam.size == 49
     assert sol.truncation["bound"] == 0.0 and model not in modal_solve._KRYLOV
-    full = sd.Model(surf, PLATE, boundary="clamped").dynamic(LOAD, 4.0)
+    full = sd.Model(surf, PLATE, boundary="clamped").dynamic(LOAD, 4.0, modes="all")
     err = relative_errors(model, sol.control_points(times), full.control_points(times),
                           times, LOAD)
     assert err.max() <= 1e-12        # the same complete solution: round-off only

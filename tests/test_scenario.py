@@ -181,7 +181,7 @@ SHAPE_TEXTS = {shape: shape_scenario(shape, {k: key.default for k, key in params
 FILE_TEXTS = [file_scenario("net.json", "frame = 0"),
               file_scenario("grid.npy", 'cells = 3\ndegree = 2\nknots = ["open", "open"]\n'
                                         'method = "l2"'),
-              file_scenario("patch.3dm", "face = 1").replace('"file"', '"cad"')]
+              file_scenario("patch.3dm", 'face = 1\nunits = "in"').replace('"file"', '"cad"')]
 
 
 def all_test_texts() -> list[str]:
@@ -540,8 +540,11 @@ def test_surface_from_control_net_and_point_grid_files(tmp_path, shapes):
     np.save(tmp_path / "grid.npy", grid)
     fitted = build(parse_scenario(FILE_TEXTS[1], directory=tmp_path)).surface
     assert fitted.shape == (5, 5)                                       # 3 cells, degree 2
-    # x = u, y = v, z = u v lies in the space: the fit reproduces it at the grid points
-    np.testing.assert_allclose(fitted.evaluate_grid(u, u), grid, atol=1e-10)
+    # x = u, y = v, z = u v lies in the space: the fit reproduces it at the grid points,
+    # spread evenly over the default domain (the grid's mean chord lengths)
+    (_, lu), (_, lv) = fitted.domain
+    np.testing.assert_allclose(fitted.evaluate_grid(np.linspace(0, lu, 7),
+                                                    np.linspace(0, lv, 7)), grid, atol=1e-10)
 
 
 def test_control_net_files_refuse_fitting_keys(tmp_path, shapes):

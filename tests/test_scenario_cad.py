@@ -1,11 +1,13 @@
 """Scenarios whose [surface] is a NURBS surface of a CAD file (shape = "cad")."""
 
+import warnings
+
 import numpy as np
 import pytest
 
 import splinedeform as sd
 from splinedeform.cad import NurbsPatch, refine, surface_from_patch, write_3dm
-from splinedeform.errors import ScenarioError
+from splinedeform.errors import InputWarning, ScenarioError
 from splinedeform.scenario import build, load_scenario
 
 r3 = pytest.importorskip("rhino3dm", reason="the 'cad' extra (rhino3dm) is not installed")
@@ -90,20 +92,28 @@ def test_degree_zero_surface_is_refused():
     # so the reader's check is fed a stand-in with rhino3dm's attribute names
     from types import SimpleNamespace
 
-    from splinedeform.cad import _patch_from_rhino
+    from splinedeform.cad_3dm_read import _patch_from_rhino
     from splinedeform.errors import InputError
 
     with pytest.raises(InputError, match=r"flat.3dm face 0: surface of degree \(0, 2\)"):
         _patch_from_rhino(SimpleNamespace(OrderU=1, OrderV=3), "flat.3dm face 0")
 
 
-def test_brep_face_is_read_untrimmed_with_a_warning(tmp_path):
+def test_brep_face_is_read_whole_and_only_its_open_seam_is_warned_about(tmp_path):
     model = r3.File3dm()
     sphere = r3.Brep.CreateFromSphere(r3.Sphere(r3.Point3d(0, 0, 0), 2.0))
     model.Objects.AddBrep(sphere)
     model.Write(str(tmp_path / "ball.3dm"), 7)
-    with pytest.warns(UserWarning, match="ball.3dm: face 0 is a Brep face"):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         surf = build(load_scenario(scenario(tmp_path, 'path = "ball.3dm"'))).surface
+    # the sphere's face is not trimmed; its u seam (first = last column) is not joined, its
+    # v ends are poles (one point each), not a seam
+    assert [str(w.message) for w in caught] == [
+        f"{tmp_path / 'ball.3dm'} face 0 is closed in u (its first and last control points "
+        "in u coincide) but the seam is not joined: its two sides are separate unknowns and "
+        "move apart under load"]
+    assert all(issubclass(w.category, InputWarning) for w in caught)
     # a revolved surface: weights a_i b_j, one rational basis per direction
     assert isinstance(surf.basis_u, sd.RationalBasis) and isinstance(surf.basis_v, sd.RationalBasis)
     u, v = np.meshgrid(*surf.sample_parameters(20), indexing="ij")
@@ -164,7 +174,7 @@ def test_poles_of_a_cad_sphere_move_as_one_point(tmp_path):
     model = r3.File3dm()
     model.Objects.AddBrep(r3.Brep.CreateFromSphere(r3.Sphere(r3.Point3d(0, 0, 0), 1.0)))
     model.Write(str(tmp_path / "ball.3dm"), 7)
-    with pytest.warns(UserWarning, match="Brep face"):
+    with pytest.warns(InputWarning, match="NURBS patch is closed in u"):
         from splinedeform.cad import read_3dm
         surf = surface_from_patch(read_3dm(tmp_path / "ball.3dm"))
     m = sd.Model(surf, sd.Material(w10=1.0, w01=1.0), boundary={"v0": "pole", "v1": "pole"})
@@ -175,3 +185,53 @@ def test_poles_of_a_cad_sphere_move_as_one_point(tmp_path):
     d = m.dynamic(sd.Point(1.0, 0.0, (0, 0, 1.0)), t_end=0.5).control_points(0.5)
     for row in (d[:, 0], d[:, -1]):          # every pole's control points stay together
         assert np.abs(row - row[0]).max() <= 1e-12 * np.abs(d).max()
+
+
+@pytest.mark.parametrize("written, problem", [
+    ("roof\\u0000.3dm", "surface.path: contains a NUL character (at position 4)"),
+    ("r" * 6000 + ".3dm", "surface.path: is too long (6004 characters"),
+    ("a/" * 3000 + "roof.3dm", "surface.path: is too long (6008 characters"),
+])
+def test_unusable_path_is_a_located_error(tmp_path, written, problem):
+    with pytest.raises(ScenarioError) as info:
+        load_scenario(scenario(tmp_path, f'path = "{written}"'))
+    assert f"case.toml:3: {problem}" in str(info.value)
+
+
+def test_closed_nurbs_cylinder_with_an_unjoined_seam_is_warned_about_once():
+    import warnings
+
+    # the full circle of 4 quarter arcs: 9 poles, the first and the last at (1, 0)
+    square = np.array([[1.0, 0], [1, 1], [0, 1], [-1, 1], [-1, 0], [-1, -1], [0, -1], [1, -1],
+                       [1, 0]])
+    ring = np.c_[square, np.zeros(9)]
+    points = np.stack([ring, ring + [0, 0, 2.0]], axis=1)
+    knots_u = np.array([0, 0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 4.0])
+    full = NurbsPatch((2, 1), knots_u, np.array([0, 0, 1, 1.0]), points,
+                      np.outer([1, S, 1, S, 1, S, 1, S, 1], [1, 1]))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        surface_from_patch(full, source="pipe.3dm face 0")
+        surface_from_patch(quarter_cylinder(), source="roof.3dm face 0")   # open: no warning
+    assert [str(w.message) for w in caught] == [
+        "pipe.3dm face 0 is closed in u (its first and last control points in u coincide) "
+        "but the seam is not joined: its two sides are separate unknowns and move apart "
+        "under load"]
+
+
+def test_command_line_prints_a_cad_warning_as_one_line(tmp_path):
+    pytest.importorskip("typer", reason="the 'tool' extra (command line) is not installed")
+    from typer.testing import CliRunner
+
+    from splinedeform import cli
+
+    model = r3.File3dm()
+    model.Objects.AddBrep(r3.Brep.CreateFromSphere(r3.Sphere(r3.Point3d(0, 0, 0), 2.0)))
+    model.Write(str(tmp_path / "ball.3dm"), 7)
+    result = CliRunner().invoke(cli.app, ["validate", str(scenario(tmp_path,
+                                                                   'path = "ball.3dm"'))])
+    assert result.exit_code == 0, result.output
+    lines = [line for line in result.stderr.splitlines() if line.strip()]
+    # one line: no category, no source file and line of the code that warned
+    assert len(lines) == 1 and lines[0].startswith("warning: ") and "closed in u" in lines[0]
+    assert "InputWarning" not in result.stderr and ".py:" not in result.stderr

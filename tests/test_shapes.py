@@ -5,6 +5,7 @@ from math import pi
 import numpy as np
 import pytest
 
+import splinedeform as sd
 from splinedeform import shapes
 from splinedeform.basis import BSplineBasis
 from splinedeform.errors import InputError
@@ -293,12 +294,54 @@ def test_point_grid_with_as_many_points_as_control_points_is_interpolated():
     grid = smooth_map(*np.meshgrid(u, u, indexing="ij"))
     fitted = shapes.from_points(grid, cells=4, degree=3)
     assert fitted.shape == (7, 7)
-    np.testing.assert_allclose(fitted.evaluate_grid(u, u), grid, atol=1e-13)
+    # the samples sit evenly on the default domain, the grid's mean chord lengths
+    (_, lu), (_, lv) = fitted.domain
+    assert (lu, lv) == pytest.approx(shapes.chord_lengths(grid), rel=1e-15)
+    su, sv = np.linspace(0, lu, 7), np.linspace(0, lv, 7)
+    np.testing.assert_allclose(fitted.evaluate_grid(su, sv), grid, atol=1e-13)
     assert fitted.fit_error < 1e-13
     # more points than control points: least squares, close to the map but not through it
     v = np.linspace(0, 1, 41)
     dense = shapes.from_points(smooth_map(*np.meshgrid(v, v, indexing="ij")), cells=4)
     assert 1e-6 < dense.fit_error < 1e-2
+
+
+def test_point_grid_of_a_panel_gets_its_lengths_so_the_parametric_energy_is_the_physical():
+    """A 2 × 3 panel sampled evenly: the default domain is [0, 2] × [0, 3], where the
+    parametric membrane (T = μ = 1, pinned edges) has the panel's lowest frequency
+    ω₁₁ = π √(1/2² + 1/3²) and agrees with the energy measured on the surface."""
+    u, v = np.linspace(0, 2, 7), np.linspace(0, 3, 9)
+    grid = np.stack(np.broadcast_arrays(u[:, None], v[None, :], 0.0), -1)
+    membrane = sd.Material(mass=1.0, damping=0.0, w10=1.0, w01=1.0, w20=0.0, w11=0.0, w02=0.0)
+    exact = pi * np.sqrt(1 / 4 + 1 / 9)
+
+    def lowest(surface, physics):
+        return sd.Model(surface, membrane, boundary="pinned", physics=physics).frequencies(1)[0]
+
+    panel = shapes.from_points(grid, cells=(4, 6))
+    # the sum of 6 (8) equal chords of 1/3 (3/8), exact up to rounding
+    assert np.ravel(panel.domain) == pytest.approx([0, 2, 0, 3], rel=1e-14)
+    parametric, intrinsic = lowest(panel, "parametric"), lowest(panel, "intrinsic")
+    # cubic elements on 4 × 6 cells: discretisation error 3.5e-6 of ω₁₁
+    assert parametric == pytest.approx(exact, rel=1e-5)
+    # isometric parametrisation: the two energies give the same matrices up to rounding
+    assert parametric == pytest.approx(intrinsic, rel=1e-10)
+    # the unit square squeezes the panel: its parametric energy is far from the physical one
+    squeezed = shapes.from_points(grid, cells=(4, 6), domain=((0, 1), (0, 1)))
+    assert abs(lowest(squeezed, "parametric") / exact - 1) > 1.0
+    assert lowest(squeezed, "intrinsic") == pytest.approx(exact, rel=1e-5)
+
+
+def test_chord_lengths_of_a_closed_grid_count_the_seam_once():
+    t = np.linspace(0, 2 * pi, 25)
+    z = np.linspace(0, 1, 6)
+    closed = np.stack(np.broadcast_arrays(np.cos(t)[:, None], np.sin(t)[:, None], z), -1)
+    # 24 chords of the unit circle, each 2 sin(π/24); the seam chord is the repeated row's
+    polygon = 24 * 2 * np.sin(pi / 24)
+    assert shapes.chord_lengths(closed, (True, False)) == pytest.approx((polygon, 1.0),
+                                                                          rel=1e-14)
+    assert shapes.chord_lengths(closed[:-1], (True, False)) == pytest.approx((polygon, 1.0),
+                                                                               rel=1e-14)
 
 
 def test_closed_point_grid_drops_the_repeated_seam():

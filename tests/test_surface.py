@@ -204,3 +204,28 @@ def test_bad_input_says_what_is_wrong():
         s.evaluate_grid([np.inf], [0.5])
     with pytest.raises(InputError, match="resolution must be >= 2"):
         s.tessellate(1)
+
+
+def test_reprs_of_surfaces_are_one_short_line_naming_size_degree_knots_domain():
+    from splinedeform import shapes
+    from splinedeform.cad import NurbsPatch
+    from splinedeform.knots import KnotVectorBasis, RationalBasis
+
+    big = shapes.plane(size=(2.0, 3.0), cells=(61, 61))
+    text = repr(big)
+    assert "\n" not in text and len(text) < 200                  # not the 64 × 64 net
+    for part in ("'plane'", "64×64 control points", "degree=(3, 3)", "'open' 61 cells",
+                 "domain=[0, 2] × [0, 3]", "fit_error="):
+        assert part in text, (part, text)
+    arc = RationalBasis(KnotVectorBasis(2, [0, 0, 0, 1, 1, 1]), [1, 0.5 ** 0.5, 1])
+    line = KnotVectorBasis(1, [0, 0, 0.5, 1, 1])
+    rational = Surface(np.zeros((3, 3, 3)), arc, line)
+    assert repr(rational) == ("Surface('surface', 3×3 control points, degree=(2, 1), "
+                              "knots=(rational knot vector of 6, knot vector of 5), "
+                              "domain=[0, 1] × [0, 1])")
+    patch = NurbsPatch((2, 2), np.array([0, 0, 0, 2, 2, 2.0]), np.linspace(-1, 1, 40),
+                       np.zeros((3, 37, 3)), np.ones((3, 37)))
+    text = repr(patch)
+    assert "\n" not in text and len(text) < 200
+    assert text == ("NurbsPatch(3×37 control points, degree=(2, 2), knots=(knot vector of 6, "
+                    "knot vector of 40), domain=[0, 2] × [-0.897436, 0.897436], equal weights)")

@@ -94,7 +94,8 @@ def test_canvas_shows_the_surface_without_errors(page, viewer_file):
     assert page.evaluate("!!document.querySelector('#view canvas').getContext('webgl2') || "
                          "!!document.querySelector('#view canvas').getContext('webgl')")
     hook = page.evaluate("[splinedeformViewer.frameCount, splinedeformViewer.currentFrame]")
-    assert hook == [9, 0]
+    assert hook == [9, 4]                # opens at the peak: sin(πt) is largest at t = 0.5
+    move_slider(page, 0)
     pixels = canvas_pixels(page)
     assert pixels.shape[0] > 300 and pixels.shape[1] > 600
     background = np.array([0xF4, 0xF5, 0xF7])
@@ -110,8 +111,18 @@ def test_canvas_shows_the_surface_without_errors(page, viewer_file):
     assert all(url.startswith("file:") or url.startswith("data:") for url in page.requests)
 
 
+def test_the_page_opens_at_the_frame_of_largest_displacement(page, viewer_file):
+    _, surface, nets = viewer_file
+    assert page.evaluate("splinedeformViewer.currentFrame") == 4
+    assert page.evaluate("splinedeformViewer.vertexChecksum()") == \
+        pytest.approx(expected_checksum(surface, nets[4]), rel=1e-12, abs=1e-9)
+    assert page.inner_text("#time").startswith("t = 0.5")
+    assert page.problems == []
+
+
 def test_time_slider_changes_the_drawn_surface(page, viewer_file):
     _, surface, nets = viewer_file
+    move_slider(page, 0)
     before_pixels = canvas_pixels(page)
     before = page.evaluate("splinedeformViewer.vertexChecksum()")
     move_slider(page, 4)                                  # the top of the motion, t = 0.5
@@ -163,6 +174,8 @@ def test_title_is_the_given_title_and_time_zero_reads_0(browser, tmp_path):
         pg.wait_for_function("window.splinedeformViewer !== undefined", timeout=30_000)
         assert pg.title() == f"splinedeform — {title}"
         assert pg.inner_text("#title") == title
+        pg.eval_on_selector("#slider", """s => { s.value = "0";
+            s.dispatchEvent(new Event('input', { bubbles: true })); }""")
         assert pg.inner_text("#time").split() == ["t", "=", "0", "(1/9)"]
     finally:
         context.close()

@@ -220,8 +220,20 @@ def test_plot_modes_size_and_checks(tmp_path):
     shapes = np.stack([bump(s), bump(s) * (s.control_points[..., 0] - 0.5)])
     path = viz.plot_modes(tmp_path / "modes.png", s, [3.2, 7.9], shapes, resolution=16)
     image = read_png(path)
-    assert image.shape == (400, 800, 3)
+    # two 320 px panels and a 110 px bar column, white margins trimmed
+    assert image.shape[0] <= 320 and image.shape[1] <= 750
     assert distinct_colours(image) > 100
+    ink = np.any(image < 250, axis=-1)
+    rows, cols = np.flatnonzero(ink.any(axis=1)), np.flatnonzero(ink.any(axis=0))
+    margin = viz.figures.MARGIN_PIXELS
+    assert rows[0] <= margin and cols[0] <= margin                   # no wide white border
+    assert rows[-1] >= image.shape[0] - 1 - margin and cols[-1] >= image.shape[1] - 1 - margin
+    # the colour bar, right of the panels, spans the diverging map: deep red (coolwarm(1)
+    # is (180, 4, 38)) at the top, deep blue ((59, 76, 192) at 0) at the bottom
+    bar = image[:, -image.shape[1] // 6:]
+    red = np.nonzero(bar[..., 0] - bar[..., 2] > 120)[0]
+    blue = np.nonzero(bar[..., 2] - bar[..., 0] > 120)[0]
+    assert red.size > 100 and blue.size > 100 and red.mean() < blue.mean()
     with pytest.raises(InputError, match="shapes"):
         viz.plot_modes(tmp_path / "m.png", s, [1.0], shapes)
 
@@ -239,6 +251,91 @@ def test_gif_has_one_distinct_frame_per_time(tmp_path):
         assert np.mean(np.any(a != b, axis=-1)) > 0.005
     assert calls == [(1, 4), (2, 4), (3, 4), (4, 4)]
     assert [p.name for p in tmp_path.iterdir()] == ["motion.gif"]
+
+
+def test_gif_progress_counts_frames_already_encoded(tmp_path):
+    """Each progress call finds the (temporary) GIF longer: frames are encoded as they are
+    drawn, not all at the end after the last count."""
+    s = plane(3)
+    times, nets = motion(s, 4)
+    sizes = []
+
+    def progress(done, total):
+        sizes.append(sum(p.stat().st_size for p in tmp_path.iterdir()))
+
+    viz.write_animation(tmp_path / "motion.gif", s, s.control_points, times, nets,
+                        resolution=8, progress=progress)
+    assert len(sizes) == 4 and sizes[0] > 768            # header and 256-colour table
+    assert all(b > a for a, b in zip(sizes, sizes[1:]))
+
+
+def test_a_frame_drawn_over_the_kept_background_is_the_full_drawing():
+    """Only the surface and the title are drawn per frame; a full redraw of the figure
+    with the same surface gives the same picture (8 levels of 255 and 0.5 % of the
+    pixels: antialiasing along the silhouette, composited once more over the background)."""
+    from splinedeform.viz.animation import _FrameDrawer
+    from splinedeform.viz.figures import _collection, _face_colors
+
+    s = plane(3)
+    times, nets = motion(s, 3)
+    draw = _FrameDrawer(s, s.control_points, times, nets, 10, 1.0, (28.0, -60.0))
+    draw(0)
+    image = draw(2)
+    surface = _collection(draw.X[2], draw.faces, _face_colors(draw.mag[2], draw.faces,
+                                                              draw.vmax))
+    draw.ax.add_collection3d(surface)
+    draw.fig.canvas.draw()
+    full = np.asarray(draw.fig.canvas.buffer_rgba())[..., :3].astype(int)
+    assert np.mean(np.any(np.abs(full - image) > 8, axis=-1)) < 0.005
+    assert np.mean(np.any(image != draw(0), axis=-1)) > 0.01     # frames do differ
+
+
+def test_gif_colour_bar_is_the_colour_map_ramp_exactly(tmp_path):
+    """Every pixel down the middle of the bar is one of the ramp's colours, unchanged by the
+    palette, and the bar climbs the ramp level by level (no bands of one colour)."""
+    from splinedeform.viz.gif import RAMP_LEVELS, ramp_colors
+
+    s = plane(3)
+    times, nets = motion(s, 3)
+    path = viz.write_animation(tmp_path / "motion.gif", s, s.control_points, times, nets,
+                               resolution=10)
+    frame = iio.imread(path, index=1)[..., :3].astype(int)
+    # the bar's axes span x in [0.86, 0.885] and y in [0.15, 0.85] of the 640 x 480 frame
+    column = frame[480 - int(0.85 * 480) + 3:480 - int(0.15 * 480) - 3, int(0.8725 * 640)]
+    ramp = ramp_colors(viz.COLORMAP).astype(int)
+    match = np.all(column[:, None, :] == ramp[None], axis=-1)
+    assert match.any(axis=1).all()              # exact: every bar pixel is a ramp colour
+    level = match.argmax(axis=1)[::-1]          # bottom (0) to top (RAMP_LEVELS - 1)
+    assert np.all(np.diff(level) >= 0)
+    # 330 rows for 128 levels: all but a few levels at the two ends appear
+    assert len(np.unique(level)) >= RAMP_LEVELS - 4
+
+
+def test_gif_palette_maps_to_the_nearest_entry():
+    """The lookup table agrees with a brute-force nearest search over the palette."""
+    from splinedeform.viz.gif import PaletteMap
+
+    rng = np.random.default_rng(3)
+    palette = rng.integers(0, 256, (256, 3)).astype(np.uint8)
+    image = rng.integers(0, 256, (40, 50, 3)).astype(np.uint8)
+    image[0, :5] = palette[[7, 8, 9, 200, 255]]        # palette colours map to themselves
+    index = PaletteMap(palette)(image)
+    distance = ((image[..., None, :].astype(int) - palette.astype(int)) ** 2).sum(-1)
+    chosen = np.take_along_axis(distance, index[..., None].astype(int), -1)[..., 0]
+    np.testing.assert_array_equal(chosen, distance.min(-1))   # integers: exact
+    assert index[0, :5].tolist() == [7, 8, 9, 200, 255]
+
+
+def test_gif_frame_delay_follows_fps(tmp_path):
+    s = plane(3)
+    times, nets = motion(s, 2)
+    path = viz.write_animation(tmp_path / "m.gif", s, s.control_points, times, nets,
+                               resolution=6, fps=25.0)
+    from PIL import Image
+
+    with Image.open(path) as gif:
+        assert gif.n_frames == 2 and gif.info["duration"] == 40   # 1000 / 25 ms
+        assert gif.info["loop"] == 0
 
 
 def test_mp4_when_an_encoder_is_available(tmp_path):
@@ -282,6 +379,17 @@ def test_viewer_data_holds_float32_frames_and_nets():
               for n in nets)
     assert data["vmax"] == pytest.approx(top, rel=1e-12)
     assert data["times"] == times.tolist() and data["netShape"] == [6, 6]
+    assert data["startFrame"] == 2            # sin(πt/2) rises to the last frame
+
+
+def test_viewer_starts_at_the_peak_not_the_last_frame():
+    s = plane(3)
+    times = np.linspace(0.0, 1.0, 7)
+    lift = np.zeros_like(s.control_points)
+    lift[..., 2] = 0.3 * bump(s)
+    nets = s.control_points[None] + np.sin(np.pi * times)[:, None, None, None] * lift
+    # sin(πt) on 7 frames peaks at t = 1/2, frame 3, and is back to rest at the end
+    assert viz.viewer_data(s, s.control_points, times, nets, resolution=5)["startFrame"] == 3
 
 
 def test_vertex_checksum_weights():

@@ -6,9 +6,15 @@ For every coordinate alike (DESIGN.md §1.5)::
     K = w10 G1u⊗G0v + w01 G0u⊗G1v + w20 G2u⊗G0v + 2 w11 G1u⊗G1v + w02 G0u⊗G2v
 
 with exact 1-D Gram matrices ``G_a`` (:func:`splinedeform.quadrature.gram_matrix`).
+Constraints of tensor-product form ``T = T_u ⊗ T_v`` reduce each factor apart,
+``Tᵀ (A ⊗ B) T = (T_uᵀ A T_u) ⊗ (T_vᵀ B T_v)``, so the reduced matrices are assembled
+from 1-D matrices without forming ``Tᵀ K T``. Every sum of Kronecker products is built
+directly in compressed form on the union of the terms' patterns (:func:`kronecker_sum`).
 """
 
 from __future__ import annotations
+
+from typing import Any, Sequence
 
 import numpy as np
 import scipy.sparse as sp
@@ -16,16 +22,19 @@ import scipy.sparse as sp
 from .material import Material
 
 
+def stiffness_terms(gram_u: Sequence[sp.spmatrix], gram_v: Sequence[sp.spmatrix],
+                    material: Material) -> list[tuple[float, sp.spmatrix, sp.spmatrix]]:
+    """The non-zero terms ``(w_ab, G_a^u, G_b^v)`` of ``K`` (the twist weight doubled)."""
+    terms = [(material.w10, 1, 0), (material.w01, 0, 1), (material.w20, 2, 0),
+             (2 * material.w11, 1, 1), (material.w02, 0, 2)]
+    return [(weight, gram_u[a], gram_v[b]) for weight, a, b in terms if weight]
+
+
 def stiffness(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], material: Material
               ) -> sp.csr_matrix:
     """``K = w10 G1u⊗G0v + w01 G0u⊗G1v + w20 G2u⊗G0v + 2 w11 G1u⊗G1v + w02 G0u⊗G2v``."""
-    terms = [(material.w10, 1, 0), (material.w01, 0, 1), (material.w20, 2, 0),
-             (2 * material.w11, 1, 1), (material.w02, 0, 2)]
-    K = sp.csr_matrix((gram_u[0].shape[0] * gram_v[0].shape[0],) * 2)
-    for weight, a, b in terms:
-        if weight:
-            K = K + weight * sp.kron(gram_u[a], gram_v[b], format="csr")
-    return K.tocsr()
+    shape = (gram_u[0].shape[0] * gram_v[0].shape[0],) * 2
+    return kronecker_sum(stiffness_terms(gram_u, gram_v, material), shape)
 
 
 def mass(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], density: float,
@@ -35,7 +44,132 @@ def mass(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], density: float,
         rows = np.kron(np.asarray(gram_u[0].sum(axis=1)).ravel(),
                        np.asarray(gram_v[0].sum(axis=1)).ravel())
         return sp.diags(density * rows, format="csr")
-    return (density * sp.kron(gram_u[0], gram_v[0], format="csr")).tocsr()
+    return kronecker_sum([(density, gram_u[0], gram_v[0])])
+
+
+def reduced_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix],
+                     material: Material, lumped: bool, M_full: sp.spmatrix, constraints: Any
+                     ) -> tuple[sp.csc_matrix, sp.csc_matrix] | None:
+    """``(K_r, M_r) = (Tᵀ K T, Tᵀ M T)`` from the reduced 1-D factors, in CSC.
+
+    ``None`` unless the constraints are of tensor-product form (``T_u``, ``T_v`` known).
+    A lumped (diagonal) mass ``M_full`` is reduced as it is.
+    """
+    T_u, T_v = constraints.T_u, constraints.T_v
+    if T_u is None or T_v is None:
+        return None
+    reduced_u = [(T_u.T @ G @ T_u).tocsr() for G in gram_u]
+    reduced_v = [(T_v.T @ G @ T_v).tocsr() for G in gram_v]
+    shape = (T_u.shape[1] * T_v.shape[1],) * 2
+    stiff = stiffness_terms(reduced_u, reduced_v, material)
+    if lumped:
+        T = constraints.T
+        return kronecker_sum(stiff, shape, "csc"), (T.T @ M_full @ T).tocsc()
+    K, M = kronecker_sums([stiff, [(material.mass, reduced_u[0], reduced_v[0])]], shape, "csc")
+    return K, M
+
+
+def full_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], material: Material,
+                  lumped: bool = False) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """``(K, M)`` of :func:`stiffness` and :func:`mass` on one shared layout."""
+    if lumped:
+        return stiffness(gram_u, gram_v, material), mass(gram_u, gram_v, material.mass, True)
+    shape = (gram_u[0].shape[0] * gram_v[0].shape[0],) * 2
+    K, M = kronecker_sums([stiffness_terms(gram_u, gram_v, material),
+                           [(material.mass, gram_u[0], gram_v[0])]], shape)
+    return K, M
+
+
+def kronecker_sum(terms: Sequence[tuple[float, sp.spmatrix, sp.spmatrix]],
+                  shape: tuple[int, int] | None = None, format: str = "csr") -> sp.spmatrix:
+    """``Σ_t w_t A_t ⊗ B_t`` assembled directly in CSR (or CSC) form (:func:`kronecker_sums`)."""
+    return kronecker_sums([terms], shape, format)[0]
+
+
+def kronecker_sums(sums: Sequence[Sequence[tuple[float, sp.spmatrix, sp.spmatrix]]],
+                   shape: tuple[int, int] | None = None, format: str = "csr"
+                   ) -> list[sp.spmatrix]:
+    """Several sums ``Σ_t w_t A_t ⊗ B_t`` on one shared compressed layout.
+
+    On the union patterns of all the ``A_t`` and of all the ``B_t``, each stored as a
+    padded table ``(line, slot)`` of its compressed lines (rows for CSR, columns for
+    CSC), the value of a sum at the entry pair ``((i, e), (k, f))`` is
+    ``Σ_t w_t A_t[i, e] B_t[k, f]``: one matrix product ``Aᵀ W B`` of the stacked tables
+    (``W = diag w``). Line ``(i, k)`` of ``P_A ⊗ P_B`` (``i n_B + k``) holds the entries
+    of line ``i`` of ``P_A`` times those of line ``k`` of ``P_B``, ``e``-major, which is
+    also the order of their other indices ``j m_B + l``: the product read in the order
+    ``(i, k, e, f)``, less the padding, is the compressed data. The layout is computed
+    once for all the sums.
+    """
+    cls = sp.csr_matrix if format == "csr" else sp.csc_matrix
+    if not any(sums):
+        return [cls(shape) for _ in sums]
+    sums = [[(w, cls(A), cls(B)) for w, A, B in terms] for terms in sums]
+    PA = _union_pattern([A for terms in sums for _, A, _ in terms])
+    PB = _union_pattern([B for terms in sums for _, _, B in terms])
+    other_a, slot_a = _table(PA, PA.indices)
+    other_b, slot_b = _table(PB, PB.indices)
+    stored = (other_a >= 0)[:, None, :, None] & (other_b >= 0)[None, :, None, :]  # (i, k, e, f)
+    indptr = np.zeros(stored.shape[0] * stored.shape[1] + 1, dtype=np.int64)
+    np.cumsum(np.outer(np.diff(PA.indptr), np.diff(PB.indptr)).ravel(), out=indptr[1:])
+    width_b = PB.shape[1] if format == "csr" else PB.shape[0]
+    indices = (other_a[:, None, :, None] * width_b + other_b[None, :, None, :])[stored]
+    full_shape = (PA.shape[0] * PB.shape[0], PA.shape[1] * PB.shape[1])
+    out = []
+    for terms in sums:
+        if terms:
+            weights = np.array([w for w, _, _ in terms], dtype=float)
+            values_a = np.stack([_table(PA, _values_on(A, PA))[0] for _, A, _ in terms])
+            values_b = np.stack([_table(PB, _values_on(B, PB))[0] for _, _, B in terms])
+            la, ca = values_a.shape[1:]
+            lb, cb = values_b.shape[1:]
+            with np.errstate(over="ignore", invalid="ignore"):   # scales are checked later
+                product = ((values_a * weights[:, None, None]).reshape(len(terms), -1).T
+                           @ values_b.reshape(len(terms), -1))          # (i e, k f)
+            data = product.reshape(la, ca, lb, cb).transpose(0, 2, 1, 3)[stored]
+        else:
+            data = np.zeros(indices.size)
+        matrix = cls((data, indices, indptr), shape=full_shape if shape is None else shape)
+        matrix.has_sorted_indices = True
+        out.append(matrix)
+    return out
+
+
+def _table(pattern: sp.spmatrix, entries: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``entries`` (one per stored position of ``pattern``) as a table ``(line, slot)``.
+
+    Padding slots hold ``-1`` for integer entries and ``0`` for values; returns the table
+    and the slot of each stored position.
+    """
+    counts = np.diff(pattern.indptr)
+    line = np.repeat(np.arange(counts.size), counts)
+    slot = np.arange(pattern.nnz) - pattern.indptr[line]
+    fill = -1 if entries.dtype.kind in "iu" else 0.0
+    table = np.full((counts.size, int(counts.max()) if counts.size else 0), fill,
+                    dtype=np.int64 if fill == -1 else float)
+    table[line, slot] = entries
+    return table, slot
+
+
+def _union_pattern(matrices: Sequence[sp.spmatrix]) -> sp.spmatrix:
+    """Sorted compressed pattern of the entries stored in any of ``matrices`` (same format)."""
+    pattern = matrices[0].copy()
+    pattern.data = np.ones_like(pattern.data)
+    for A in matrices[1:]:
+        other = A.copy()
+        other.data = np.ones_like(other.data)
+        pattern = pattern + other
+    pattern.sum_duplicates()
+    pattern.sort_indices()
+    return pattern
+
+
+def _values_on(A: sp.spmatrix, pattern: sp.spmatrix) -> np.ndarray:
+    """Entries of ``A`` at the stored positions of ``pattern`` (zero where ``A`` stores none)."""
+    lines = np.repeat(np.arange(pattern.indptr.size - 1), np.diff(pattern.indptr))
+    if sp.isspmatrix_csr(pattern):
+        return np.asarray(A[lines, pattern.indices]).ravel()
+    return np.asarray(A[pattern.indices, lines]).ravel()
 
 
 def _largest(A: sp.spmatrix) -> float:

@@ -19,12 +19,17 @@ Three knot layouts are supported, all with ``m`` equal cells of width ``h = L/m`
 Function index ``j`` (0-based) of a uniform basis is Höllig's ``k = j - n``.
 On cell ``i`` the non-zero functions are ``j = i, ..., i + n`` (modulo ``m`` when
 periodic), so every evaluation returns ``n + 1`` values per parameter.
+
+Evaluation: each basis keeps the Bernstein coefficients of its non-zero functions on
+every cell (:mod:`splinedeform.spans`, found once from the Cox–de Boor recurrence of the
+knot vector); a parameter's values are then its cell's coefficients against the Bernstein
+polynomials of its local parameter ``s = x/h - i``, for all parameters at once.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from math import comb
+from math import comb, isfinite
 from typing import Literal
 
 import numpy as np
@@ -32,6 +37,7 @@ import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
 from .errors import InputError
+from .spans import SpanForm, span_form
 
 KnotKind = Literal["uniform", "open", "periodic"]
 KNOT_KINDS: tuple[str, ...] = ("uniform", "open", "periodic")
@@ -117,6 +123,8 @@ class BSplineBasis:
     length: float = 1.0
     kind: KnotKind = "open"
     knots: NDArray[np.float64] = field(init=False, repr=False, compare=False)
+    form: SpanForm = field(init=False, repr=False, compare=False)
+    _span_functions: NDArray[np.int64] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         _check_degree(self.degree)
@@ -134,6 +142,12 @@ class BSplineBasis:
             raise InputError(f"parameter length must be finite and > 0, got {self.length!r}")
         object.__setattr__(self, "length", float(self.length))
         object.__setattr__(self, "knots", self._knot_vector())
+        below, above = self._cell_windows()
+        object.__setattr__(self, "form", span_form(-below, above, np.full(self.cells, self.h),
+                                                   self.degree))
+        index = np.arange(self.cells)[:, None] + np.arange(self.degree + 1)
+        object.__setattr__(self, "_span_functions", np.mod(index - self.degree, self.cells)
+                           if self.kind == "periodic" else index)
 
     # -- layout -------------------------------------------------------------
     @property
@@ -156,6 +170,24 @@ class BSplineBasis:
             return np.concatenate([np.zeros(n), np.arange(m + 1) * h, np.full(n, self.length)])
         # uniform and periodic: the bi-infinite grid hZ, restricted to the functions used
         return np.arange(-n, m + n + 1) * h
+
+    def _cell_windows(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Knots ``τ_{μ+1-k} - i`` and ``τ_{μ+k} - i`` (``k = 1..n``) of each cell ``i``, in cells.
+
+        ``τ = t / h`` are the knots in units of the cell width (integers), ``μ = i + n`` the
+        knot index starting cell ``i``; shape ``(n, m)`` each. With the local parameter
+        ``s = x/h - i`` the recurrence's ``left_k = s - (τ_{μ+1-k} - i)`` and
+        ``right_k = (τ_{μ+k} - i) - s`` are exact at the cell's left end ``s = 0``, where
+        :func:`splinedeform.spans.span_form` takes them.
+        """
+        n, m = self.degree, self.cells
+        if self.kind == "open":
+            tau = np.concatenate([np.zeros(n), np.arange(m + 1.0), np.full(n, float(m))])
+        else:
+            tau = np.arange(-n, m + n + 1.0)
+        cell = np.arange(m)
+        k = np.arange(1, n + 1)[:, None]
+        return tau[cell + n + 1 - k] - cell, tau[cell + n + k] - cell
 
     def greville(self) -> NDArray[np.float64]:
         """Greville abscissae ``ξ_j = (t_{j+1} + … + t_{j+n}) / n`` inside ``[0, L]``.
@@ -180,16 +212,19 @@ class BSplineBasis:
     # -- evaluation ---------------------------------------------------------
     def _check_points(self, x: ArrayLike) -> NDArray[np.float64]:
         x = np.asarray(x, dtype=float)
-        if not np.all(np.isfinite(x)):
+        if not x.size:
+            return x
+        lo, hi = x.min(), x.max()                  # NaN and infinities show in these
+        if not (np.isfinite(lo) and np.isfinite(hi)):
             raise InputError("parameters must be finite numbers")
         if self.kind == "periodic":
             return np.mod(x, self.length)
         tol = 1e-12 * self.length
-        if x.size and (x.min() < -tol or x.max() > self.length + tol):
+        if lo < -tol or hi > self.length + tol:
             raise InputError(
                 f"parameter outside the domain [0, {self.length:g}]: "
-                f"got values in [{x.min():g}, {x.max():g}]")
-        return np.clip(x, 0.0, self.length)
+                f"got values in [{lo:g}, {hi:g}]")
+        return np.clip(x, 0.0, self.length) if lo < 0.0 or hi > self.length else x
 
     def span(self, x: ArrayLike) -> NDArray[np.int64]:
         """Index ``i`` of the cell ``[i h, (i+1) h)`` holding each parameter (last cell closed)."""
@@ -225,26 +260,36 @@ class BSplineBasis:
         """
         if not isinstance(max_derivative, (int, np.integer)) or max_derivative < 0:
             raise InputError(f"derivative order must be an integer >= 0, got {max_derivative!r}")
-        x = self._check_points(x)
-        n, h = self.degree, self.h
-        cell = np.clip(np.floor(x / h).astype(np.int64), 0, self.cells - 1)
-        index = cell[..., None] + np.arange(n + 1)
-        if self.kind == "periodic":
-            index = np.mod(index - n, self.cells)
-        jmax = min(max_derivative, n)
-        table = _hollig_table(x / h - cell, n, jmax)
-        # function r (0..n) on the cell is b^n(s + n - r): reverse the q axis
-        values = np.stack([table[j][..., ::-1] * h ** (-j) for j in range(jmax + 1)])
-        if self.kind == "open":
-            # cells n-1 .. m-n see only uniform knots (Höllig applies); the n-1 cells at
-            # each end see repeated knots and take the general Cox–de Boor recurrence
-            ends = (cell < n - 1) | (cell > self.cells - n)
-            if np.any(ends):
-                values[:, ends] = _cox_de_boor(self.knots, n, cell[ends] + n, x[ends], jmax)
-        if max_derivative > jmax:
-            pad = np.zeros((max_derivative - jmax,) + values.shape[1:])
-            values = np.concatenate([values, pad])
-        return index, values
+        x = np.asarray(x, dtype=float)
+        cell, s = self.locate(x)
+        values = self.form.values(cell, s, max_derivative)
+        index = self._span_functions[cell].reshape(x.shape + (self.degree + 1,))
+        return index, values.reshape((max_derivative + 1,) + x.shape + (self.degree + 1,))
+
+    def locate(self, x: ArrayLike) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+        """Cell ``i`` and local parameter ``s = x/h - i ∈ [0, 1]`` of each parameter (flattened)."""
+        y = self._check_points(x).ravel() / self.h
+        cell = y.astype(np.int64)                  # y >= 0: truncation is the floor
+        np.minimum(cell, self.cells - 1, out=cell)   # x = L belongs to the last cell
+        return cell, y - cell
+
+    def locate_scalar(self, x: float) -> tuple[int, float]:
+        """:meth:`locate` of one parameter, in plain Python numbers."""
+        L = self.length
+        if self.kind == "periodic" and isfinite(x):
+            x = x % L
+        if not 0.0 <= x <= L:                      # also refuses NaN and infinities
+            self._check_points(x)                  # says why (or accepts a rounding error)
+            x = min(max(x, 0.0), L)
+        y = x / self.h
+        cell = int(y)
+        if cell >= self.cells:
+            cell = self.cells - 1
+        return cell, y - cell
+
+    def span_functions(self) -> NDArray[np.int64]:
+        """Indices of the ``n + 1`` functions not vanishing on each cell, shape ``(m, n+1)``."""
+        return self._span_functions.copy()
 
     def matrix(self, x: ArrayLike, derivative: int = 0) -> sp.csr_matrix:
         """Sparse collocation matrix ``A_{ij} = D^derivative b_j(x_i)``, shape ``(len(x), size)``."""
@@ -257,80 +302,3 @@ class BSplineBasis:
     def __call__(self, x: ArrayLike, derivative: int = 0) -> NDArray[np.float64]:
         """Dense collocation matrix; convenient for small problems and tests."""
         return self.matrix(x, derivative).toarray()
-
-
-def _cox_de_boor(knots: NDArray[np.float64], degree: int, span: NDArray[np.int64],
-                 x: NDArray[np.float64], max_derivative: int) -> NDArray[np.float64]:
-    """Non-zero B-splines and derivatives over a general knot vector (Cox–de Boor).
-
-    Vectorised form of Piegl & Tiller's algorithms A2.2/A2.3: ``span`` is the knot
-    index ``μ`` with ``t_μ <= x < t_{μ+1}``; returns ``D^j N_{μ-n+r, n}(x)`` for
-    ``r = 0..n`` and ``j = 0..max_derivative``, shape ``(max_derivative+1,) + x.shape + (n+1,)``.
-    Derivatives use ``D N_{i,p} = p/(t_{i+p}-t_i) N_{i,p-1} - p/(t_{i+p+1}-t_{i+1}) N_{i+1,p-1}``.
-    """
-    n = degree
-    # levels[p][..., r] = N_{span-p+r, p}(x), r = 0..p
-    levels = [np.ones(x.shape + (1,))]
-    for p in range(1, n + 1):
-        prev = levels[-1]
-        out = np.zeros(x.shape + (p + 1,))
-        for r in range(p):
-            i = span - p + 1 + r  # N_{i, p-1} = prev[..., r]
-            left_den = knots[i + p] - knots[i]
-            right_den = knots[i + p] - knots[i]
-            # contribution of N_{i,p-1} to N_{i-1,p} (right part) and N_{i,p} (left part)
-            w_left = _safe_div(x - knots[i], left_den)
-            w_right = _safe_div(knots[i + p] - x, right_den)
-            out[..., r + 1] += w_left * prev[..., r]
-            out[..., r] += w_right * prev[..., r]
-        levels.append(out)
-    result = np.zeros((max_derivative + 1,) + x.shape + (n + 1,))
-    result[0] = levels[n]
-    for j in range(1, max_derivative + 1):
-        # D^j N_{i,n} = Σ_q coeff[r, q] N_{i+q, n-j} with i = span - n + r
-        coeff = _derivative_coefficients(knots, n, span, j)
-        low = levels[n - j]  # low[..., r''] = N_{span-(n-j)+r'', n-j}, so r'' = r + q - j
-        acc = np.zeros(x.shape + (n + 1,))
-        for r in range(n + 1):
-            for q in range(j + 1):
-                if 0 <= r + q - j <= n - j:
-                    acc[..., r] += coeff[..., r, q] * low[..., r + q - j]
-        result[j] = acc
-    return result
-
-
-def _derivative_coefficients(knots: NDArray[np.float64], n: int, span: NDArray[np.int64],
-                             j: int) -> NDArray[np.float64]:
-    """Coefficients ``a_{r,q}`` with ``D^j N_{i,n} = n!/(n-j)! Σ_q a_{r,q} N_{i+q, n-j}``.
-
-    ``i = span - n + r``. Recurrence (Piegl & Tiller eq. 2.10):
-    ``a_{0,0}=1``, ``a_{k,0} = a_{k-1,0}/(t_{i+n-k+1} - t_i)``,
-    ``a_{k,q} = (a_{k-1,q} - a_{k-1,q-1})/(t_{i+n+q-k+1} - t_{i+q})``,
-    ``a_{k,k} = -a_{k-1,k-1}/(t_{i+n+1} - t_{i+k})``.
-    """
-    shape = span.shape
-    out = np.zeros(shape + (n + 1, j + 1))
-    scale = 1.0
-    for k in range(j):
-        scale *= n - k
-    for r in range(n + 1):
-        i = span - n + r
-        a = np.zeros(shape + (j + 1,))
-        a[..., 0] = 1.0
-        for k in range(1, j + 1):
-            new = np.zeros_like(a)
-            for q in range(k + 1):
-                prev_q = a[..., q] if q <= k - 1 else 0.0
-                prev_q1 = a[..., q - 1] if q >= 1 else 0.0
-                den = knots[i + n + q - k + 1] - knots[i + q]
-                new[..., q] = _safe_div(prev_q - prev_q1, den)
-            a = new
-        out[..., r, :] = scale * a
-    return out
-
-
-def _safe_div(num: NDArray[np.float64] | float, den: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``num/den`` with the B-spline convention ``0/0 = 0`` (repeated knots)."""
-    den = np.asarray(den, dtype=float)
-    safe = np.where(den == 0.0, 1.0, den)
-    return np.where(den == 0.0, 0.0, np.asarray(num) / safe)

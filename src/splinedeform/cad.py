@@ -6,8 +6,10 @@ vectors (``N + n + 1`` knots each, our convention and splipy's/geomdl's), contro
 
 .. math:: S(u, v) = \\frac{\\sum_{ij} w_{ij} N_i(u) N_j(v) P_{ij}}{\\sum_{ij} w_{ij} N_i(u) N_j(v)}.
 
-openNURBS stores ``N + n - 1`` knots (the first and last are implied) and homogeneous
-control points ``(w x, w y, w z, w)``. Needs the ``cad`` extra.
+and its coordinates are in :attr:`NurbsPatch.units`. openNURBS stores ``N + n - 1`` knots
+(the first and last are implied) and homogeneous control points ``(w x, w y, w z, w)``;
+files are read in a child process (:mod:`splinedeform.cad_3dm_read`,
+:mod:`splinedeform.cad_child`). Needs the ``cad`` extra.
 """
 
 from __future__ import annotations
@@ -21,13 +23,18 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .basis import BSplineBasis
-from .errors import InputError
+from .cad_3dm_read import _rhino3dm, read_3dm_arrays
+from .cad_child import read_in_child
+from .cad_units import check_units, rhino_name
+from .errors import InputError, InputWarning
 from .export.atomic import atomic_path
 from .knots import KnotVectorBasis, RationalBasis
 from .surface import Basis, Surface
 
 #: relative tolerance for weights to count as a product ``a_i b_j`` (or as all equal)
 WEIGHT_TOL = 1e-12
+#: distance (relative to the net's size) under which a seam's two rows of points coincide
+SEAM_TOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -39,8 +46,11 @@ class NurbsPatch:
     knots_v: NDArray[np.float64]
     points: NDArray[np.float64]
     weights: NDArray[np.float64]
+    #: length unit of ``points`` (a key of :data:`splinedeform.cad_units.UNITS`), None: unknown
+    units: str | None = None
 
     def __post_init__(self) -> None:
+        check_units(self.units, "NURBS patch units")
         bu = KnotVectorBasis(self.degrees[0], self.knots_u)
         bv = KnotVectorBasis(self.degrees[1], self.knots_v)
         shape = (bu.size, bv.size)
@@ -50,6 +60,19 @@ class NurbsPatch:
                              f"weights {np.shape(self.weights)}")
         if np.any(np.asarray(self.weights) <= 0):
             raise InputError("NURBS weights must be > 0")
+
+    def __repr__(self) -> str:
+        """One line: net size, degrees, knot counts, domain, weights (never the arrays)."""
+        shape = np.shape(self.weights)
+        spans = []
+        for n, knots in zip(self.degrees, (self.knots_u, self.knots_v)):
+            t = np.asarray(knots, dtype=float).ravel()
+            spans.append(f"[{t[n]:.6g}, {t[t.size - n - 1]:.6g}]")
+        w = np.asarray(self.weights, dtype=float)
+        rational = "equal weights" if np.ptp(w) <= WEIGHT_TOL * np.abs(w).max() else "rational"
+        return (f"NurbsPatch({shape[0]}×{shape[1]} control points, degree={tuple(self.degrees)}, "
+                f"knots=(knot vector of {np.size(self.knots_u)}, knot vector of "
+                f"{np.size(self.knots_v)}), domain={spans[0]} × {spans[1]}, {rational})")
 
     def evaluate(self, u: NDArray[np.float64], v: NDArray[np.float64]) -> NDArray[np.float64]:
         """``S(u_a, v_b)`` on the grid ``u × v``, shape ``(len(u), len(v), 3)``."""
@@ -83,7 +106,7 @@ def refine(patch: NurbsPatch, splits: int) -> NurbsPatch:
     hom = np.concatenate([patch.points * w[..., None], w[..., None]], axis=-1)
     hom = np.einsum("ai,ijc,bj->abc", Su, hom, Sv)
     return NurbsPatch(patch.degrees, fu.knots, fv.knots, hom[..., :3] / hom[..., 3:],
-                      hom[..., 3])
+                      hom[..., 3], patch.units)
 
 
 def surface_from_patch(patch: NurbsPatch, name: str = "cad surface",
@@ -100,10 +123,31 @@ def surface_from_patch(patch: NurbsPatch, name: str = "cad surface",
     bu = KnotVectorBasis(patch.degrees[0], patch.knots_u)
     bv = KnotVectorBasis(patch.degrees[1], patch.knots_v)
     bu, bv = bu.shifted(bu.domain[0]), bv.shifted(bv.domain[0])
+    warn_open_seams(patch, source)
     a, b = weight_factors(np.asarray(patch.weights, dtype=float), source)
     basis_u: Basis = bu if np.ptp(a) <= WEIGHT_TOL * a.max() else RationalBasis(bu, a)
     basis_v: Basis = bv if np.ptp(b) <= WEIGHT_TOL * b.max() else RationalBasis(bv, b)
     return Surface(np.asarray(patch.points, dtype=float), basis_u, basis_v, name=name)
+
+
+def warn_open_seams(patch: NurbsPatch, source: str = "NURBS patch") -> None:
+    """Warn (once per direction) where the surface is closed but its seam is not joined.
+
+    The surface is closed in ``u`` when its first and last rows of control points
+    coincide, ``P_0j = P_{N-1,j}`` within :data:`SEAM_TOL` of the net's size (a row that
+    is one point, a pole, does not count). Read from a file, the two rows are separate
+    unknowns: nothing keeps the seam closed, and its two sides move apart under load.
+    """
+    P = np.asarray(patch.points, dtype=float)
+    size = max(float(np.ptp(P.reshape(-1, 3), axis=0).max()), 1e-300)
+    for axis, name in ((0, "u"), (1, "v")):
+        first, last = np.take(P, 0, axis=axis), np.take(P, -1, axis=axis)
+        if (np.linalg.norm(first - last, axis=-1).max() <= SEAM_TOL * size
+                and np.ptp(first, axis=0).max() > SEAM_TOL * size):
+            warnings.warn(f"{source} is closed in {name} (its first and last control points "
+                          f"in {name} coincide) but the seam is not joined: its two sides "
+                          "are separate unknowns and move apart under load", InputWarning,
+                          stacklevel=3)
 
 
 def weight_factors(w: NDArray[np.float64], source: str = "NURBS patch"
@@ -161,26 +205,22 @@ def read_cad(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
     return read_step(path, face)
 
 
-def _rhino3dm():
-    try:
-        import rhino3dm
-    except ImportError as exc:  # pragma: no cover - depends on the installation
-        raise InputError("reading or writing .3dm files needs the 'cad' extra: "
-                         "pip install 'splinedeform[cad]'") from exc
-    return rhino3dm
-
-
 def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch],
-              names: list[str] | None = None) -> Path:
+              names: list[str] | None = None, units: str | None = None) -> Path:
     """Write ``patches`` as NURBS surfaces to a ``.3dm`` file (atomically); return its path.
 
-    ``names`` label the objects (openNURBS object names), one per patch.
+    ``names`` label the objects (openNURBS object names), one per patch. ``units`` (a key
+    of :data:`splinedeform.cad_units.UNITS`; default: the first patch's) is the file's
+    ``ModelUnitSystem``; ``None`` when not known (openNURBS ``UnitSystem.None``).
     """
     r3 = _rhino3dm()
     path = Path(path)
     if names is not None and len(names) != len(patches):
         raise InputError(f"{len(names)} object names for {len(patches)} surfaces")
+    if units is None and patches:
+        units = patches[0].units
     model = r3.File3dm()
+    model.Settings.ModelUnitSystem = getattr(r3.UnitSystem, rhino_name(units))
     for index, patch in enumerate(patches):
         (nu, nv), w = patch.degrees, np.asarray(patch.weights)
         cu, cv = w.shape
@@ -221,57 +261,29 @@ def frame_patches(surface: Surface, times: NDArray[np.float64], nets: NDArray[np
 
 
 def write_frames_3dm(path: str | os.PathLike, surface: Surface, times: NDArray[np.float64],
-                     nets: NDArray[np.float64], label: str = "t") -> Path:
+                     nets: NDArray[np.float64], label: str = "t",
+                     units: str | None = None) -> Path:
     """The initial surface and every frame as named NURBS surfaces in one ``.3dm`` file
-    (object ``k + 1`` is frame ``k``; see :func:`frame_patches`). Written atomically."""
-    return write_3dm(path, *frame_patches(surface, times, nets, label))
-
-
-def _patch_from_rhino(srf, source: str) -> NurbsPatch:
-    nu, nv = srf.OrderU - 1, srf.OrderV - 1
-    if nu < 1 or nv < 1:
-        raise InputError(f"{source}: surface of degree ({nu}, {nv}); degree 0 is not supported")
-    ku = [srf.KnotsU[i] for i in range(len(srf.KnotsU))]
-    kv = [srf.KnotsV[i] for i in range(len(srf.KnotsV))]
-    cu, cv = srf.Points.CountU, srf.Points.CountV
-    hom = np.array([[list(_xyzw(srf.Points[i, j])) for j in range(cv)] for i in range(cu)])
-    w = hom[..., 3]
-    return NurbsPatch((nu, nv), np.r_[ku[0], ku, ku[-1]], np.r_[kv[0], kv, kv[-1]],
-                      hom[..., :3] / w[..., None], w)
-
-
-def _xyzw(p) -> tuple[float, float, float, float]:
-    return p.X, p.Y, p.Z, p.W
+    (object ``k + 1`` is frame ``k``; see :func:`frame_patches`), in ``units`` (see
+    :func:`write_3dm`). Written atomically."""
+    return write_3dm(path, *frame_patches(surface, times, nets, label), units=units)
 
 
 def read_3dm(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
-    """Surface number ``face`` of a ``.3dm`` file (surfaces and Brep faces, in file order).
+    """Surface number ``face`` of a ``.3dm`` file (surfaces and Brep faces, in file order),
+    in the file's ``ModelUnitSystem`` (:attr:`NurbsPatch.units`; None if not one of ours).
 
-    A Brep face is read as its underlying (untrimmed) surface, with a warning.
+    Read in a child process (:func:`splinedeform.cad_child.read_in_child`): a file that
+    crashes openNURBS is an ``InputError`` naming the file. A Brep face is read as its
+    underlying surface; a face that is really trimmed (its outer loop is not the
+    surface's own boundary, or it has inner loops) is warned about, once.
     """
-    r3 = _rhino3dm()
+    _rhino3dm()
     path = Path(path)
     if not path.is_file():
         raise InputError(f"{path}: no such file")
-    model = r3.File3dm.Read(str(path))
-    if model is None:
-        raise InputError(f"{path}: not a .3dm (openNURBS) file")
-    found = []
-    for obj in model.Objects:
-        geometry = obj.Geometry
-        if isinstance(geometry, r3.Brep):
-            found += [(f, True) for f in geometry.Faces]
-        elif isinstance(geometry, r3.Surface):
-            found.append((geometry, False))
-    if not found:
-        raise InputError(f"{path}: the file holds no surface")
-    if not isinstance(face, int) or not 0 <= face < len(found):
-        raise InputError(f"{path}: face {face!r} out of range; the file holds "
-                         f"{len(found)} surface(s), numbered 0..{len(found) - 1}")
-    surface, in_brep = found[face]
-    if in_brep:
-        warnings.warn(f"{path}: face {face} is a Brep face; its underlying surface is used "
-                      "and any trimming is dropped", stacklevel=2)
-        surface = surface.UnderlyingSurface()
-    return _patch_from_rhino(surface.ToNurbsSurface(), f"{path} face {face}")
-
+    if isinstance(face, bool) or not isinstance(face, int) or face < 0:
+        raise InputError(f"{path}: face {face!r} out of range; faces are numbered from 0")
+    data = read_in_child(read_3dm_arrays, path, face, library="openNURBS (rhino3dm)")
+    return NurbsPatch(tuple(data["degrees"]), data["knots_u"], data["knots_v"],
+                      data["points"], data["weights"], units=data["units"])

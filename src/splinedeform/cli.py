@@ -5,6 +5,8 @@ command-line overrides, draws progress bars (stderr) and prints a closing summar
 (stdout). Bad input (:class:`~splinedeform.errors.InputError`, which includes
 :class:`~splinedeform.errors.ScenarioError`) prints its message on stderr and exits with
 code 2, without a traceback unless ``--debug``; any other failure exits with code 1.
+Ctrl-C during a run prints one line (where it stopped, what it left incomplete) and exits
+with code 130.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from __future__ import annotations
 import importlib.util
 import platform
 import sys
+import warnings
 from contextlib import contextmanager
 from importlib import metadata, resources
 from pathlib import Path
@@ -25,6 +28,8 @@ from .errors import InputError
 
 EXIT_INPUT_ERROR = 2
 EXIT_INTERNAL_ERROR = 1
+#: exit status after Ctrl-C (128 + SIGINT), as shells report it
+EXIT_INTERRUPTED = 130
 
 #: optional modules reported by ``splinedeform info``: import name -> (distribution, use)
 OPTIONAL = {
@@ -39,6 +44,8 @@ OPTIONAL = {
     "playwright": ("playwright", "viewer test in a headless browser"),
     "starlette": ("starlette", "sculpt server (extra: sculpt)"),
     "uvicorn": ("uvicorn", "sculpt server (extra: sculpt)"),
+    "rhino3dm": ("rhino3dm", "openNURBS .3dm files (extra: cad)"),
+    "OCP": ("cadquery-ocp-novtk", "STEP and IGES files, OpenCASCADE (extra: cad-step)"),
 }
 
 
@@ -117,7 +124,18 @@ INFO_WIDTH = 100
 
 @contextmanager
 def _reported_errors(debug: bool) -> Iterator[None]:
-    """Turn errors into a message on stderr and an exit code (a traceback only with --debug)."""
+    """Turn errors into a message on stderr and an exit code (a traceback only with --debug);
+    warnings are one line each on stderr, ``warning: <message>`` (with their source line
+    only with --debug)."""
+    with warnings.catch_warnings():
+        if not debug:
+            warnings.showwarning = _print_warning
+        with _errors_reported(debug):
+            yield
+
+
+@contextmanager
+def _errors_reported(debug: bool) -> Iterator[None]:
     try:
         yield
     except (typer.Exit, typer.Abort, KeyboardInterrupt):
@@ -133,6 +151,13 @@ def _reported_errors(debug: bool) -> Iterator[None]:
         _print_error(f"internal error: {type(exc).__name__}: {exc}\n"
                      "(run again with --debug for the traceback)")
         raise typer.Exit(EXIT_INTERNAL_ERROR) from None
+
+
+def _print_warning(message: Warning | str, category: type[Warning], filename: str,
+                   lineno: int, file: Any = None, line: str | None = None) -> None:
+    _, err = _consoles()
+    err.print(f"[bold yellow]warning:[/] {_escape(str(message))}", highlight=False,
+              soft_wrap=True)
 
 
 def _print_error(message: str) -> None:
@@ -164,12 +189,16 @@ def _run(scenario: Any, outdir: Path, quiet: bool, budget: str | None = None) ->
     """Run a validated scenario with progress bars and print the summary table."""
     from ._progress import StageProgress
     from .budget import Budget
-    from .pipeline import run, summary_rows
+    from .pipeline import RunInterrupted, run, summary_rows
 
     limits = Budget.parse(budget) if budget is not None else None
     out, err = _consoles()
-    with StageProgress(err, enabled=not quiet) as progress:
-        result = run(scenario, outdir, progress=progress, budget=limits)
+    try:
+        with StageProgress(err, enabled=not quiet) as progress:
+            result = run(scenario, outdir, progress=progress, budget=limits)
+    except RunInterrupted as exc:          # Ctrl-C: one line, not a traceback
+        err.print(_escape(str(exc)), style="bold yellow", highlight=False, soft_wrap=True)
+        raise typer.Exit(EXIT_INTERRUPTED) from None
     if not quiet:
         out.print(_table(f"splinedeform: {scenario.title or scenario.name}",
                          summary_rows(result)))
@@ -229,17 +258,19 @@ def demo_command(outdir: Path = typer.Option(Path("demo-output"), "-o", "--outdi
 
 @app.command("validate")
 def validate_command(scenario: Path = SCENARIO_ARG, allow_outside_paths: bool = OUTSIDE_OPT,
-                     debug: bool = DEBUG_OPT) -> None:
-    """Check a scenario file and print what it would run (with every default filled in)."""
-    from .budget import estimate
+                     budget: Optional[str] = BUDGET_OPT, debug: bool = DEBUG_OPT) -> None:
+    """Check a scenario file and print what it would run (with every default filled in);
+    a run over its budget is refused here as by ``run``."""
+    from .budget import Budget, check
     from .scenario import build, describe, load_scenario, scenario_to_toml
     from .terminal import printable
 
     with _reported_errors(debug):
         loaded = load_scenario(scenario, allow_outside_paths=allow_outside_paths)
         built = build(loaded)
+        found = check(loaded, built.model, Budget.parse(budget) if budget is not None else None)
         out, _ = _consoles()
-        rows = describe(loaded, built) + estimate(loaded, built.model).rows()
+        rows = describe(loaded, built) + found.rows()
         out.print(_table(f"{scenario}: valid", rows))
         out.print(printable(scenario_to_toml(loaded)), markup=False, highlight=False)
 
@@ -267,7 +298,7 @@ def _optional_rows() -> list[tuple[str, str]]:
         try:
             importlib.import_module(module)
         except ImportError:
-            rows.append((dist, f"missing  ({use})"))
+            rows.append((dist, f"not installed  ({use})"))
             continue
         except Exception as exc:  # noqa: BLE001  (installed but broken, e.g. a missing library)
             rows.append((dist, f"installed but fails to import: {type(exc).__name__}: {exc}  "
@@ -301,6 +332,10 @@ def info_command() -> None:
     out.print(_table("optional packages", _optional_rows()))
 
 
+#: default folder of ``splinedeform bench`` (``out/`` is git-ignored in a source checkout)
+BENCH_OUTDIR = Path("out") / "bench"
+
+
 def _register_bench() -> None:
     """Add ``splinedeform bench`` when the cost study module is installed."""
     try:
@@ -313,16 +348,16 @@ def _register_bench() -> None:
     @app.command("bench")
     def bench_command(sizes: Optional[str] = typer.Option(
                           None, "--sizes", help="Comma-separated net sizes, e.g. 8,16,32."),
-                      quick: bool = typer.Option(False, "--quick", help="A short run."),
-                      outdir: Path = typer.Option(Path("bench-output"), "-o", "--outdir",
-                                                  help="Output folder."),
+                      quick: bool = typer.Option(
+                          False, "--quick", help="A smoke run of a few seconds: nets of 3×3 "
+                                                 "and 4×4 cells, target 1e-3, regime a only."),
+                      outdir: Path = typer.Option(BENCH_OUTDIR, "-o", "--outdir",
+                                                  help="Output folder (created if missing)."),
                       quiet: bool = QUIET_OPT, debug: bool = DEBUG_OPT) -> None:
         """Cost study: analytic against numerical solvers, cost against net size."""
-        from . import bench, bench_goals
+        from . import bench
 
-        with _reported_errors(debug), bench_goals.blas_threads(1) as threads:
-            if not quiet:
-                typer.echo(threads)
+        with _reported_errors(debug):              # bench.main limits the BLAS threads
             parsed = None
             if sizes is not None:
                 try:

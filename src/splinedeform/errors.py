@@ -11,3 +11,10 @@ class SingularSystemError(InputError):
 
 class ScenarioError(InputError):
     """A scenario file is invalid; the message names the file, the key path and the line."""
+
+
+class InputWarning(UserWarning):
+    """Input that is used but deserves a look (a dropped trimming, an unjoined seam, …).
+
+    The command line prints each as one line, ``warning: <message>``, on stderr.
+    """

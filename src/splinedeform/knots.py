@@ -15,13 +15,15 @@ layout CAD programs write; the uniform / open / periodic layouts of
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from bisect import bisect_right
 from math import comb
 
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
-from .basis import _check_degree, _cox_de_boor
+from .basis import _check_degree
+from .spans import SpanForm, span_form
 from .errors import InputError
 
 
@@ -49,6 +51,10 @@ class KnotVectorBasis:
     degree: int
     knots: NDArray[np.float64]
     breaks: NDArray[np.float64] = field(init=False, repr=False, compare=False)
+    widths: NDArray[np.float64] = field(init=False, repr=False, compare=False)
+    first: NDArray[np.int64] = field(init=False, repr=False, compare=False)
+    form: SpanForm = field(init=False, repr=False, compare=False)
+    _break_list: list = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         _check_degree(self.degree)
@@ -70,7 +76,16 @@ class KnotVectorBasis:
                                  f"at most the degree ({n}) keeps the basis continuous")
         t.setflags(write=False)
         object.__setattr__(self, "knots", t)
-        object.__setattr__(self, "breaks", np.unique(t[n:t.size - n]))
+        breaks = np.unique(t[n:t.size - n])
+        object.__setattr__(self, "breaks", breaks)
+        # the non-empty spans: knot index μ with t_μ = breaks[i] < t_{μ+1}
+        mu = np.searchsorted(t, breaks[:-1], side="right") - 1
+        k = np.arange(1, n + 1)[:, None]
+        object.__setattr__(self, "widths", np.diff(breaks))
+        object.__setattr__(self, "_break_list", breaks.tolist())
+        object.__setattr__(self, "first", mu - n)
+        object.__setattr__(self, "form", span_form(t[mu] - t[mu + 1 - k], t[mu + k] - t[mu],
+                                                   self.widths, n))
 
     @property
     def size(self) -> int:
@@ -144,14 +159,33 @@ class KnotVectorBasis:
         """
         if not isinstance(max_derivative, (int, np.integer)) or max_derivative < 0:
             raise InputError(f"derivative order must be an integer >= 0, got {max_derivative!r}")
-        x = self._check_points(x)
-        n = self.degree
-        mu = self.span(x)
-        jmax = min(max_derivative, n)
-        values = _cox_de_boor(self.knots, n, mu, x, jmax)
-        if max_derivative > jmax:
-            values = np.concatenate([values, np.zeros((max_derivative - jmax,) + values.shape[1:])])
-        return mu[..., None] - n + np.arange(n + 1), values
+        x = np.asarray(x, dtype=float)
+        span, s = self.locate(x)
+        values = self.form.values(span, s, max_derivative)
+        index = self.first[span].reshape(x.shape)[..., None] + np.arange(self.degree + 1)
+        return index, values.reshape((max_derivative + 1,) + x.shape + (self.degree + 1,))
+
+    def locate(self, x: ArrayLike) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+        """Non-empty span ``i`` (``breaks[i] <= x``) and local ``s = (x - breaks[i]) / w_i`` (flattened)."""
+        flat = self._check_points(x).ravel()
+        b = self.breaks
+        span = np.clip(np.searchsorted(b, flat, side="right") - 1, 0, b.size - 2)
+        return span, (flat - b[span]) / self.widths[span]
+
+    def locate_scalar(self, x: float) -> tuple[int, float]:
+        """:meth:`locate` of one parameter, in plain Python numbers."""
+        b = self._break_list
+        if not b[0] <= x <= b[-1]:                 # also refuses NaN and infinities
+            self._check_points(x)                  # says why (or accepts a rounding error)
+            x = min(max(x, b[0]), b[-1])
+        span = bisect_right(b, x) - 1
+        if span >= len(b) - 1:
+            span = len(b) - 2
+        return span, (x - b[span]) / (b[span + 1] - b[span])
+
+    def span_functions(self) -> NDArray[np.int64]:
+        """Indices of the ``n + 1`` functions not vanishing on each non-empty span."""
+        return self.first[:, None] + np.arange(self.degree + 1)
 
     def nonzero(self, x: ArrayLike, derivative: int = 0
                 ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:

@@ -9,50 +9,82 @@
 from __future__ import annotations
 
 import time
+import warnings
 import weakref
+from collections.abc import Callable
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
+from . import spectrum
 from .errors import InputError
 from .solution import ModalSolution
 from .solvers import modal_basis, mode_select
 from .solvers.sparse_eigen import BlockLanczos
 from .solvers.analytic import ModalResponse
+from .solvers.rigid import UnresolvedSpectrum
 
 if TYPE_CHECKING:
     from .model import Model
 
 Array = NDArray[np.float64]
 _KRYLOV: weakref.WeakKeyDictionary[Any, BlockLanczos] = weakref.WeakKeyDictionary()
-#: up to this many free coordinates ``tolerance=`` takes all modes at once: the dense
-#: eigen-solution is cheaper than starting the sparse one (cost study, 2026-11-29: 16²
-#: plate, 225 free, 0.04 s all modes against 0.16 s for the sparse path, which then needed
-#: more than half the modes anyway; at 32², 961 free, the sparse path was the faster)
-DENSE_BELOW = 256
 """Per model: the Krylov space and LU of the automatic mode count, kept for further load
 cases (a model's ``K`` and ``M`` never change; the space lives as long as the model)."""
+#: up to this many free coordinates the automatic mode count takes all modes at once: the
+#: dense eigen-solution costs no more than the sparse one (one BLAS thread, the bench
+#: plate at 1e-8, load average 4: 32², 961 free, 1.7 s all modes against 1.6 s for 201
+#: sparse modes; 24², 529 free, 0.18 s against 0.77 s; at 64² 35 s against 5 s)
+DENSE_BELOW = 1024
+DEFAULT_TOLERANCE = 1e-8
+"""The accuracy :meth:`splinedeform.Model.dynamic` keeps by default: largest control-point
+coordinate error at most this fraction of the largest static displacement, at any time."""
+DEFAULT_TIMES = 201
+"""Without ``times=`` the modes are chosen for this many evenly spaced times on ``[0, t_end]``."""
+_POINTWISE: weakref.WeakKeyDictionary[Any, float] = weakref.WeakKeyDictionary()
 
 
 def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
-             function_samples: int = 400, modes: int | None = None,
+             function_samples: int = 400, modes: int | str | None = None,
              omega_max: float | None = None, eigensolver: str = "auto",
-             tolerance: float | None = None, times: ArrayLike | None = None
-             ) -> ModalSolution:
+             tolerance: float | None = None, times: ArrayLike | None = None,
+             _of_static: bool = False) -> ModalSolution:
     """Closed-form modal solution; ``modes``/``omega_max`` truncate with mode acceleration,
-    ``tolerance`` chooses the number of modes (:mod:`~splinedeform.solvers.mode_count`)."""
+    ``tolerance`` chooses the number of modes (:mod:`~splinedeform.solvers.mode_count`).
+
+    With none of ``modes``, ``omega_max`` and ``tolerance`` the modes are chosen for
+    :data:`DEFAULT_TOLERANCE` where the bound applies (piecewise-constant loads from rest,
+    no rigid modes) and all modes are taken otherwise; ``modes="all"`` takes all modes.
+    """
+    requested = tolerance
+    if isinstance(modes, str):
+        if modes != "all":
+            raise InputError(f"modes must be an integer >= 1 or 'all', got {modes!r}")
+        if tolerance is not None or omega_max is not None:
+            raise InputError("modes='all' takes every mode: give it without tolerance= or "
+                             "omega_max=")
+        modes = None
+    elif modes is None and omega_max is None and tolerance is None:
+        tolerance = DEFAULT_TOLERANCE
     modes, omega_max = truncation_request(model, modes, omega_max)
     # the reduced force terms in space: modal terms of the identity basis
     spatial = forcing.modal_terms(sp.identity(model.n_free, format="csr"), t_end,
                                   function_samples)
     report: dict[str, Any] = {}
-    if tolerance is not None:
+    if requested is not None:
         report = _automatic_modes(model, spatial, d0, v0, t_end, tolerance, times,
-                                  modes, omega_max)
-        if report["modes"] < model.n_free:
-            modes, eigensolver = report["modes"], "sparse"
+                                  modes, omega_max, _of_static)
+    elif tolerance is not None and _bound_applies(model, spatial, d0, v0, eigensolver):
+        try:
+            report = _automatic_modes(model, spatial, d0, v0, t_end, tolerance, times,
+                                      modes, omega_max)
+        except UnresolvedSpectrum:
+            report = {}                  # all modes: the auto eigen-solution resolves them
+    if report and report["modes"] < model.n_free:
+        modes, eigensolver = report["modes"], "sparse"
     basis = model.modal_basis(eigensolver, modes, omega_max)
     start = time.perf_counter()
     M, _, K = model.matrices()
@@ -63,23 +95,80 @@ def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
     response = ModalResponse(lam, c, basis.project(M @ d0), basis.project(M @ v0),
                              jumps, harmonics)
     correction, truncation = report.pop("correction", None), {}
+    estimate, chosen_at = report.pop("estimate", None), report.pop("times", None)
     if not basis.complete:
         correction, truncation = _truncation(model, basis, spatial, d0, v0, correction)
     if report:
         truncation.update({key: report[key] for key in ("tolerance", "bound", "omitted_static",
-                                                        "static_residual") if key in report})
+                                                        "static_residual", "met")
+                           if key in report})
     timings = dict(model.timings)
     timings["modal setup"] = time.perf_counter() - start
+    accuracy = None
+    if estimate is not None and not basis.complete:
+        of_static = float(report["of_static"])
+        accuracy = Accuracy(of_static, estimate, chosen_at,
+                            lambda at: analytic(model, forcing, t_end, d0, v0,
+                                                function_samples, tolerance=of_static,
+                                                times=at, _of_static=True))
     return ModalSolution(model.readout, t_end, forcing, timings, basis, response, truncation,
-                         correction)
+                         correction, accuracy)
+
+
+@dataclass
+class Accuracy:
+    """What keeps a solution of the automatic mode count within ``tolerance`` at any time.
+
+    ``estimate`` bounds the error of the solution's basis at any ``t``; when it exceeds
+    ``tolerance`` at a time asked (only just after a load jump: the bound is
+    non-increasing between jumps), ``refine(times)`` gives a solution whose modes are chosen
+    for ``times``, which serves such times from then on. ``chosen_at``: the times the basis
+    was chosen for (the bound holds there).
+    """
+
+    tolerance: float
+    estimate: mode_select.ErrorEstimate
+    chosen_at: Array
+    refine: Callable[[Array], ModalSolution]
+
+    def outside(self, times: Array) -> Array:
+        """Mask of the ``times`` at which the basis' bound exceeds the tolerance."""
+        times = np.asarray(times, dtype=float)
+        ask = ~np.isin(times, self.chosen_at)
+        out = np.zeros(times.shape, dtype=bool)
+        if np.any(ask):
+            out[ask] = self.estimate.relative(times[ask]) > self.tolerance
+        return out
+
+
+def _bound_applies(model: Model, spatial: tuple[list, list], d0: Array, v0: Array,
+                   eigensolver: str) -> bool:
+    """Whether the default call counts its modes: the bound covers the problem
+    (piecewise-constant load from rest, no rigid modes), no eigensolver was asked for, and
+    all modes are not cheaper (more than :data:`DENSE_BELOW` free coordinates, no
+    separable factors, which give all modes in ``O(n^{3/2})``)."""
+    return bool(eigensolver == "auto" and not spatial[1] and not np.any(d0)
+                and not np.any(v0) and model.n_free > DENSE_BELOW
+                and model.rigid_modes == 0 and spectrum.separable_reason(model) is not None)
+
 
 def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Array,
                      t_end: float, tolerance: Any, times: ArrayLike | None,
-                     modes: int | None, omega_max: float | None) -> dict[str, Any]:
-    """Lowest modes meeting ``tolerance`` (relative M-norm at ``times``): the report of
+                     modes: int | None, omega_max: float | None, of_static: bool = False
+                     ) -> dict[str, Any]:
+    """Lowest modes meeting ``tolerance`` at ``times``: the largest control-point coordinate
+    error relative to the largest displacement on ``[0, t_end]`` (``of_static``: to the
+    largest static displacement ``S``). The report of
     :func:`~splinedeform.solvers.mode_select.automatic_basis` (``modes = n_free``: all),
-    with its static correction under ``"correction"``; all modes, exact, on nets of at most
-    :data:`DENSE_BELOW` free coordinates."""
+    with its static correction under ``"correction"``, its error estimate under
+    ``"estimate"`` and the tolerance relative to ``S`` it met under ``"of_static"``; all
+    modes, exact, on nets of at most :data:`DENSE_BELOW` free coordinates.
+
+    The bound is relative to ``S``. When the motion stays below it (a short horizon),
+    ``D = max_t |d_p(t)| − bound(t)·S`` at the coordinate ``p`` of ``S``, on the
+    :data:`DEFAULT_TIMES` grid and ``times``, is a lower bound of the largest displacement,
+    and the modes are chosen again for ``tolerance · D / S``.
+    """
     try:
         tolerance = float(tolerance)
     except (TypeError, ValueError):
@@ -93,20 +182,84 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
                          "rest on a model without rigid modes; give modes=k otherwise")
     if model.n_free <= DENSE_BELOW:
         return {"tolerance": tolerance, "modes": model.n_free, "bound": 0.0}
-    at = np.linspace(0.0, t_end, 201) if times is None else np.asarray(times, dtype=float)
+    at = (np.linspace(0.0, t_end, DEFAULT_TIMES) if times is None
+          else np.asarray(times, dtype=float).ravel())
     m = model.material
     M, _, K = model.matrices()
     krylov = _KRYLOV.get(model)
     if krylov is None:
         krylov = _KRYLOV[model] = BlockLanczos(K, M)
+    gamma, beta, c_inf = m.damping / m.mass, m.rayleigh, pointwise_factor(model)
+    out_of_reach = model.n_free > modal_basis.DENSE_MAX    # all modes cannot be had
     basis, correction, report = mode_select.automatic_basis(
-        K, M, spatial[0], m.damping / m.mass, m.rayleigh, at, tolerance, krylov=krylov)
+        K, M, spatial[0], gamma, beta, at, tolerance, krylov=krylov, pointwise=c_inf,
+        best_effort=out_of_reach)
+    report["of_static"] = tolerance
+    if basis is not None and not of_static:
+        grid = np.union1d(np.linspace(0.0, t_end, DEFAULT_TIMES), at)
+        largest = _largest_below(basis, correction, report, spatial[0], gamma, beta, grid)
+        if largest < report["scale"]:
+            below = tolerance * max(largest, 0.0) / report["scale"]
+            basis, correction, report = (None, None, {"tolerance": tolerance}) if below <= 0 \
+                else mode_select.automatic_basis(K, M, spatial[0], gamma, beta, at, below,
+                                                 krylov=krylov, pointwise=c_inf,
+                                                 best_effort=out_of_reach)
+            report.update(tolerance=tolerance, of_static=below)
+            if basis is not None:
+                report["bound"] *= tolerance / below
+    if report.get("met") is False:
+        warnings.warn(
+            f"the tolerance {tolerance:g} is not met at every time asked: all "
+            f"{model.n_free} modes would be needed (times just after a load jump), more than "
+            f"a dense eigen-solution takes ({modal_basis.DENSE_MAX}); {report['modes']} modes "
+            f"reach a bound of {report['bound']:.2g} (solution.truncation['bound']). Ask "
+            "times further after the jumps, a looser tolerance=, or fewer cells",
+            stacklevel=4)
     if basis is None:
         report["modes"] = model.n_free
     else:
         model._bases[("sparse", report["modes"], None)] = basis
         report["correction"] = correction
+        report["times"] = at
     return report
+
+
+def _largest_below(basis: Any, correction: Any, report: dict[str, Any], jumps: list,
+                   gamma: float, beta: float, times: Array) -> float:
+    """A lower bound of the largest displacement coordinate: at the coordinate of the
+    largest static displacement, ``max_t |d_m(t)| − bound(t) · S`` over ``times``
+    (``d_m``: the chosen basis with its static correction)."""
+    merged: dict[float, Array] = {}
+    for t_j, F in jumps:
+        merged[t_j] = merged.get(t_j, 0.0) + np.asarray(F, dtype=float)
+    order = sorted(merged)
+    coef = [basis.project(merged[t_j]) / basis.lam[:, None] for t_j in order]
+    statics = np.cumsum([basis.expand(g[None])[0] + part
+                         for g, part in zip(coef, correction.jump_parts)], axis=0)
+    _, p, c = np.unravel_index(int(np.argmax(np.abs(statics))), statics.shape)
+    lam = basis.lam
+    zero = np.zeros((lam.size, 3))
+    response = ModalResponse(lam, gamma + beta * lam, zero, zero,
+                             [(t_j, basis.project(merged[t_j])) for t_j in order], [])
+    row = basis.phi[p]                          # a DenseBasis (automatic_basis)
+    d = response(times)[0][:, :, c] @ row + correction(times)[:, p, c]
+    error = report["estimate"].relative(times) * report["scale"]
+    return float(np.max(np.abs(d) - error))
+
+
+def pointwise_factor(model: Model) -> float:
+    """``c_∞ ≥ max_p √((M_r⁻¹)_pp)`` of the model (:func:`.mode_select.pointwise_bound`):
+    for the parametric consistent mass ``M = μ G0u⊗G0v`` the diagonal of ``M⁻¹`` is the
+    Kronecker product of the 1-D ones over ``μ``; cached per model."""
+    if model not in _POINTWISE:
+        M = model.matrices()[0]
+        inverse = None
+        if model.physics == "parametric" and model.mass_matrix == "consistent":
+            gu, gv = (np.diag(np.linalg.inv(g[0].toarray())) for g in (model.gram_u,
+                                                                       model.gram_v))
+            inverse = np.kron(gu, gv) / model.material.mass
+        _POINTWISE[model] = mode_select.pointwise_bound(M, model.constraints.T, inverse)
+    return _POINTWISE[model]
 
 def truncation_request(model: Model, modes: int | None, omega_max: float | None
                        ) -> tuple[int | None, float | None]:

@@ -21,7 +21,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
-from .assembly import _largest, mass, stiffness  # noqa: F401 (public here too)
+from .assembly import (_largest, full_matrices, mass, reduced_matrices,  # noqa: F401
+                       stiffness)
 from .boundary import Constraints, build_constraints
 from .errors import InputError, SingularSystemError
 from .loads import Load, as_load, static_time
@@ -33,9 +34,11 @@ from .modal_solve import check_count as _check_count
 from .solution import ModalSolution, Readout, SampledSolution, StaticSolution
 from . import spectrum
 from .solvers import modal_basis, numeric
+from .solvers.factor import factorise
 from .solvers.forcing import ReducedForcing
 from .solvers.system import KroneckerFactors, Reduction
 from .surface import Surface
+from .threads import owned
 
 Array = NDArray[np.float64]
 METHODS = ("analytic", "newmark", "radau3", "radau5", "radau7", "genalpha", "rk45", "dop853",
@@ -130,12 +133,12 @@ class Model:
         if physics == "intrinsic":
             K, M = intrinsic.matrices(surface, material, mass_matrix == "lumped")
         else:
-            K = stiffness(self.gram_u, self.gram_v, material)
-            M = mass(self.gram_u, self.gram_v, material.mass, mass_matrix == "lumped")
+            K, M = full_matrices(self.gram_u, self.gram_v, material, mass_matrix == "lumped")
         T = self.constraints.T
         self.K_full, self.M_full = K, M
-        self._K = (T.T @ K @ T).tocsc()
-        self._M = (T.T @ M @ T).tocsc()
+        reduced = None if physics == "intrinsic" else reduced_matrices(
+            self.gram_u, self.gram_v, material, mass_matrix == "lumped", M, self.constraints)
+        self._K, self._M = reduced or ((T.T @ K @ T).tocsc(), (T.T @ M @ T).tocsc())
         if self._M.nnz:
             check_scales(material, _largest(self._K), _largest(self._M))
         self._C = ((material.damping / material.mass) * self._M
@@ -183,6 +186,7 @@ class Model:
         return np.asarray(self.constraints.T.T @ F_full)
 
     # -- static ----------------------------------------------------------------------
+    @owned
     def static(self, load: Load | None, t: float | None = None) -> StaticSolution:
         """Equilibrium ``K_r d = Tᵀ F(t)`` by a sparse direct solve.
 
@@ -217,7 +221,9 @@ class Model:
             raise SingularSystemError(message + f" ({self.rigid_modes} deformation(s) without "
                                       "energy, counted from the weights and the constraints)")
         try:
-            lu = spla.splu(self._K)
+            lu = getattr(self, "_stiffness_factor", None)
+            if lu is None:                     # once constrained K is SPD: a Cholesky,
+                lu = self._stiffness_factor = factorise(self._K)   # kept for further loads
             d = lu.solve(F)
         except RuntimeError:
             raise SingularSystemError(message) from None
@@ -240,6 +246,7 @@ class Model:
             "Raise the smallest weight, or use fewer cells or a lower degree")
 
     # -- modes -------------------------------------------------------------------------
+    @owned
     def eigen(self, k: int | None = None) -> tuple[Array, Array]:
         """Lowest ``k`` (default all) eigenpairs of ``K_r φ = λ M_r φ`` with ``Φᵀ M_r Φ = I``.
 
@@ -254,6 +261,7 @@ class Model:
         """
         return spectrum.eigen(self, None if k is None else _check_count(k, self.n_free))
 
+    @owned
     def modal_basis(self, eigensolver: str = "auto", modes: int | None = None,
                     omega_max: float | None = None) -> modal_basis.ModalBasis:
         """Modes as a :class:`~splinedeform.solvers.modal_basis.ModalBasis` (cached).
@@ -313,6 +321,7 @@ class Model:
             raise InputError(f"{what} moves control points that the boundary conditions fix")
         return free
 
+    @owned
     def dynamic(self, load: Load | None, t_end: float, method: str = "analytic",
                 times: ArrayLike | None = None, initial_displacement: ArrayLike | None = None,
                 initial_velocity: ArrayLike | None = None, **options: Any) -> Any:
@@ -325,18 +334,27 @@ class Model:
             ``analytic`` is the closed-form modal solution, valid at any ``t``.
             Numerical methods integrate to the output ``times``.
         times : array, optional
-            Output times for numerical methods (default 201 evenly spaced on ``[0, t_end]``).
+            Output times for numerical methods (default 201 evenly spaced on ``[0, t_end]``);
+            for ``analytic``, the times the modes are chosen for (below).
         options
-            ``analytic``: ``function_samples`` (piecewise-constant sampling of time-dependent
-            ``Function`` loads, default 400); ``modes`` (keep the lowest k modes) or
-            ``omega_max`` (keep ``ω <= omega_max``), both with the exact static part of the
-            omitted modes (mode acceleration) and a report in ``solution.truncation``;
-            ``tolerance`` (piecewise-constant loads from rest): the fewest lowest modes for
-            which an a-priori bound of the omitted modes' dynamic response at ``times``
-            (default 201 on ``[0, t_end]``; one time for one state) is at most ``tolerance``
-            of the largest static displacement in the M-norm
-            (:mod:`splinedeform.solvers.mode_select`), the bound reached in
-            ``solution.truncation["bound"]``;
+            ``analytic``: by default (no ``modes``, ``omega_max`` or ``tolerance``) the modes
+            are chosen for ``tolerance = 1e-8``
+            (:data:`splinedeform.modal_solve.DEFAULT_TOLERANCE`) where the bound applies
+            (piecewise-constant loads from rest, no rigid modes, more than 1024 free
+            coordinates and no separable factors), all modes otherwise;
+            ``modes="all"`` takes all modes. ``tolerance``: the fewest lowest modes, plus
+            the exact static part of the rest, for which an a-priori bound of the omitted
+            modes' dynamic response ``c_∞ Σ_j ‖R_j‖_M E(t − t_j)`` is at most ``tolerance``
+            of the largest static displacement ``max_t ‖K⁻¹F(t)‖_∞``, in the largest
+            control-point coordinate (``c_∞ ≥ max_p √((M⁻¹)_pp)``,
+            :mod:`splinedeform.solvers.mode_select`) at ``times`` (default 201 on
+            ``[0, t_end]``; one time for one state). It holds at **any** time asked later:
+            ``E`` never grows between jumps, and a time where the basis' bound misses
+            (just after a jump) is computed with modes chosen for it
+            (``solution.accuracy``); the bound reached is ``solution.truncation["bound"]``.
+            ``modes`` (keep the lowest k modes) or ``omega_max`` (keep ``ω <= omega_max``),
+            both with the exact static part of the omitted modes (mode acceleration) and a
+            report in ``solution.truncation``;
             ``eigensolver`` (``"auto"``, ``"dense"``, ``"separable"``, ``"sparse"``, see
             :func:`splinedeform.solvers.modal_basis.choose`). ``newmark``: ``dt``.
             ``radau3/5/7`` (Radau IIA, order 5/9/13) and ``genalpha``: ``dt`` or
@@ -356,9 +374,7 @@ class Model:
         d0, v0 = self.initial_state(initial_displacement, initial_velocity)
         forcing = ReducedForcing(self.reduction, load)
         if method == "analytic":
-            if options.get("tolerance") is not None:
-                options["times"] = times
-            return self._analytic(forcing, t_end, d0, v0, **options)
+            return self._analytic(forcing, t_end, d0, v0, times=times, **options)
         start = time.perf_counter()
         M, C, K = self.matrices()
         out_times, d, v, stats = numeric.run(M, C, K, forcing, forcing.breakpoints, method,

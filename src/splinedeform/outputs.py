@@ -36,6 +36,9 @@ def _mesh_net(result: RunResult) -> Any:
     return result.nets[-1]
 
 
+#: what the frames of each solve kind are called in the pictures
+FRAME_LABELS = {"dynamic": "t", "static": "load factor", "modes": "phase"}
+
 #: STEP / IGES output formats and their file suffixes (the 'cad-step' extra)
 STEP_FILES = {"step": ".step", "iges": ".igs"}
 
@@ -58,10 +61,41 @@ def planned_outputs(result: RunResult) -> list[str]:
             names.append("probes.png")
         if result.omegas is not None:
             names.append("modes.png")
+        if getattr(result.built.model, "physics", None) == "shell":
+            names.append("stresses.png")
     names += [f"{name}.{ext}" for ext in ("gif", "mp4") if ext in formats]
     names += ["viewer.html"] if "viewer" in formats else []
     names += ["report.json", "report.md"] if "report" in formats else []
+    return names + mode_file_names(result)
+
+
+def mode_file_names(result: RunResult) -> list[str]:
+    """The per-mode files of a modes solve: ``<name>_modes.vtu`` (vtu), the frames of each
+    mode ``<name>_mode<k>_nets.json/.npz`` (json, npz) and the animation of each mode of
+    ``output.animate_modes`` but the first, ``<name>_mode<k>.gif/.mp4`` (gif, mp4)."""
+    s = result.scenario
+    if s.solve.kind != "modes" or result.mode_nets is None:
+        return []
+    formats, name = s.output.formats, s.name
+    names = [f"{name}_modes.vtu"] if "vtu" in formats else []
+    names += [f"{name}_mode{k}_nets.{ext}" for k in range(1, len(result.mode_nets) + 1)
+              for ext in ("json", "npz") if ext in formats]
+    names += [f"{name}_mode{k}.{ext}" for k in animated_modes(result) if k != 1
+              for ext in ("gif", "mp4") if ext in formats]
     return names
+
+
+def animated_modes(result: RunResult) -> tuple[int, ...]:
+    """``output.animate_modes`` (mode numbers from 1), mode 1 when not given."""
+    return tuple(result.scenario.output.animate_modes or (1,))
+
+
+def mode_frames(result: RunResult, k: int) -> Any:
+    """Control nets of mode ``k`` (from 1) over one period: ``P_rest + sin(2π φ) D_k`` at the
+    phases ``φ`` of the frames (the frames of a modes solve are those of mode 1)."""
+    phase = np.asarray(result.times, dtype=float)
+    return result.rest_net + np.sin(2.0 * np.pi * phase)[:, None, None, None] \
+        * result.mode_nets[k - 1]
 
 
 def write_outputs(result: RunResult, folder: Path, stages: Stages) -> None:
@@ -111,9 +145,13 @@ def _write_files(result: RunResult, folder: Path, stages: Stages) -> None:
                 result.outputs.append((f"mesh .{ext}", export.write_mesh(
                     folder / f"{name}.{ext}", vertices, faces, point_data=data)))
     if "vtu" in formats:
+        from .export.shell_fields import is_shell, stress_fields
+
+        model = result.built.model          # a shell's frames also carry its stresses
+        fields = stress_fields(model, rest, nets, res) if is_shell(model) else None
         with stages.stage("time series"):
             result.outputs.append(("time series .pvd", export.write_time_series(
-                folder, name, surface, rest, times, nets, resolution=res)))
+                folder, name, surface, rest, times, nets, resolution=res, fields=fields)))
     if "json" in formats or "npz" in formats:
         with stages.stage("control nets"):
             wanted = [ext for ext in export.CONTROL_NET_FORMATS if ext in formats]
@@ -127,14 +165,15 @@ def _write_files(result: RunResult, folder: Path, stages: Stages) -> None:
             label = {"dynamic": "time", "static": "load factor",
                      "modes": "phase"}[scenario.solve.kind]
             result.outputs.append(("NURBS surfaces .3dm", write_frames_3dm(
-                folder / f"{name}.3dm", surface, times, nets, label)))
+                folder / f"{name}.3dm", surface, times, nets, label,
+                units=result.built.units)))
     for ext, suffix in STEP_FILES.items():
         if ext in formats:
             from .cad_step import write_frames_step
 
             with stages.stage(f"CAD surfaces {suffix}"):
                 result.outputs.append((f"NURBS surfaces {suffix}", write_frames_step(
-                    folder / f"{name}{suffix}", surface, times, nets)))
+                    folder / f"{name}{suffix}", surface, times, nets, result.built.units)))
     if "images" in formats:
         _write_images(result, folder, stages)
     for ext in ("gif", "mp4"):
@@ -147,6 +186,8 @@ def _write_files(result: RunResult, folder: Path, stages: Stages) -> None:
             result.outputs.append(("viewer", write_viewer(
                 folder / "viewer.html", surface, rest, times, nets, resolution=res,
                 title=scenario.title or scenario.name)))
+    if mode_file_names(result):
+        _write_mode_files(result, folder, stages)
     if "report" in formats:
         with stages.stage("report"):
             result.report = make_report(result)
@@ -198,6 +239,22 @@ def dense_probes(result: RunResult, samples: int = DENSE_PROBE_SAMPLES
     return t, out
 
 
+def picture_warp(result: RunResult) -> float:
+    """The warp factor of the pictures and the animation: ``output.warp``, or for "auto"
+    :func:`splinedeform.viz.warp.auto_warp` of the largest displacement and the largest
+    side of the control net's bounding box (1 for a modes solve, whose amplitude is
+    chosen for drawing)."""
+    from .viz.warp import auto_warp
+
+    warp = result.scenario.output.warp
+    if warp != "auto":
+        return float(warp)
+    if result.scenario.solve.kind == "modes":       # drawn at 10 % of the size already
+        return 1.0
+    rest = np.asarray(result.rest_net, dtype=float).reshape(-1, 3)
+    return auto_warp(float(result.max_displacement), float(np.ptp(rest, axis=0).max()))
+
+
 def _write_images(result: RunResult, folder: Path, stages: Stages) -> None:
     """surfaces.png (rest shape and the frame of largest displacement), probes.png, modes.png."""
     from . import viz
@@ -205,12 +262,13 @@ def _write_images(result: RunResult, folder: Path, stages: Stages) -> None:
     surface, rest = result.built.surface, result.rest_net
     kind = result.scenario.solve.kind
     with stages.stage("images"):
-        label = {"dynamic": "t", "static": "load factor", "modes": "phase"}[kind]
+        label = FRAME_LABELS[kind]
         peak = peak_frame(result)
         result.outputs.append(("picture", viz.render_surfaces(
             folder / "surfaces.png", surface, rest, [result.nets[0], result.nets[peak]],
             [f"initial ({label} = {result.times[0]:g})",
-             f"largest displacement ({label} = {result.times[peak]:.4g})"])))
+             f"largest displacement ({label} = {result.times[peak]:.4g})"],
+            warp=picture_warp(result), camera=result.scenario.output.camera)))
         if kind == "dynamic":
             dense = dense_probes(result)
             result.outputs.append(("probe plot", viz.plot_probes(
@@ -218,18 +276,61 @@ def _write_images(result: RunResult, folder: Path, stages: Stages) -> None:
                 *(dense if dense is not None else (None, None)))))
         if result.omegas is not None:
             result.outputs.append(("mode shapes", viz.plot_modes(
-                folder / "modes.png", surface, result.omegas, result.mode_shapes)))
+                folder / "modes.png", surface, result.omegas, result.mode_shapes,
+                camera=result.scenario.output.camera)))
+        from .export.shell_fields import is_shell, peak_stress_frame
+
+        if is_shell(result.built.model):
+            from .viz.stresses import render_stresses
+
+            f = peak_stress_frame(result.built.model, rest, result.nets,
+                                  result.scenario.output.resolution)
+            result.outputs.append(("stress picture", render_stresses(
+                folder / "stresses.png", result.built.model, rest, result.nets[f],
+                f"{label} = {result.times[f]:.4g}", result.scenario.output.resolution)))
 
 
-def _write_animation(result: RunResult, path: Path, stages: Stages) -> None:
+def _write_animation(result: RunResult, path: Path, stages: Stages, nets: Any = None,
+                     what: str = "animation", label: str | None = None) -> None:
     from .viz import write_animation
 
-    stage = f"animation {path.suffix}"
+    stage = f"{what} {path.suffix}"
     with stages.stage(stage):
         result.outputs.append((stage, write_animation(
-            path, result.built.surface, result.rest_net, result.times, result.nets,
+            path, result.built.surface, result.rest_net, result.times,
+            result.nets if nets is None else nets,
             resolution=result.scenario.output.resolution,
-            progress=lambda done, total: stages.tick(stage, done, total + 1))))
+            progress=lambda done, total: stages.tick(stage, done, total + 1),
+            fps=result.scenario.output.fps, warp=picture_warp(result),
+            camera=result.scenario.output.camera,
+            label=label or FRAME_LABELS[result.scenario.solve.kind])))
+
+
+def _write_mode_files(result: RunResult, folder: Path, stages: Stages) -> None:
+    """The files of :func:`mode_file_names`: mode fields, per-mode nets and animations."""
+    from . import export
+
+    s = result.scenario
+    formats, name, res = s.output.formats, s.name, s.output.resolution
+    surface = result.built.surface
+    if "vtu" in formats:
+        with stages.stage("mode fields .vtu"):
+            result.outputs.append(("mode fields .vtu", export.write_mode_fields(
+                folder / f"{name}_modes.vtu", surface, result.mode_nets, resolution=res)))
+    wanted = [ext for ext in export.CONTROL_NET_FORMATS if ext in formats]
+    if wanted:
+        with stages.stage("mode nets"):
+            for k in range(1, len(result.mode_nets) + 1):
+                for path in export.write_control_nets(folder, f"{name}_mode{k}_nets", surface,
+                                                      result.times, mode_frames(result, k),
+                                                      formats=wanted):
+                    result.outputs.append((f"mode {k} nets {path.suffix}", path))
+    for k in animated_modes(result):
+        for ext in ("gif", "mp4"):
+            if k != 1 and ext in formats:
+                _write_animation(result, folder / f"{name}_mode{k}.{ext}", stages,
+                                 mode_frames(result, k), f"mode {k}",
+                                 f"mode {k} (ω = {float(result.omegas[k - 1]):.5g}), phase")
 
 
 def make_report(result: RunResult) -> dict[str, Any]:
@@ -241,6 +342,7 @@ def make_report(result: RunResult) -> dict[str, Any]:
                     "degree": [surface.basis_u.degree, surface.basis_v.degree],
                     "knots": [surface.basis_u.kind, surface.basis_v.kind],
                     "domain": [list(d) for d in surface.domain],
+                    "units": result.built.units or "none",
                     "fit_error": surface.fit_error,
                     _unknowns(result.built.model): result.n_free},
         "solver": {"kind": s.solve.kind,
@@ -250,10 +352,16 @@ def make_report(result: RunResult) -> dict[str, Any]:
                    "max displacement": result.max_displacement},
         "timings": {**_solution_timings(result), **result.timings},
     }
+    from .export.shell_fields import is_shell, mode_maxima, stress_report
+
+    shell = is_shell(result.built.model)
     if result.omegas is not None:
         report["modes"] = {"mode": list(range(1, len(result.omegas) + 1)),
                            "omega": result.omegas,
                            "frequency (omega / 2 pi)": np.asarray(result.omegas) / (2 * np.pi)}
+        if shell and result.shell_modes is not None:
+            report["modes"].update(mode_maxima(result.built.model, result.shell_modes,
+                                               s.output.resolution))
     if result.energy is not None:
         report["energies"] = result.energy
     frame_label = {"dynamic": "time", "static": "load factor", "modes": "phase"}[s.solve.kind]
@@ -262,6 +370,10 @@ def make_report(result: RunResult) -> dict[str, Any]:
         probes.update({f"{name} d{c}": d[:, i] for i, c in enumerate("xyz")})
         probes[f"{name} magnitude"] = np.linalg.norm(d, axis=1)
     report["probes"] = probes
+    if shell:
+        report.update(stress_report(result.built.model, result.rest_net, result.times,
+                                    result.nets, s.output.resolution, result.probe_points,
+                                    frame_label))
     return report
 
 

@@ -13,13 +13,20 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterator
 
+from ._progress import reporting_simulated_time
 from .budget import Budget, check as check_budget
 from .errors import InputError
 from .outputs import make_report, planned_outputs, summary_rows, write_outputs
-from .scenario import Built, Scenario, SolveSpec, _located, build
+from .load_scale import ScaledSolution, load_scale
+from .scenario import Built, Scenario, SolveSpec, _located, build, build_load
 
 #: ``progress(stage, done, total)``, called as each stage advances
 ProgressCallback = Callable[[str, int, int], None]
+
+
+class RunInterrupted(KeyboardInterrupt):
+    """A run stopped by Ctrl-C (SIGINT); ``str()`` is one line saying where it stopped, what
+    it left incomplete and that re-running the same command cleans it up."""
 
 
 @dataclass
@@ -38,6 +45,11 @@ class RunResult:
     nets: Any
     omegas: Any = None
     mode_shapes: Any = None
+    #: each computed mode as a displacement of the control net ``(k, n_u, n_v, 3)``, scaled
+    #: as the frames of a modes solve draw it (:func:`mode_displacements`)
+    mode_nets: Any = None
+    #: the shell's mass-normalised mode shapes ``(k, n_u, n_v, 3)`` (None otherwise)
+    shell_modes: Any = None
     probes: dict[str, Any] = field(default_factory=dict)
     probe_points: dict[str, tuple[float, float]] = field(default_factory=dict)
     energy: dict[str, Any] | None = None
@@ -65,8 +77,10 @@ class _Stages:
     def __init__(self, progress: ProgressCallback | None) -> None:
         self.progress = progress
         self.timings: dict[str, float] = {}
+        self.current = "start"
 
     def tick(self, stage: str, done: int, total: int) -> None:
+        self.current = stage
         if self.progress is not None:
             self.progress(stage, done, total)
 
@@ -77,6 +91,12 @@ class _Stages:
         yield
         self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - start
         self.tick(name, 1, 1)
+
+    def simulated(self, name: str) -> Any:
+        """A block in which the integrators' simulated time goes to the bar of ``name``
+        (when the progress callback draws it: a ``receiver(stage)`` method)."""
+        receiver = getattr(self.progress, "receiver", None)
+        return reporting_simulated_time(receiver(name) if callable(receiver) else None)
 
 
 def run(scenario: Scenario, outdir: str | Path | None = None,
@@ -98,15 +118,30 @@ def run(scenario: Scenario, outdir: str | Path | None = None,
     stages = _Stages(progress)
     formats = scenario.output.formats
     folder = _prepare_outdir(scenario, outdir) if formats else None
-    with stages.stage("build"):
-        built = build(scenario)
-        check_budget(scenario, built.model, budget)
-    result = _solve(scenario, built, stages)
-    result.timings = stages.timings
-    if folder is not None:
-        write_outputs(result, folder, stages)
+    try:
+        with stages.stage("build"):
+            built = build(scenario)
+            check_budget(scenario, built.model, budget)
+        result = _solve(scenario, built, stages)
+        result.timings = stages.timings
+        if folder is not None:
+            write_outputs(result, folder, stages)
+    except KeyboardInterrupt:
+        raise RunInterrupted(_interrupted(scenario, folder, stages.current)) from None
     result.timings = dict(stages.timings)
     return result
+
+
+def _interrupted(scenario: Scenario, folder: Path | None, stage: str) -> str:
+    """The line said when Ctrl-C stops a run during ``stage``."""
+    from .export.run_folder import incomplete_note
+
+    note = incomplete_note(folder, scenario.name) if folder is not None else None
+    if note is not None:
+        return (f"interrupted during {stage}: {note}; run the same command again to clean "
+                "it up and write the whole set")
+    where = f" in {folder}" if folder is not None else ""
+    return f"interrupted during {stage}: no output of this run was written{where}"
 
 
 def _prepare_outdir(scenario: Scenario, outdir: str | Path | None) -> Path:
@@ -142,21 +177,29 @@ def _solve(scenario: Scenario, built: Built, stages: _Stages) -> RunResult:
     solution, omegas, shapes = None, None, None
     times = np.asarray(solve.frame_times() if solve.kind == "dynamic"
                        else np.linspace(0.0, 1.0, solve.frames))
-    with stages.stage("solve"), _located(scenario, "solve"):
+    scale = load_scale(scenario)           # extreme loads solved at order one, then scaled
+    with stages.stage("solve"), _located(scenario, "solve"), stages.simulated("solve"):
+        load = built.load if scale == 1.0 else build_load(scenario, scale)
         if solve.kind == "static":
-            solution = model.static(built.load)
+            solution = model.static(load)
         elif solve.kind == "dynamic":
-            solution = model.dynamic(built.load, solve.t_end, method=solve.method,
+            solution = model.dynamic(load, solve.t_end, method=solve.method,
                                      **_method_options(solve, times, scenario.output.time))
+        if solution is not None and scale != 1.0:
+            solution = ScaledSolution(solution, scale)
     if solve.modes > 0 and solve.kind != "static":
         with stages.stage("modes"), _located(scenario, "solve.modes"):
             omegas, shapes = model.modes(min(solve.modes, model.n_free))
+    mode_nets = None if shapes is None else mode_displacements(built.surface, shapes)
     with stages.stage("frames"), _located(scenario, "solve"):
-        nets = _frames(scenario, built, solution, times, shapes)
+        nets = _frames(scenario, built, solution, times, mode_nets)
+    shell_modes = None
     if shapes is not None and shapes.ndim == 4:     # the shell's modes move x, y, z
+        shell_modes = shapes
         shapes = np.einsum("kabc,abc->kab", shapes, _net_normals(built.surface))
     result = RunResult(scenario=scenario, built=built, solution=solution, times=times,
-                       nets=nets, omegas=omegas, mode_shapes=shapes)
+                       nets=nets, omegas=omegas, mode_shapes=shapes, mode_nets=mode_nets,
+                       shell_modes=shell_modes)
     with np.errstate(over="ignore", invalid="ignore"):
         _measure(result)
     _require_finite(result)
@@ -224,7 +267,23 @@ def _method_options(solve: SolveSpec, times: Any, mesh_time: float | None) -> di
     return options
 
 
-def _frames(scenario: Scenario, built: Built, solution: Any, times: Any, shapes: Any) -> Any:
+def mode_displacements(surface: Any, shapes: Any) -> Any:
+    """The modes as control-net displacements ``D_k (k, n_u, n_v, 3)``, each scaled so that
+    its largest control-point displacement is 0.1 × the largest side of the net's box.
+
+    A scalar mode ``φ_k (n_u, n_v)`` moves along the net's normals (``φ_k n``); a shell
+    mode ``(n_u, n_v, 3)`` is a displacement net already.
+    """
+    import numpy as np
+
+    D = shapes if shapes.ndim == 4 else shapes[..., None] * _net_normals(surface)[None]
+    rest = surface.control_points
+    size = float(np.ptp(rest.reshape(-1, 3), axis=0).max()) or 1.0
+    peak = np.linalg.norm(D, axis=-1).max(axis=(1, 2))
+    return D * (0.1 * size / np.where(peak > 0, peak, 1.0))[:, None, None, None]
+
+
+def _frames(scenario: Scenario, built: Built, solution: Any, times: Any, mode_nets: Any) -> Any:
     """Control nets ``(F, n_u, n_v, 3)`` at the frame times (see :class:`RunResult`)."""
     import numpy as np
 
@@ -235,13 +294,8 @@ def _frames(scenario: Scenario, built: Built, solution: Any, times: Any, shapes:
     if kind == "static":
         d = solution.control_points() - rest
         return rest + times[:, None, None, None] * d
-    # a scalar mode moves along the normals; a shell mode is a displacement net already
-    shape = shapes[0] if shapes.ndim == 4 else shapes[0][..., None] * _net_normals(built.surface)
-    size = float(np.ptp(rest.reshape(-1, 3), axis=0).max()) or 1.0
-    peak = float(np.linalg.norm(shape, axis=-1).max()) or 1.0
-    amplitude = 0.1 * size / peak
-    wave = np.sin(2.0 * np.pi * times)
-    return rest + amplitude * wave[:, None, None, None] * shape
+    # the lowest mode over one period of its phase
+    return rest + np.sin(2.0 * np.pi * times)[:, None, None, None] * mode_nets[0]
 
 
 def _net_normals(surface: Any) -> Any:
@@ -266,16 +320,22 @@ def _measure(result: RunResult) -> None:
     scenario, surface = result.scenario, result.built.surface
     D = result.nets - surface.control_points
     probes = scenario.output.probes or (_domain_centre(surface),)
+    at = np.asarray(probes, dtype=float)
+    E = surface.evaluation_matrix(at[:, 0], at[:, 1])          # (P, n_u n_v), sparse
+    F = D.shape[0]
+    histories = (E @ np.moveaxis(D.reshape(F, -1, 3), 0, 1).reshape(E.shape[1], F * 3)
+                 ).reshape(len(probes), F, 3)
     for i, (u, v) in enumerate(probes, start=1):
-        E = surface.evaluation_matrix([u], [v]).toarray()[0].reshape(surface.shape)
         name = f"p{i} ({u:g}, {v:g})"
-        result.probes[name] = np.einsum("kl,fklc->fc", E, D)
+        result.probes[name] = histories[i - 1]
         result.probe_points[name] = (float(u), float(v))
     uu, vv = surface.sample_parameters(scenario.output.resolution)
     Bu = surface.basis_u.matrix(uu).toarray()
     Bv = surface.basis_v.matrix(vv).toarray()
     grid = np.einsum("ik,fklc,jl->fijc", Bu, D, Bv, optimize=True)
-    result.max_displacement = float(np.linalg.norm(grid, axis=-1).max())
+    size = float(np.abs(grid).max(initial=0.0))      # |d| of tiny d without squares underflowing
+    result.max_displacement = size * float(np.linalg.norm(grid / size, axis=-1).max()) \
+        if 0.0 < size < np.inf else size
     solution = result.solution
     if scenario.solve.kind == "dynamic":
         energy = solution.energy(result.times)

@@ -1,7 +1,10 @@
 """Fitting a control net to a grid of points sampled evenly on the parameter domain.
 
 Point ``grid[i, j]`` is taken as ``x(u_i, v_j)``; the control net is the (weighted) least
-squares solution, one 1-D operator per direction (:func:`from_points`). Re-exported from
+squares solution, one 1-D operator per direction (:func:`from_points`). The parameter
+domain defaults to the grid's mean chord lengths (:func:`chord_lengths`), so that a grid
+sampled evenly in arc length gets a parametrisation close to isometric and the parametric
+energy (the paper's) approximates the one measured on the surface. Re-exported from
 :mod:`splinedeform.shapes`.
 """
 
@@ -19,7 +22,7 @@ from .surface import Surface
 
 def from_points(grid: ArrayLike, cells: int | tuple[int, int] = DEFAULT_CELLS, degree: int = 3,
                 knots: str | tuple[str, str] = "open", method: str = "interpolate",
-                domain: Domain = ((0.0, 1.0), (0.0, 1.0)),
+                domain: Domain | None = None,
                 name: str | None = None) -> Surface:
     """Fit a spline surface to a grid of points sampled evenly on the parameter domain.
 
@@ -31,8 +34,15 @@ def from_points(grid: ArrayLike, cells: int | tuple[int, int] = DEFAULT_CELLS, d
     Parameters
     ----------
     grid : array_like, shape ``(N_u, N_v, 3)``
-    cells, degree, knots, domain, name
+    cells, degree, knots, name
         As in :func:`from_function`.
+    domain : ((a, b), (c, d)), optional
+        Parameter rectangle; only its lengths ``L_u = b - a``, ``L_v = d - c`` matter. Default:
+        the grid's mean chord lengths (:func:`chord_lengths`), ``L_u = (1/N_v) Σ_j Σ_i
+        |X_{i+1,j} - X_ij|`` and likewise ``L_v``. On a plane sampled evenly this is the
+        arc-length parametrisation, where the parametric energy *is* the physical one; with
+        ``((0, 1), (0, 1))`` a 2 × 3 panel would be squeezed into the unit square and its
+        parametric energy (tension and bending measured in ``u, v``) would be far off.
     method : {"interpolate", "l2"}
         ``"interpolate"``: collocation ``B_u P B_vᵀ = X`` when ``N`` equals the number of
         control points in a direction, least squares ``min |B_u P B_vᵀ - X|`` (solved per
@@ -66,8 +76,12 @@ def from_points(grid: ArrayLike, cells: int | tuple[int, int] = DEFAULT_CELLS, d
         i, j = np.argwhere(~np.all(np.isfinite(X), axis=-1))[0]
         raise InputError(f"point grid must be finite; point ({i}, {j}) is {X[i, j]}")
     kinds = _knot_kinds(knots)
-    (a, b), (c, d) = _domain(domain)
-    bu, bv = _bases(cells, degree, kinds, (b - a, d - c))
+    if domain is None:
+        lengths = chord_lengths(X, (kinds[0] == "periodic", kinds[1] == "periodic"))
+    else:
+        (a, b), (c, d) = _domain(domain)
+        lengths = (b - a, d - c)
+    bu, bv = _bases(cells, degree, kinds, lengths)
     X, u = _grid_parameters(X, bu, axis=0)
     X, v = _grid_parameters(X, bv, axis=1)
     Au = _least_squares_operator(bu, u, method, "u")
@@ -78,6 +92,26 @@ def from_points(grid: ArrayLike, cells: int | tuple[int, int] = DEFAULT_CELLS, d
     surface = Surface(P, bu, bv, name=name or "points")
     error = float(np.linalg.norm(surface.evaluate_grid(u, v) - X, axis=-1).max())
     return Surface(P, bu, bv, fit_error=error, name=surface.name)
+
+
+def chord_lengths(X: NDArray[np.float64], periodic: tuple[bool, bool] = (False, False)
+                  ) -> tuple[float, float]:
+    """Mean chord lengths ``(L_u, L_v)`` of a point grid ``X`` of shape ``(N_u, N_v, 3)``.
+
+    ``L_u = (1/N_v) Σ_j Σ_i |X_{i+1,j} - X_ij|``: the length of the polygon through each
+    column of points (u direction), averaged over the columns; likewise ``L_v`` over the
+    rows. A periodic direction adds the closing chord ``|X_{0,j} - X_{N_u-1,j}|`` (zero when
+    the grid repeats its first row). A grid whose points all coincide in a direction gets
+    length 1 there (and is refused by the fit, which names the coincident points).
+    """
+    out = []
+    for axis, closed in ((0, periodic[0]), (1, periodic[1])):
+        steps = np.linalg.norm(np.diff(X, axis=axis), axis=-1).sum(axis=axis)
+        if closed:
+            steps = steps + np.linalg.norm(np.take(X, 0, axis=axis) - np.take(X, -1, axis=axis),
+                                           axis=-1)
+        out.append(float(steps.mean()) or 1.0)
+    return out[0], out[1]
 
 
 def _check_distinct(X: NDArray[np.float64]) -> None:

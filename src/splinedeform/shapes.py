@@ -31,10 +31,10 @@ from .fit import (  # noqa: F401 (FIT_METHODS, POINT_METHODS and the fitting fun
     CLOSED_CELLS, DEFAULT_CELLS, FIT_METHODS, POINT_METHODS, Domain, Map, _bases, _check_method,
     _domain, _fitted, _knot_kinds, _pair, _positive, error_samples, fit_control_points,
     fit_error, quasi_weights)
-from .point_grid import from_points  # noqa: F401 (public here)
+from .point_grid import chord_lengths, from_points  # noqa: F401 (public here)
 from .surface import Surface
 
-__all__ = ["FIT_METHODS", "cylinder", "error_samples", "fit_control_points", "fit_error",
+__all__ = ["FIT_METHODS", "chord_lengths", "cylinder", "error_samples", "fit_control_points", "fit_error",
            "from_function", "from_points", "half_sphere", "plane", "quasi_weights", "saddle",
            "tile", "torus"]
 

@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from .errors import InputError
 from .solvers.bases import DenseBasis, ModalBasis
 from .surface import Surface
+from .threads import owned
 
 Array = NDArray[np.float64]
 
@@ -122,6 +123,7 @@ class StaticSolution(_Displaced):
         self.force_free = force_free
         self.timings = timings
 
+    @owned
     def control_points(self) -> Array:
         """Deformed control net ``(n_u, n_v, 3)``."""
         return self._full(self.d_free)
@@ -130,11 +132,13 @@ class StaticSolution(_Displaced):
         """The deformed surface."""
         return self.rest.with_control_points(self.control_points(), name="static")
 
+    @owned
     def displacement(self, u: ArrayLike, v: ArrayLike) -> Array:
         """Displacement ``d(u, v)`` of surface points, shape ``S + (3,)``."""
         net = self.control_points() - self.rest.control_points
         return self.rest.derivative(u, v, control_points=net)
 
+    @owned
     def energy(self) -> Energy:
         K = self.readout.K
         strain = 0.5 * np.sum(self.d_free * (K @ self.d_free))
@@ -164,16 +168,19 @@ class Solution(_Displaced):
         self.timings = timings
         self._grid_matrices: dict = {}
 
+    @owned
     def state(self, t: ArrayLike) -> tuple[Array, Array]:
         """Free displacements and velocities at times ``t`` (F,), each ``(F, n_free, 3)``."""
         raise NotImplementedError
 
+    @owned
     def control_points(self, t: ArrayLike) -> Array:
         """Control net at ``t``: ``(n_u, n_v, 3)`` for a number, ``(F, n_u, n_v, 3)`` for an array."""
         times, scalar = _check_times(t)
         nets = self._full(self.state(times)[0])
         return nets[0] if scalar else nets
 
+    @owned
     def velocities(self, t: ArrayLike) -> Array:
         """Control point velocities, same shapes as :meth:`control_points`."""
         times, scalar = _check_times(t)
@@ -185,6 +192,7 @@ class Solution(_Displaced):
         return self.rest.with_control_points(self.control_points(float(t)),
                                                       name=f"t={float(t):g}")
 
+    @owned
     def displacement(self, t: ArrayLike, u: ArrayLike, v: ArrayLike) -> Array:
         """Displacement of surface points: ``S + (3,)`` for scalar ``t``, ``(F,) + S + (3,)`` else."""
         times, scalar = _check_times(t)
@@ -196,6 +204,7 @@ class Solution(_Displaced):
         out = out.reshape((times.size,) + u.shape + (3,))
         return out[0] if scalar else out
 
+    @owned
     def frames(self, times: ArrayLike, resolution: int | tuple[int, int] | None = None
                ) -> Frames:
         """Control nets at many times and, with ``resolution``, the surface sampled per frame.
@@ -220,6 +229,7 @@ class Solution(_Displaced):
         points = np.moveaxis(np.asarray(E @ flat).reshape(ru, rv, times_arr.size, 3), 2, 0)
         return Frames(times_arr, nets, points)
 
+    @owned
     def energy(self, t: ArrayLike) -> Energy:
         """Kinetic, strain and load-work energies at ``t`` (see the module docstring)."""
         times, scalar = _check_times(t)
@@ -247,19 +257,26 @@ class ModalSolution(Solution):
     accepted too); a truncated basis adds the mode-acceleration ``correction(t)`` and reports
     its truncation in ``truncation`` (see :meth:`splinedeform.Model.dynamic`). Times are
     processed in chunks of about :attr:`chunk_entries` modal values so that many frames of a
-    large net fit in memory.
+    large net fit in memory. ``accuracy`` (automatic mode count) keeps every time asked
+    within its tolerance: times where the basis' bound exceeds it (just after a load jump)
+    come from :attr:`finer`, a solution whose modes are chosen for them
+    (:class:`splinedeform.modal_solve.Accuracy`); the other times keep the cheaper basis.
     """
 
     chunk_entries = 4_000_000
 
     def __init__(self, readout: Readout, t_end: float, force_free: Callable[[float], Array],
                  timings: dict[str, float], phi: Any, response: Callable, omitted: dict,
-                 correction: Callable[[Array], Array] | None = None):
+                 correction: Callable[[Array], Array] | None = None, accuracy: Any = None):
         super().__init__(readout, "analytic", t_end, force_free, timings)
         self.basis = phi if isinstance(phi, ModalBasis) else DenseBasis(response.lam, phi)
         self.response = response
         self.truncation = omitted
         self.correction = correction
+        self.accuracy = accuracy
+        self.finer: ModalSolution | None = None
+        """The solution chosen for the first times asked where ``accuracy``'s bound missed;
+        it serves every such time (choosing its own finer one when its bound misses)."""
 
     @property
     def phi(self) -> Array:
@@ -271,6 +288,22 @@ class ModalSolution(Solution):
         return [times[i:i + per] for i in range(0, times.size, per)] or [times]
 
     def _displacements(self, times: Array, velocities: bool) -> tuple[Array, Array | None]:
+        """``d`` (and ``v``) at ``times``; with an ``accuracy`` (automatic mode count), the
+        times where its bound exceeds the tolerance come from a solution chosen for them."""
+        if self.accuracy is not None:
+            finer = self.accuracy.outside(times)
+            if np.any(finer):
+                d, v = self._own(times, velocities)
+                if self.finer is None:
+                    self.finer = self.accuracy.refine(times[finer])
+                d[finer], v_finer = self.finer._displacements(times[finer], velocities)
+                if v is not None and v_finer is not None:
+                    v[finer] = v_finer
+                return d, v
+        return self._own(times, velocities)
+
+    def _own(self, times: Array, velocities: bool) -> tuple[Array, Array | None]:
+        """``d`` (and ``v``) at ``times`` from this solution's own basis and correction."""
         n = self.basis.n_free
         d = np.zeros((times.size, n, 3))
         v = np.zeros((times.size, n, 3)) if velocities else None
@@ -291,12 +324,14 @@ class ModalSolution(Solution):
             i += part.size
         return d, v
 
+    @owned
     def state(self, t: ArrayLike) -> tuple[Array, Array]:
         times, _ = _check_times(t)
         d, v = self._displacements(times, True)
         assert v is not None
         return d, v
 
+    @owned
     def control_points(self, t: ArrayLike) -> Array:
         """Control net at ``t``: ``(n_u, n_v, 3)`` for a number, ``(F, n_u, n_v, 3)`` for an array."""
         times, scalar = _check_times(t)
@@ -320,6 +355,7 @@ class SampledSolution(Solution):
         self.times, self.d, self.v = times, d, v
         self.stats = stats
 
+    @owned
     def state(self, t: ArrayLike) -> tuple[Array, Array]:
         times, _ = _check_times(t, self.t_end)
         i = np.clip(np.searchsorted(self.times, times, side="right") - 1, 0,

@@ -15,11 +15,42 @@ import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
 from .basis import BSplineBasis
+from .deboor import BLOCK
+from .patches import evaluate_patch_point, evaluate_patches, patches_when_worth
+from .spans import scalar_bernstein
 from .errors import InputError
 from .knots import KnotVectorBasis, RationalBasis
 
 #: the 1-D bases a surface composes: the fast layouts, a general knot vector, a weighted one
 Basis = BSplineBasis | KnotVectorBasis | RationalBasis
+
+
+_SCALARS = (float, int, np.float64)
+_POINTS = ("patches", 0, 0)
+
+
+def _has_span_form(basis: Basis) -> bool:
+    return getattr(basis, "form", None) is not None
+
+
+def span_values(basis: Basis, span: int, s: float, derivative: int) -> NDArray[np.float64]:
+    """``D^j`` of the ``n + 1`` functions of one span at local parameter ``s`` (a float)."""
+    return basis.form.coefficients[derivative][span] @ np.array(
+        scalar_bernstein(s, basis.degree - derivative))
+
+
+def span_indices(basis: Basis, span: int) -> NDArray[np.int64]:
+    """Indices of the ``n + 1`` functions not vanishing on one span."""
+    n = basis.degree
+    if basis.kind == "periodic":
+        return (span - n + np.arange(n + 1)) % basis.cells
+    first = basis.first[span] if basis.kind == "general" else span
+    return first + np.arange(n + 1)
+
+
+def _order(order: object) -> bool:
+    """Whether ``order`` is a valid derivative order (else the general path says why not)."""
+    return isinstance(order, (int, np.integer)) and not isinstance(order, bool) and order >= 0
 
 
 #: largest number of sample points ``ru * rv`` of one tessellation (2048², about 300 MiB
@@ -74,6 +105,15 @@ class Surface:
         P.setflags(write=False)
         object.__setattr__(self, "control_points", P)
 
+    def __repr__(self) -> str:
+        """One line: name, net size, degrees, knot layouts, domain (never the net itself)."""
+        (_, lu), (_, lv) = self.domain
+        fit = "" if self.fit_error is None else f", fit_error={self.fit_error:.3g}"
+        return (f"Surface({self.name!r}, {self.shape[0]}×{self.shape[1]} control points, "
+                f"degree=({self.basis_u.degree}, {self.basis_v.degree}), "
+                f"knots=({knots_summary(self.basis_u)}, {knots_summary(self.basis_v)}), "
+                f"domain=[0, {lu:.6g}] × [0, {lv:.6g}]{fit})")
+
     # -- layout ---------------------------------------------------------------
     @property
     def shape(self) -> tuple[int, int]:
@@ -121,20 +161,61 @@ class Surface:
 
         ``u`` and ``v`` broadcast to a common shape ``S``; returns ``S + (3,)``.
         ``control_points`` evaluates another net (e.g. a displacement) on the same bases.
+
+        The surface's own net is evaluated from its Bézier patches (:mod:`splinedeform.patches`,
+        computed once it has been asked for as many points as it has cells); until then, and
+        for another net, by the sum over the ``(n+1)²`` control points of each parameter's
+        cell, ``Σ_r Σ_s D^du b_r(u) D^dv b_s(v) p_rs``.
         """
+        Q = None
+        own = control_points is None and _order(du) and _order(dv)
+        one = type(u) in _SCALARS and type(v) in _SCALARS
+        if own:
+            Q = patches_when_worth(self, du, dv, 1 if one else np.broadcast(u, v).size)
+        degrees = (self.basis_u.degree - du, self.basis_v.degree - dv)
+        if own and one:
+            if Q is not None:
+                return evaluate_patch_point(Q, degrees, self.basis_u, self.basis_v, u, v)
+            if _has_span_form(self.basis_u) and _has_span_form(self.basis_v) and min(degrees) >= 0:
+                return self._direct_point(u, v, du, dv)
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
+        if Q is not None:
+            points = evaluate_patches(Q, degrees, self.basis_u, self.basis_v, u.ravel(),
+                                      v.ravel())
+            return points.reshape(u.shape + (3,))
         P = self.control_points if control_points is None else np.asarray(control_points, float)
-        iu, bu = self.basis_u.nonzero(u.ravel(), du)
-        iv, bv = self.basis_v.nonzero(v.ravel(), dv)
-        # gather the (n+1)² control points of each parameter's cell: Σ_r Σ_s bu_r bv_s p_rs
-        flat = P.reshape(P.shape[0] * P.shape[1], -1)
-        index = (iu[:, :, None] * P.shape[1] + iv[:, None, :]).reshape(u.size, -1)
-        weights = (bu[:, :, None] * bv[:, None, :]).reshape(u.size, -1)
-        out = np.einsum("pk,pkc->pc", weights, np.take(flat, index, axis=0))
+        uf, vf = u.ravel(), v.ravel()
+        n_v = P.shape[1]
+        flat = P.reshape(P.shape[0] * n_v, -1)
+        out = np.empty((uf.size, flat.shape[1]))
+        for start in range(0, uf.size, BLOCK):
+            block = slice(start, start + BLOCK)
+            iu, bu = self.basis_u.nonzero(uf[block], du)
+            iv, bv = self.basis_v.nonzero(vf[block], dv)
+            # the (n+1)² control points of each parameter's cell: Σ_r Σ_s bu_r bv_s p_rs
+            count = iu.shape[0]
+            index = (iu[:, :, None] * n_v + iv[:, None, :]).reshape(count, -1)
+            weights = (bu[:, :, None] * bv[:, None, :]).reshape(count, -1)
+            np.einsum("pk,pkc->pc", weights, flat[index], out=out[block])
         return out.reshape(u.shape + P.shape[2:])
+
+    def _direct_point(self, u: float, v: float, du: int, dv: int) -> NDArray[np.float64]:
+        """One point by the ``(n+1)²`` control points of its cell, from plain floats."""
+        i, s = self.basis_u.locate_scalar(u)
+        j, t = self.basis_v.locate_scalar(v)
+        bu = span_values(self.basis_u, i, s, du)
+        bv = span_values(self.basis_v, j, t, dv)
+        net = self.control_points[np.ix_(span_indices(self.basis_u, i),
+                                         span_indices(self.basis_v, j))]   # (n+1, n+1, 3)
+        return bu @ (bv @ net)
 
     def evaluate(self, u: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
         """Points ``x(u, v)``; ``u`` and ``v`` broadcast to ``S``, result ``S + (3,)``."""
+        if type(u) in _SCALARS and type(v) in _SCALARS:   # one point: no array set-up at all
+            Q = self._cache.get(_POINTS)
+            if Q is not None:
+                return evaluate_patch_point(Q, (self.basis_u.degree, self.basis_v.degree),
+                                            self.basis_u, self.basis_v, u, v)
         return self.derivative(u, v)
 
     def evaluate_grid(self, u: ArrayLike, v: ArrayLike, du: int = 0, dv: int = 0,
@@ -144,8 +225,8 @@ class Surface:
         Two sparse products ``B_u P B_vᵀ`` per coordinate; result ``(len(u), len(v), 3)``.
         """
         P = self.control_points if control_points is None else np.asarray(control_points, float)
-        Bu = self.basis_u.matrix(u, du)
-        Bv = self.basis_v.matrix(v, dv)
+        Bu = _collocation(self.basis_u, u, du)
+        Bv = _collocation(self.basis_v, v, dv)
         n_u, n_v = self.shape
         tmp = (Bu @ P.reshape(n_u, -1)).reshape(Bu.shape[0], n_v, -1)   # (Nu, n_v, c)
         out = Bv @ tmp.transpose(1, 0, 2).reshape(n_v, -1)               # (Nv, Nu*c)
@@ -185,6 +266,29 @@ class Surface:
         u, v = self.sample_parameters(resolution)
         vertices = self.evaluate_grid(u, v, control_points=control_points).reshape(-1, 3)
         return vertices, grid_faces(u.size, v.size)
+
+
+def _collocation(basis: Basis, x: ArrayLike, derivative: int) -> sp.csr_array:
+    """``A_{ij} = D^derivative b_j(x_i)`` as a sparse array built from its CSR arrays.
+
+    The same matrix as ``basis.matrix``; ``csr_array`` skips the ``np.matrix`` layer of
+    ``csr_matrix``, whose construction costs more than these products on small grids.
+    """
+    x = np.atleast_1d(np.asarray(x, dtype=float)).ravel()
+    index, values = basis.nonzero(x, derivative)
+    width = index.shape[-1]
+    indptr = np.arange(0, x.size * width + 1, width)
+    return sp.csr_array((values.ravel(), index.ravel(), indptr), shape=(x.size, basis.size))
+
+
+def knots_summary(basis: Basis) -> str:
+    """A basis's knots in a few words: ``'open' 4 cells``, ``knot vector of 11``, or
+    ``rational`` before either."""
+    if isinstance(basis, RationalBasis):
+        return f"rational {knots_summary(basis.basis)}"
+    if isinstance(basis, KnotVectorBasis):
+        return f"knot vector of {np.size(basis.knots)}"
+    return f"{basis.kind!r} {basis.cells} cells"
 
 
 def grid_faces(ru: int, rv: int) -> NDArray[np.int64]:

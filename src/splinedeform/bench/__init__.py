@@ -49,8 +49,9 @@ def main(sizes: Sequence[int] | None = None, quick: bool = False,
          frames: int | None = None, target: float | None = None, budget: float | None = None,
          methods: Sequence[str] | None = None, families: Sequence[str] | None = None,
          goals: bool | None = None, regimes_too: bool | None = None,
-         threads: int = 1) -> dict[str, Any]:
-    """Run the cost study with BLAS on ``threads`` threads and write its results to ``outdir``.
+         threads: int | None = None) -> dict[str, Any]:
+    """Run the cost study and write its results to ``outdir``; ``threads`` pins BLAS to that
+    many threads for the whole study (default: not pinned, the library as it ships).
 
     Files: ``bench.json`` (every number, see :func:`render`), ``bench.md`` (the tables and
     goals), ``bench.csv`` (one row per run) and ``cost_<family>.png`` (log–log time against
@@ -58,9 +59,9 @@ def main(sizes: Sequence[int] | None = None, quick: bool = False,
 
     Parameters
     ----------
-    sizes : cells per direction (default 8, 16, 32, 64, 128; quick: 4, 6).
-    quick : a short smoke run (:data:`QUICK`: 4×4 and 6×6 nets, 20 frames, target 1e-4,
-        5 s budget, no regimes b–e, no goals at scale).
+    sizes : cells per direction (default 8, 16, 32, 64, 128; quick: 3, 4).
+    quick : a short smoke run (:data:`QUICK`: 3×3 and 4×4 nets, 20 frames, target 1e-3,
+        5 s budget, Radau IIA-7/-3 and generalised-α, no regimes b–e, no goals at scale).
     outdir : output folder (created).
     quiet : print nothing.
     frames, target, budget, methods, families, goals, regimes_too : override the

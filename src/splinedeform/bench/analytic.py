@@ -1,13 +1,13 @@
-"""The analytic rows of the study: automatic mode count, all modes, and the reference nets.
+"""The analytic rows of the study: the default call, all modes, and the reference nets.
 
-* ``analytic`` (the headline row): ``Model.dynamic(load, t_end, times=frames,
-  tolerance=tol)`` — the lowest modes plus the exact static part of the rest, as many as an
-  a-priori bound of the omitted modes' response at the frames needs
-  (:mod:`splinedeform.solvers.mode_count`). Like the integrators it runs at its cheapest
-  setting that reaches the target: ``tolerance = target``, and while the error *measured
-  against the reference* misses it (the bound is in the M-norm, the study's error is the
-  largest control-point difference) √2 times more modes. Its row reports the modes used
-  and the bound reached.
+* ``analytic`` (the headline row): the README's call as it ships,
+  ``Model.dynamic(load, t_end)`` and then ``solution.control_points(frames)`` — no
+  ``times=``, no ``tolerance=``, no thread pinning by the study: the library chooses the
+  lowest modes plus the exact static part of the rest for its default accuracy
+  (``1e-8`` of the largest static displacement in the largest control-point coordinate, at
+  any time; all modes on small or separable nets) and runs its solves with its own BLAS
+  thread setting (:mod:`splinedeform.threads`). Its row reports the modes used, the bound
+  reached and the error measured against the reference.
 * ``analytic-all``: all modes (the complete eigen-solution), while ``n_free`` is at most
   :data:`DENSE_LIMIT`; beyond, a row *not run* with the cost forecast from the measured
   growth of the smaller nets. Its nets are the reference where it runs.
@@ -27,13 +27,13 @@ import math
 import time
 from typing import Any
 
+from ..modal_solve import DEFAULT_TOLERANCE
 from .bookkeeping import Row, power_forecast
 from .cases import Case, relative_error
 from .timing import median_run
 
 DENSE_LIMIT = 4000
 """All-modes rows run up to this many free coordinates (64²: 3969)."""
-TRIES = 4
 REFERENCE_FACTOR = 0.1
 
 
@@ -52,7 +52,7 @@ def all_modes(case: Case, repeats: int = 3) -> Row:
     """All modes from scratch; the nets become the case's reference."""
     runs: list[tuple[float, float, float]] = []
     for i in range(max(1, repeats)):
-        _, nets, setup, frames = _solve(case)
+        _, nets, setup, frames = _solve(case, modes="all")
         runs.append((setup + frames, setup, frames))
         if i == 0:
             case.set_reference(nets, "all modes (exact up to rounding)")
@@ -80,63 +80,40 @@ def _truncation(solution: Any) -> dict[str, Any]:
 
 
 def automatic(case: Case, target: float, repeats: int = 3) -> Row:
-    """The automatic mode count, made finer by √2 while its measured error misses ``target``.
+    """The README's call as it ships: ``Model.dynamic(load, t_end)``, then
+    ``solution.control_points(frames)``, with the library's own thread setting.
 
-    The first run asks ``tolerance = target``; the library picks ``k`` modes (doubling from
-    32) by its bound. When the error measured against the reference misses the target, the
-    next runs keep ``round(√2^j k)`` modes (``modes=``, the same mode acceleration): the same
-    factor √2 between settings as the integrators' search.
+    No ``times=``, no ``tolerance=``: the library chooses its modes for its default accuracy
+    (:data:`splinedeform.modal_solve.DEFAULT_TOLERANCE`, any time in ``[0, t_end]``), so the
+    row reports the error measured against the reference next to ``target``, the modes the
+    default chose and its bound; nothing is retried.
     """
-    settings: list[dict[str, Any]] = [{"tolerance": target}]
-    tries = []
-    for attempt_no in range(TRIES):
-        options = settings[-1]
-        solution, nets, setup, frames = _solve(case, times=case.times, **options)
-        error = relative_error(nets, case)
-        report = _truncation(solution)
-        tries.append((options, error, setup, frames, report))
-        if error <= target:
-            break
-        first = int(tries[0][4].get("modes", 0) or 0)
-        if not first or first >= case.model.n_free // 2:
-            break                                   # all modes already: nothing finer
-        settings.append({"modes": int(round(first * math.sqrt(2.0) ** (attempt_no + 1)))})
-    options, error, setup, frames, report = tries[-1]
-    first_report = tries[0][4]
-    modes = int(report.get("modes", options.get("modes", 0)) or 0)
-    bound = float(first_report.get("bound", math.nan))
+    solution, nets, setup, frames = _solve(case)
+    error = relative_error(nets, case)
+    report = _truncation(solution)
+    modes = int(solution.basis.size)
+    bound = float(report.get("bound", 0.0 if modes >= case.model.n_free else math.nan))
+    tolerance = float(report.get("tolerance", DEFAULT_TOLERANCE))
     row = Row(case.family, case.cells, case.model.n_free, "analytic",
-              "ok" if error <= target else "not reached", error=error, modes=modes, bound=bound,
-              runs=len(tries))
-    row.setting = automatic_label(target, int(first_report.get("modes", 0) or 0), bound,
-                                  case.model.n_free)
-    if "modes" in options:
-        row.setting += f"; measured error above target, so {options['modes']} modes"
-        row.bound = math.nan
-    if error <= target:
-        runs = [(setup + frames, setup, frames)]
-        while runs[0][0] < 3.0 and len(runs) < repeats:
-            _, _, s, f = _solve(case, times=case.times, **options)
-            runs.append((s + f, s, f))
-        row.seconds, row.setup, frames = sorted(runs)[len(runs) // 2]
-        row.per_frame = frames / case.times.size
-        row.runs += len(runs) - 1
-    if len(tries) > 1:
-        row.note = ("measured error above the target with " + "; ".join(
-            f"{_setting_text(t[0], t[4])}: {t[1]:.2e}" for t in tries[:-1]))
+              "ok" if error <= target else "not reached", error=error, modes=modes,
+              bound=bound, runs=1)
+    row.setting = "default call, " + automatic_label(tolerance, modes, bound,
+                                                     case.model.n_free)
+    runs = [(setup + frames, setup, frames)]
+    while runs[0][0] < 3.0 and len(runs) < repeats:
+        _, _, s, f = _solve(case)
+        runs.append((s + f, s, f))
+    row.seconds, row.setup, frames = sorted(runs)[len(runs) // 2]
+    row.per_frame = frames / case.times.size
+    row.runs = len(runs)
     return row
-
-
-def _setting_text(options: dict[str, Any], report: dict[str, Any]) -> str:
-    if "modes" in options:
-        return f"{options['modes']} modes"
-    return f"tolerance {options['tolerance']:g} ({report.get('modes', '?')} modes)"
 
 
 def automatic_label(tolerance: float, modes: int, bound: float, n_free: int) -> str:
     """``tolerance 1e-06: 256 modes, bound 2.1e-07`` (or all modes when the bound needed them)."""
     if not modes or modes >= n_free:
-        return f"tolerance {tolerance:g}: all modes (a truncated basis would need ≥ n/2)"
+        return (f"tolerance {tolerance:g}: all modes (a small or separable net, or a "
+                "truncated basis would need ≥ n/2)")
     return f"tolerance {tolerance:g}: {modes} modes, bound {bound:.1e}"
 
 

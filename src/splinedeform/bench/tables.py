@@ -184,11 +184,12 @@ LEGEND = ("Cells: total time (×ratio to the fastest run of the line; error reac
           "`> budget`: stopped at the budget, the full run extrapolated from the simulated time "
           "reached (below 5 % of t_end nothing is extrapolated and the ratio is a lower bound); "
           "`skipped`: forecast from the smaller nets; `not run`: forecast from the measured "
-          "growth of the smaller nets, never measured. Automatic modes: `Model.dynamic(..., "
-          "times=frames, tolerance=target)`, then √2 times more modes (`modes=`) while the "
-          "error measured against the reference misses the target; the a-priori bound is in "
-          "the M-norm, relative to the largest static displacement. `= all modes`: the "
-          "automatic count fell back to all modes, the reference itself.")
+          "growth of the smaller nets, never measured. Analytic: the README's call as it "
+          "ships, `Model.dynamic(load, t_end)` then `control_points(frames)`: modes chosen "
+          "for the default 1e-8 (largest control-point coordinate error over the largest "
+          "static displacement, at any time), library's own thread setting; its error is "
+          "measured against the reference. `= all modes`: the default took all modes, the "
+          "reference itself.")
 
 
 def markdown(rows: list[Row], goals: list[Goal], study: Study, seconds: float,

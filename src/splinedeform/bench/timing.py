@@ -29,12 +29,17 @@ Array = NDArray[np.float64]
 
 
 @contextlib.contextmanager
-def blas_threads(n: int = 1) -> Iterator[str]:
+def blas_threads(n: int | None = None) -> Iterator[str]:
     """Limit BLAS/OpenMP threads to ``n`` (threadpoolctl); yields the setting as text.
 
-    Complex sparse LUs and the dense ``eigh`` stall erratically with two OpenBLAS threads on
-    a loaded 2-core machine, so the study runs on one.
+    ``None`` (the study's default) pins nothing: the library runs as it ships, its own calls
+    with the BLAS threads of :mod:`splinedeform.threads`.
     """
+    if n is None:
+        from ..threads import threads
+        yield (f"BLAS threads not pinned by the study; the library's own setting in its "
+               f"calls: {threads()} (splinedeform.threads, SPLINEDEFORM_THREADS)")
+        return
     try:
         from threadpoolctl import threadpool_limits
     except ImportError:                                         # pragma: no cover

@@ -13,6 +13,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..basis import KNOT_KINDS, BSplineBasis
 from ..errors import InputError
+from ..input_files import check_array_file, load_json, open_input
 from ..knots import KnotVectorBasis, RationalBasis
 from ..surface import Basis, Surface
 from .atomic import _check_stem, _require_folder, write_text, write_with
@@ -147,10 +148,7 @@ def _check_header(path: Path, fmt: Any, version: Any) -> None:
 
 
 def _load_json_nets(path: Path) -> dict[str, Any]:
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise InputError(f"{path}: not a valid JSON control-net file: {exc}") from None
+    doc = load_json(path, "JSON control-net file")
     if not isinstance(doc, dict) or "control_points" not in doc or "basis" not in doc:
         raise InputError(f"{path}: a control-net file needs the keys 'control_points' and "
                          f"'basis' (with 'u' and 'v': degree, cells, length, kind)")
@@ -165,8 +163,10 @@ def _load_json_nets(path: Path) -> dict[str, Any]:
 
 def _load_npz_nets(path: Path) -> dict[str, Any]:
     try:
-        with np.load(path, allow_pickle=False) as z:
-            data = {key: z[key] for key in z.files}
+        with open_input(path, "control-net file") as fh:
+            check_array_file(fh, path)
+            with np.load(fh, allow_pickle=False) as z:
+                data = {key: z[key] for key in z.files}
     except (OSError, ValueError, EOFError) as exc:
         raise InputError(f"{path}: not a valid .npz control-net file: {exc}") from None
     missing = [f"{k}_{d}" for d in "uv" for k in _BASIS_KEYS if f"{k}_{d}" not in data]
@@ -310,7 +310,7 @@ def read_control_net(path: str | os.PathLike[str], frame: int = -1) -> Surface:
     suffix = source.suffix.lower()
     if suffix not in (".json", ".npz"):
         raise InputError(f"control nets are read from .json or .npz files, got {source.name!r}")
-    if not source.is_file():
+    if not source.exists():        # a pipe or device is refused on opening, naming it
         raise InputError(f"control-net file {source} does not exist")
     data = _load_json_nets(source) if suffix == ".json" else _load_npz_nets(source)
     P = real_array(data["control_points"], f"{source}: control_points")

@@ -126,6 +126,29 @@ class FolderClaim:
             self._lock = None
 
 
+def incomplete_note(folder: str | os.PathLike[str], stem: str) -> str | None:
+    """What an interrupted run of ``stem`` left in ``folder``, in words; None if nothing.
+
+    Reads ``<stem>.manifest.json``: when it says ``"complete": false``, the note names it
+    and counts the listed files present (whole: every file is written atomically) and
+    missing. A complete manifest, or none, means the folder holds no unfinished set.
+    """
+    root = Path(folder)
+    path = root / manifest_name(stem)
+    try:
+        doc = read_manifest(path)
+    except InputError:
+        return None
+    if doc is None or doc.get("complete") is not False:
+        return None
+    names = list(_entries(doc))
+    missing = [name for name in names if not (root / name).is_file()]
+    shown = ", ".join(missing[:3]) + (f" and {len(missing) - 3} more" if len(missing) > 3
+                                       else "")
+    return (f"{path} is marked incomplete ({len(names) - len(missing)} of {len(names)} "
+            f"files there" + (f"; missing {shown}" if missing else "") + ")")
+
+
 def _lock_folder(folder: Path) -> int | None:
     try:
         import fcntl

@@ -7,16 +7,21 @@ still serves all three)::
 
 with the first fundamental form of the initial surface: ``|∇_S d|² = g^αβ d_,α d_,β``,
 ``Δ_S d = g^αβ (d_,αβ − Γ^γ_αβ d_,γ)`` (Laplace–Beltrami) and ``dA = √g du dv``. The
-Galerkin matrices are assembled on a tensor Gauss grid (:mod:`.metric`), one dense
-``(pu pv)²`` block per quadrature point, summed into sparse COO form::
+Galerkin matrices are assembled on a tensor Gauss grid (:mod:`.metric`)::
 
     K_kl = Σ_q w_q √g_q [T g^αβ N_k,α N_l,β + D (Δ_S N_k)(Δ_S N_l)],
-    M_kl = Σ_q w_q √g_q μ N_k N_l.
+    M_kl = Σ_q w_q √g_q μ N_k N_l,
+
+cell by cell: with ``g^αβ = C Cᵀ`` per point, each cell's block is ``BᵀB`` for the rows
+``B = [√(T w √g) Cᵀ ∇N; √(D w √g) Δ_S N]`` of all its points stacked, one batched
+product, scattered into a precomputed sparse pattern (:mod:`.shell_assembly`).
 
 The result depends on the surface, not on its parametrisation, up to discretisation error.
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -26,6 +31,8 @@ from ..errors import InputError
 from ..material import Material
 from ..surface import Surface
 from . import metric
+from .shell import by_cell
+from .shell_assembly import Pattern, assemble_cells
 
 Array = NDArray[np.float64]
 
@@ -69,21 +76,42 @@ def matrices(surface: Surface, material: Material, lumped: bool = False
     T, D = coefficients(material)
     if D and min(surface.basis_u.degree, surface.basis_v.degree) < 2:
         raise InputError("the bending term D (Δ_S d)² needs degree >= 2 in u and v")
-    G = metric.grid(surface)
-    N = metric.shape_derivatives(G)
-    index = metric.global_index(G, surface.basis_v.size)
-    size = surface.basis_u.size * surface.basis_v.size
-    dA = G.weight * G.sqrt_g
-    grad = np.stack([N[1, 0], N[0, 1]])                                    # (2, Qu, Qv, k)
-    K = np.zeros(dA.shape + (index.shape[-1],) * 2)
-    if T:
-        coef = (T * dA)[..., None, None] * G.g_inv                         # (Qu, Qv, 2, 2)
-        K += np.einsum("abij,iabk,jabl->abkl", coef, grad, grad)
-    if D:
-        L = laplace_beltrami(G, N)
-        K += (D * dA)[..., None, None] * L[..., :, None] * L[..., None, :]
-    M = (material.mass * dA)[..., None, None] * N[0, 0][..., :, None] * N[0, 0][..., None, :]
-    K_full, M_full = metric.assemble(index, K, size), metric.assemble(index, M, size)
+    G = metric.grid(surface, extra_points=2)
+    qu, qv = surface.basis_u.degree + 3, surface.basis_v.degree + 3     # points per cell
+    cells_u, cells_v = G.index_u[::qu], G.index_v[::qv]
+    pattern = Pattern.of(cells_u, cells_v, surface.basis_u.size, surface.basis_v.size, 1)
+
+    def rows_of(rows: slice) -> tuple[metric.Grid, dict[tuple[int, int], Array], Array]:
+        p = slice(rows.start * qu, rows.stop * qu)
+        part = replace(G, index_u=G.index_u[p], values_u=G.values_u[:, p], weight=G.weight[p],
+                       a=G.a[:, p], a2=G.a2[:, p], sqrt_g=G.sqrt_g[p], g_inv=G.g_inv[p],
+                       gamma=G.gamma[:, :, p])
+        return part, metric.shape_derivatives(part), part.weight * part.sqrt_g
+
+    def stiffness(rows: slice) -> Array:
+        part, N, dA = rows_of(rows)
+        B = []
+        if T:
+            C = np.linalg.cholesky(part.g_inv)                              # g^αβ = C Cᵀ
+            grad = np.stack([N[1, 0], N[0, 1]], axis=2)                     # (Qa, Qv, 2, k)
+            Ct_grad = np.einsum("...ji,...jk->...ik", C, grad)
+            B.append(np.sqrt(T * dA)[..., None, None] * Ct_grad)
+        if D:
+            B.append(np.sqrt(D * dA)[..., None, None] * laplace_beltrami(part, N)[..., None, :])
+        if not B:
+            return np.zeros((rows.stop - rows.start, cells_v.shape[0]) + (N[0, 0].shape[-1],) * 2)
+        rows_b = by_cell(np.concatenate(B, axis=2), (qu, qv))             # (A, B, q, r, k)
+        rows_b = rows_b.reshape(rows_b.shape[:2] + (-1, rows_b.shape[-1]))
+        return np.swapaxes(rows_b, -1, -2) @ rows_b
+
+    def mass(rows: slice) -> Array:
+        _, N, dA = rows_of(rows)
+        N0 = by_cell(N[0, 0], (qu, qv))                                     # (A, B, q, k)
+        return np.swapaxes(N0, -1, -2) @ (by_cell(material.mass * dA, (qu, qv))[..., None] * N0)
+
+    K_full = assemble_cells(pattern, cells_u, cells_v, stiffness)
+    M_full = assemble_cells(pattern, cells_u, cells_v, mass)
     if lumped:
         M_full = sp.diags(np.asarray(M_full.sum(axis=1)).ravel(), format="csr")
     return K_full, M_full
+

@@ -93,10 +93,18 @@ def grid(surface: Surface, extra_points: int = 2) -> Grid:
     iu, Bu = bu.nonzero_derivatives(xu, 2)
     iv, Bv = bv.nonzero_derivatives(xv, 2)
     P = surface.control_points
-    net = np.take(np.take(P, iu, axis=0), iv, axis=2)          # (Qu, pu, Qv, pv, 3)
+    n_u, n_v = P.shape[:2]
+
+    def collocation(index: NDArray[np.int64], values: Array, n: int) -> sp.csr_matrix:
+        rows = np.broadcast_to(np.arange(index.shape[0])[:, None], index.shape)
+        return sp.csr_matrix((values.ravel(), (rows.ravel(), index.ravel())),
+                             shape=(index.shape[0], n))
 
     def derivative(p: int, q: int) -> Array:
-        return np.einsum("ai,bj,aibjc->abc", Bu[p], Bv[q], net)
+        # x_{,u^p v^q} = B_u^(p) P B_v^(q)ᵀ per coordinate, two sparse products
+        tmp = (collocation(iu, Bu[p], n_u) @ P.reshape(n_u, -1)).reshape(-1, n_v, 3)
+        out = collocation(iv, Bv[q], n_v) @ tmp.transpose(1, 0, 2).reshape(n_v, -1)
+        return np.asarray(out).reshape(len(xv), len(xu), 3).transpose(1, 0, 2)
 
     a = np.stack([derivative(1, 0), derivative(0, 1)])
     a2 = np.stack([derivative(2, 0), derivative(1, 1), derivative(0, 2)])

@@ -30,6 +30,7 @@ from numpy.typing import NDArray
 from ..errors import InputError
 from ..surface import Surface
 from . import metric
+from .shell_assembly import Pattern, assemble_cells
 
 Array = NDArray[np.float64]
 
@@ -109,7 +110,12 @@ def strain_operators(G: metric.Grid, N: dict[tuple[int, int], Array]) -> tuple[A
 
 
 def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, sp.csr_matrix]:
-    """Stiffness ``K`` and consistent mass ``M`` over the ``3n`` interleaved displacements."""
+    """Stiffness ``K`` and consistent mass ``M`` over the ``3n`` interleaved displacements.
+
+    ``K = Σ_cells Σ_q Bᵀ D B`` with ``B = [B_m; B_b]`` (6 rows) and
+    ``D = √g w_q diag(E t/(1−ν²) H, E t³/(12(1−ν²)) H)``, ``M = ρ t ∫ N_k N_l dA ⊗ I₃``;
+    cell by cell into a precomputed pattern (:mod:`.shell_assembly`).
+    """
     if min(surface.basis_u.degree, surface.basis_v.degree) < 2:
         raise InputError("the Kirchhoff–Love shell needs degree >= 2 in u and v (curvatures)")
     for name, basis in (("u", surface.basis_u), ("v", surface.basis_v)):
@@ -120,38 +126,82 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
                 "where bending energy is undefined); use a knot vector without such knots")
     G = metric.grid(surface, extra_points=1)
     q = (surface.basis_u.degree + 2, surface.basis_v.degree + 2)    # Gauss points per cell
-    N = metric.shape_derivatives(G)
-    index = metric.global_index(G, surface.basis_v.size)[::q[0], ::q[1]]   # one row per cell
-    dofs = (3 * index[..., :, None] + np.arange(3)).reshape(index.shape[:2] + (-1,))
-    size = 3 * surface.basis_u.size * surface.basis_v.size
+    n_u, n_v = surface.basis_u.size, surface.basis_v.size
+    cells_u, cells_v = G.index_u[::q[0]], G.index_v[::q[1]]
     E, nu, t = material.E, material.nu, material.thickness
     dA = G.weight * G.sqrt_g
-    H = constitutive(G.g_inv, nu)
-    Bm, Bb = strain_operators(G, N)
-    shape = Bm.shape[:2] + (3, -1)
-    B = np.concatenate([Bm.reshape(shape), Bb.reshape(shape)], axis=2)   # (Qu, Qv, 6, 3k)
-    D = np.zeros(B.shape[:2] + (6, 6))
-    D[..., :3, :3] = (E * t / (1 - nu ** 2) * dA)[..., None, None] * H
-    D[..., 3:, 3:] = (E * t ** 3 / (12 * (1 - nu ** 2)) * dA)[..., None, None] * H
-    K = cell_sums(B, D @ B, q)                    # Σ_q Bmᵀ Dm Bm + Bbᵀ Db Bb per cell
+    membrane, bending = E * t / (1 - nu ** 2), E * t ** 3 / (12 * (1 - nu ** 2))
+
+    def stiffness(rows: slice) -> Array:
+        points = slice(rows.start * q[0], rows.stop * q[0])
+        S = by_cell(point_shapes(G, points), q)                     # (A, B, qu qv, 5, k)
+        V = by_cell(strain_vectors(G, points), q)                   # (A, B, qu qv, 6, 3, 5)
+        H = by_cell(constitutive(G.g_inv[points], nu), q)
+        w = by_cell(dA[points], q)[..., None, None]
+        # D = L Lᵀ per point, so Bᵀ D B = (Lᵀ B)ᵀ (Lᵀ B) with Lᵀ B = (Lᵀ V) S
+        L = np.linalg.cholesky(H)
+        Lt = np.concatenate([np.swapaxes(L, -1, -2) * np.sqrt(membrane * w),
+                             np.swapaxes(L, -1, -2) * np.sqrt(bending * w)], axis=-2)
+        LV = np.concatenate([sum(Lt[..., :3, j, None, None] * V[..., j, None, :, :]
+                                 for j in range(3)),
+                             sum(Lt[..., 3:, j, None, None] * V[..., 3 + j, None, :, :]
+                                 for j in range(3))], axis=-3)
+        C = LV.reshape(LV.shape[:3] + (18, 5)) @ S                  # (A, B, qu qv, 18, k)
+        C = C.reshape(C.shape[:2] + (-1, 3 * C.shape[-1]))          # rows (q, i), cols (c, k)
+        return np.swapaxes(C, -1, -2) @ C
+
+    K = assemble_cells(Pattern.of(cells_u, cells_v, n_u, n_v, 3), cells_u, cells_v, stiffness)
+
+    def mass(rows: slice) -> Array:
+        points = slice(rows.start * q[0], rows.stop * q[0])
+        N0 = (G.values_u[0][points, None, :, None] * G.values_v[0][None, :, None, :])
+        N0 = by_cell(N0.reshape(N0.shape[:2] + (-1,)), q)              # (A, B, qu qv, k)
+        w = by_cell(material.density * t * dA[points], q)[..., None]
+        return np.swapaxes(N0, -1, -2) @ (w * N0)
+
+    scalar = assemble_cells(Pattern.of(cells_u, cells_v, n_u, n_v, 1), cells_u, cells_v, mass)
     # mass ρt ∫ N_k N_l dA for each coordinate alike: the scalar matrix ⊗ I₃ (interleaved)
-    N0 = N[0, 0][..., None, :]
-    mass = cell_sums((material.density * t * dA)[..., None, None] * N0, N0, q)
-    M = sp.kron(metric.assemble(index, mass, size // 3), sp.identity(3), format="csr")
-    return metric.assemble(dofs, K, size), M
+    return K, sp.kron(scalar, sp.identity(3), format="csr")
 
 
-def cell_sums(left: Array, right: Array, q: tuple[int, int]) -> Array:
-    """``Σ_{points of a cell} leftᵀ right`` for every cell at once, ``(c_u, c_v, k, l)``.
+def point_shapes(G: metric.Grid, points: slice) -> Array:
+    """``N_,1, N_,2, N_,11, N_,12, N_,22`` at the grid rows ``points``, ``(Qa, Qv, 5, k)``."""
+    Bu, Bv = G.values_u[:, points], G.values_v
+    out = [Bu[p][:, None, :, None] * Bv[r][None, :, None, :]
+           for p, r in ((1, 0), (0, 1), (2, 0), (1, 1), (0, 2))]
+    S = np.stack(out, axis=2)
+    return S.reshape(S.shape[:3] + (-1,))
 
-    ``left (Q_u, Q_v, r, k)`` and ``right (Q_u, Q_v, r, l)`` hold the ``q_u × q_v`` Gauss
-    points of each cell consecutively (:func:`~splinedeform.quadrature.gauss_points`);
-    the points and the ``r`` rows of a cell are stacked into one axis, so each cell's
-    block is one matrix product (batched over the cells).
+
+def strain_vectors(G: metric.Grid, points: slice) -> Array:
+    """``V (Qa, Qv, 6, 3, 5)``: ``B[i, c, k] = Σ_s V[i, c, s] S[s, k]`` (:func:`point_shapes`).
+
+    Rows ``ε_11, ε_22, 2ε_12`` then ``κ_11, κ_22, 2κ_12`` of :func:`strain_operators`,
+    each a combination of the five shape derivatives ``s`` with vector coefficients.
     """
-    (Qu, Qv), (qu, qv) = left.shape[:2], q
+    a1, a2 = G.a[0, points], G.a[1, points]
+    sqrt_g = G.sqrt_g[points][..., None]
+    a3 = np.cross(a1, a2) / sqrt_g
+    V = np.zeros(a1.shape[:2] + (6, 3, 5))
+    V[..., 0, :, 0] = a1
+    V[..., 1, :, 1] = a2
+    V[..., 2, :, 1] = a1
+    V[..., 2, :, 0] = a2
+    for row, (second, slot, factor) in enumerate(((0, 2, 1.0), (2, 4, 1.0), (1, 3, 2.0))):
+        a_ab = G.a2[second, points]
+        tilde = a_ab - np.sum(a_ab * a3, -1)[..., None] * a3
+        V[..., 3 + row, :, slot] = factor * a3
+        V[..., 3 + row, :, 0] = factor * np.cross(a2, tilde) / sqrt_g
+        V[..., 3 + row, :, 1] = factor * np.cross(tilde, a1) / sqrt_g
+    return V
 
-    def by_cell(A: Array) -> Array:
-        A = A.reshape((Qu // qu, qu, Qv // qv, qv) + A.shape[2:]).swapaxes(1, 2)
-        return A.reshape(A.shape[:2] + (qu * qv * A.shape[-2], A.shape[-1]))
-    return np.swapaxes(by_cell(left), -1, -2) @ by_cell(right)
+
+def by_cell(A: Array, q: tuple[int, int]) -> Array:
+    """Grid array ``(Q_a, Q_v, ...)`` → ``(cells_a, cells_v, q_u q_v, ...)`` by cells.
+
+    The ``q_u × q_v`` Gauss points of each cell are consecutive in the grid
+    (:func:`~splinedeform.quadrature.gauss_points`).
+    """
+    (Qa, Qv), (qu, qv) = A.shape[:2], q
+    A = A.reshape((Qa // qu, qu, Qv // qv, qv) + A.shape[2:]).swapaxes(1, 2)
+    return A.reshape(A.shape[:2] + (qu * qv,) + A.shape[4:])

@@ -33,7 +33,9 @@ from . import metric
 from .shell import ShellMaterial, matrices
 from .shell_edges import EDGES, KINDS, check_edges, constraint_matrix  # noqa: F401
 from .shell_rigid import describe, free_rigid_motions
+from .shell_solve import dissection_ranks, static_displacement, unknown_order
 from .shell_solution import ShellModalSolution, ShellStaticSolution
+from .shell_stress import ShellStresses, stresses
 
 Array = NDArray[np.float64]
 
@@ -136,7 +138,20 @@ class ShellModel:
             "the shell against them (pin or clamp an edge, or fix components), or apply a "
             "self-equilibrated load")
 
+    def unknown_order(self) -> NDArray[np.int64]:
+        """The reduced unknowns in nested dissection order of their control points."""
+        if getattr(self, "_order", None) is None:
+            bu, bv = self.surface.basis_u, self.surface.basis_v
+            rank = dissection_ranks(bu.size, bv.size, (bu.degree, bv.degree),
+                                    bu.kind == "periodic", bv.kind == "periodic")
+            self._order = unknown_order(self.T, rank, np.arange(self.n_free))
+        return self._order
+
     def _static_solve(self, F: Array) -> Array:
+        """Nested dissection and no pivoting (:mod:`.shell_solve`), else the bordered system."""
+        d = static_displacement(self._K, self._M, self.rigid, F, self.unknown_order())
+        if d is not None:
+            return d
         C = self._M @ self.rigid
         k = C.shape[1]
         A = sp.bmat([[self._K, sp.csr_matrix(C)], [sp.csr_matrix(C.T), None]], format="csc")
@@ -183,7 +198,8 @@ class ShellModel:
         """The lowest ``k`` modes by shift-invert Lanczos, refusals in the shell's words."""
         try:
             return modal_basis.sparse_basis(self._K, self._M, k, None, self.rigid.shape[1],
-                                            **self._guard(check_spectrum))
+                                            **self._guard(check_spectrum),
+                                            order=self.unknown_order())
         except UnresolvedSpectrum:
             raise
         except SingularSystemError:
@@ -201,6 +217,16 @@ class ShellModel:
         lam, phi = self.eigen(k, check_spectrum)
         shapes = np.asarray(self.T @ phi).T.reshape((phi.shape[1],) + self.surface.shape + (3,))
         return np.sqrt(lam), shapes
+
+    def stresses(self, displacement: ArrayLike, u: ArrayLike, v: ArrayLike,
+                 at_poles: str = "raise") -> ShellStresses:
+        """Stresses of a displacement net ``(n_u, n_v, 3)`` (a solution's, a mode's) at ``u, v``.
+
+        See :func:`.shell_stress.stresses`: ``N``, ``M`` in the local frame, ``σ`` at top,
+        middle and bottom, principal and von Mises stresses, normal displacement;
+        ``at_poles="nan"`` gives NaN at degenerate points instead of refusing them.
+        """
+        return stresses(self.surface, self.material, displacement, u, v, at_poles)
 
     def _to_free(self, net: ArrayLike | None, what: str) -> Array:
         if net is None:

@@ -14,11 +14,13 @@ from typing import TYPE_CHECKING, Any, Callable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..errors import InputError
 from ..solution import Energy, Solution, _check_times
 from ..surface import Surface
 
 if TYPE_CHECKING:
     from .shell_model import ShellModel
+    from .shell_stress import ShellStresses
 
 Array = NDArray[np.float64]
 
@@ -57,6 +59,10 @@ class ShellStaticSolution:
         """Displacement ``d(u, v)`` of surface points, shape ``S + (3,)``."""
         return self.model.surface.derivative(u, v, control_points=self.net_displacement())
 
+    def stresses(self, u: ArrayLike, v: ArrayLike) -> ShellStresses:
+        """Resultants ``N, M``, stresses and von Mises at ``(u, v)`` (:mod:`.shell_stress`)."""
+        return self.model.stresses(self.net_displacement(), u, v)
+
     def energy(self) -> Energy:
         """Strain ``½ dᵀ K_r d``, load work ``Fᵀ d`` (total ``−½ Fᵀ d`` at equilibrium)."""
         K = self.model.matrices()[2]
@@ -94,6 +100,14 @@ class ShellModalSolution(Solution):
         if self.correction is not None:
             d = d + self.correction(times)[..., 0]
         return d, self.basis.expand(V)[..., 0]
+
+    def stresses(self, t: float, u: ArrayLike, v: ArrayLike) -> ShellStresses:
+        """Resultants, stresses and von Mises at time ``t`` (a number) and ``(u, v)``."""
+        times, scalar = _check_times(t)
+        if not scalar:
+            raise InputError(f"stresses are read at one time at a time, got {times.size} times")
+        net = self._full(self.state(times)[0])[0] - self.model.surface.control_points
+        return self.model.stresses(net, u, v)
 
     def velocities(self, t: ArrayLike) -> Array:
         """Control point velocities, same shapes as :meth:`control_points`."""

@@ -20,6 +20,7 @@ class Built:
     model: Any              # splinedeform.Model
     load: Any               # splinedeform.loads.Load or None
     fixed: Any = None       # bool mask (n_u, n_v) of the free region, or None
+    units: str | None = None  # length unit of a CAD surface (splinedeform.cad_units), or None
 
 
 @contextmanager
@@ -44,11 +45,22 @@ def _located(scenario: Scenario, path: str) -> Iterator[None]:
 
 def build_surface(scenario: Scenario) -> Any:
     """The initial surface: a built-in shape, a stored control net or a fitted point grid."""
+    return surface_and_units(scenario)[0]
+
+
+def surface_and_units(scenario: Scenario) -> tuple[Any, str | None]:
+    """The initial surface (see :func:`build_surface`) and its length unit: a CAD file's
+    (or ``surface.units``), None for other surfaces."""
+    spec = scenario.surface
+    if spec.shape == "cad":
+        return _surface_from_cad(scenario)
+    return _surface_of_shape(scenario), None
+
+
+def _surface_of_shape(scenario: Scenario) -> Any:
     spec = scenario.surface
     if spec.shape == "file":
         return _surface_from_file(scenario)
-    if spec.shape == "cad":
-        return _surface_from_cad(scenario)
     from .. import shapes
 
     with _located(scenario, "surface"), _periodic_at_knots(scenario):
@@ -76,17 +88,21 @@ def _fit_options(spec: SurfaceSpec) -> dict[str, Any]:
     return options
 
 
-def _surface_from_cad(scenario: Scenario) -> Any:
-    """Surface ``face`` of a CAD file, as a deformable NURBS surface (trimming dropped)."""
+def _surface_from_cad(scenario: Scenario) -> tuple[Any, str | None]:
+    """Surface ``face`` of a CAD file, as a deformable NURBS surface (trimming dropped),
+    and its unit: ``surface.units`` if given, else the file's."""
     from ..cad import read_cad, surface_from_patch
+    from ..input_files import open_input
 
     path = scenario.surface.path
     assert path is not None
     face = scenario.surface.parameters["face"]
     with _located(scenario, "surface.path"):
+        open_input(path, "CAD file").close()     # a regular file, not a pipe or device
         patch = read_cad(path, face)
-        return surface_from_patch(patch, name=f"{path.stem} face {face}",
-                                  source=f"{path} face {face}")
+        surface = surface_from_patch(patch, name=f"{path.stem} face {face}",
+                                     source=f"{path} face {face}")
+    return surface, scenario.surface.parameters.get("units") or patch.units
 
 
 def _surface_from_file(scenario: Scenario) -> Any:
@@ -97,7 +113,7 @@ def _surface_from_file(scenario: Scenario) -> Any:
     path = spec.path
     assert path is not None
     suffix = path.suffix.lower()
-    if not path.is_file():
+    if not path.exists():          # a pipe or device is refused on opening, naming it
         raise scenario.error("surface.path", f"file not found: {path}")
     if suffix not in (".json", ".npz", ".npy"):
         raise scenario.error("surface.path", f"expected a control net (.json, .npz) or a point "
@@ -126,9 +142,11 @@ def _point_grid(scenario: Scenario, path: Path) -> Any:
     import numpy as np
 
     from ..export.nets import real_array
+    from ..input_files import check_array_file, open_input
 
     try:
-        with open(path, "rb") as fh:
+        with open_input(path, "point grid") as fh:
+            check_array_file(fh, path)
             data = np.load(fh, allow_pickle=False)
             if isinstance(data, np.lib.npyio.NpzFile):
                 if "control_points" in data.files and "kind_u" in data.files:
@@ -138,6 +156,10 @@ def _point_grid(scenario: Scenario, path: Path) -> Any:
                     raise scenario.error("surface.path", f"{path.name} holds {names}; a point "
                                                          "grid .npz needs one array or 'points'")
                 data = data["points" if "points" in names else names[0]]
+    except ScenarioError:
+        raise
+    except InputError as exc:       # not a regular file, or arrays larger than memory
+        raise scenario.error("surface.path", str(exc)) from None
     except (OSError, ValueError) as exc:
         raise scenario.error("surface.path", f"cannot read {path.name}: {exc}") from None
     if data.ndim != 3 or data.shape[2] != 3:
@@ -147,8 +169,9 @@ def _point_grid(scenario: Scenario, path: Path) -> Any:
         return real_array(data, f"point grid {path.name}")
 
 
-def build_load(scenario: Scenario) -> Any:
-    """The sum of the ``[[load]]`` tables as a :mod:`splinedeform.loads` object (or None).
+def build_load(scenario: Scenario, scale: float = 1.0) -> Any:
+    """The sum of the ``[[load]]`` tables as a :mod:`splinedeform.loads` object (or None),
+    with forces and pressures divided by ``scale`` (see :mod:`splinedeform.load_scale`).
 
     Under ``physics = "shell"`` a ``uniform`` load is a force per unit surface area
     (:class:`~splinedeform.AreaForce`, e.g. self-weight).
@@ -160,14 +183,16 @@ def build_load(scenario: Scenario) -> Any:
 
     total = None
     for i, spec in enumerate(scenario.loads, start=1):
+        force = None if spec.force is None else tuple(f / scale for f in spec.force)
+        q = None if spec.q is None else spec.q / scale
         with _located(scenario, f"load[{i}]"):
             profile = {"constant": lambda: L.Constant(),
                        "step": lambda: L.Step(spec.t_on, spec.t_off),
                        "piecewise": lambda: L.Piecewise(spec.points),
                        "harmonic": lambda: L.Harmonic(spec.omega, spec.phase)}[spec.profile]()
-            load = {"point": lambda: L.Point(spec.at[0], spec.at[1], spec.force, profile),
-                    "uniform": lambda: uniform(force=spec.force, profile=profile),
-                    "pressure": lambda: L.Pressure(spec.q, profile)}[spec.kind]()
+            load = {"point": lambda: L.Point(spec.at[0], spec.at[1], force, profile),
+                    "uniform": lambda: uniform(force=force, profile=profile),
+                    "pressure": lambda: L.Pressure(q, profile)}[spec.kind]()
         total = load if total is None else total + load
     return total
 
@@ -227,19 +252,26 @@ def build(scenario: Scenario) -> Built:
     from ..material import Material
     from ..model import Model
 
-    surface = build_surface(scenario)
+    surface, units = surface_and_units(scenario)
+    if scenario.surface.shape in ("file", "cad"):     # the built-in shapes' lengths are keys
+        from .geometry import extent_problem
+
+        problem = extent_problem(surface, scenario.material.thickness)
+        if problem is not None:
+            raise scenario.error("surface.path", problem)
     _check_parameters(scenario, surface)
     fixed = free_region_mask(scenario, surface)
     if scenario.material.physics == "shell":
         return Built(surface=surface, model=_shell_model(scenario, surface, fixed),
-                     load=build_load(scenario), fixed=fixed)
+                     load=build_load(scenario), fixed=fixed, units=units)
     with _located(scenario, "material"):
         material = Material(**scenario.material.weights())
     with _located(scenario, "boundary"):
         model = Model(surface, material, boundary=scenario.boundary.edges(), fixed=fixed,
                       mass_matrix=scenario.material.mass_matrix,
                       physics=scenario.material.physics)
-    return Built(surface=surface, model=model, load=build_load(scenario), fixed=fixed)
+    return Built(surface=surface, model=model, load=build_load(scenario), fixed=fixed,
+                 units=units)
 
 
 def _shell_model(scenario: Scenario, surface: Any, fixed: Any) -> Any:
@@ -262,6 +294,7 @@ def describe(scenario: Scenario, built: Built | None = None) -> list[tuple[str, 
         rows += [("control net", f"{n_u} x {n_v} ({n_u * n_v} points)"),
                  (getattr(built.model, "unknowns_label", "free control points"),
                   str(built.model.n_free))]
+        rows += [("length unit", built.units)] if built.units is not None else []
     rows += [("loads", ", ".join(f"{ld.kind} ({ld.profile})" for ld in s.loads) or "none"),
              ("solve", s.solve.kind + (f" with {s.solve.method} to t = {s.solve.t_end:g}"
                                        if s.solve.kind == "dynamic" else "")),

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from ..errors import InputError, ScenarioError
+from ..input_files import read_input_text
 from ..model import METHODS
 from .keys import METHOD_SETTINGS
 from .locate import MAX_NESTING, key_lines, nesting_too_deep
@@ -42,10 +43,10 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None,
     """
     path = Path(path)
     try:
-        content = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ScenarioError(f"{path}: scenario file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
+        content = read_input_text(path, "scenario file")
+    except InputError as exc:
+        raise ScenarioError(str(exc)) from None
+    except OSError as exc:
         raise ScenarioError(f"{path}: cannot read the scenario file ({exc})") from None
     return parse_scenario(content, source=str(path), directory=path.parent.resolve(),
                           overrides=overrides, origin=origin,
@@ -55,7 +56,9 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None,
 def parse_scenario(content: str, source: str = "<scenario>", directory: Path | None = None,
                    overrides: Mapping[str, Any] | None = None,
                    origin: str = "override", allow_outside_paths: bool = False) -> Scenario:
-    """Validate the TOML text of a scenario (see :func:`load_scenario`)."""
+    """Validate the TOML text of a scenario (see :func:`load_scenario`); a leading UTF-8
+    byte order mark (as some editors write) is dropped."""
+    content = content.removeprefix("\ufeff")
     deep = nesting_too_deep(content)
     if deep is not None:
         raise ScenarioError(f"{source}:{deep}: arrays or inline tables nested more than "

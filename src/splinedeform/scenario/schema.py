@@ -35,6 +35,7 @@ from pydantic import BaseModel, ConfigDict, Field, Strict
 
 from ..basis import KNOT_KINDS
 from ..boundary import PRESETS
+from ..cad_units import UNITS
 from ..loads import OMEGA_MAX
 from ..model import METHODS, STEP_METHODS
 from ..shapes import FIT_METHODS
@@ -42,6 +43,8 @@ from ..shapes import FIT_METHODS
 PROFILES = ("constant", "step", "piecewise", "harmonic")
 IVP_METHODS = ("rk45", "dop853", "radau", "bdf")
 MASS_MATRICES = ("consistent", "lumped")
+#: length units of CAD files
+CAD_UNITS = tuple(UNITS)
 PHYSICS = ("parametric", "intrinsic", "shell")
 #: edge kinds of the Kirchhoff–Love shell only (``physics = "shell"``)
 SHELL_EDGES = ("diaphragm", "symmetry")
@@ -64,6 +67,7 @@ Time = Annotated[float, Strict(), Field(ge=0, le=TIME_MAX, allow_inf_nan=False)]
 Integer = Annotated[int, Strict()]
 Text = Annotated[str, Strict()]
 Pair = tuple[Real, Real]
+Angle = Annotated[float, Strict(), Field(ge=-360, le=360, allow_inf_nan=False)]
 #: index of a control point along one direction of the net (from 0)
 NetIndex = Annotated[int, Strict(), Field(ge=0, le=100_000)]
 Cells = Annotated[int, Strict(), Field(ge=1, le=512)]
@@ -163,6 +167,12 @@ class FromCad(_Table):
     face: Annotated[int, Strict(), Field(ge=0)] = Field(0, description=(
             "which surface of the file, counting plain surfaces and Brep faces in file "
             "order from 0; a trimmed face is taken untrimmed, with a warning"))
+    units: Optional[Literal[CAD_UNITS]] = Field(  # type: ignore[valid-type]
+        None, description=(
+            "length unit of the file's coordinates, overriding the unit the file declares "
+            "(the numbers are kept, only their unit changes); the run computes in it, "
+            "reports it and writes `3dm`, `step`, `iges` outputs in it"),
+        json_schema_extra={"doc_default": "the file's"})
 
 
 #: every ``surface.shape``; a new shape is one model here
@@ -355,6 +365,23 @@ class Output(_Table):
         json_schema_extra={"doc_default": 'the domain centre'})
     time: Optional[Time] = Field(None, description="dynamic: the state written as OBJ / STL / PLY",
         json_schema_extra={"doc_default": 'the last frame'})
+    warp: Union[Literal["auto"], Annotated[float, Strict(), Field(gt=0, le=1e6,
+                                                              allow_inf_nan=False)]] = Field(
+        "auto", description=(
+            "pictures and animation draw `x_rest + warp · d` (colours keep the true `|d|`); "
+            '"auto": below `max |d| = 0.05 · size`, `0.2 · size / max |d|` rounded to the '
+            "nearest 1, 2 or 5 × 10^k, else 1 (size: the largest side of the control net's "
+            "box; 1 for a modes solve), stated in the caption"))
+    camera: tuple[Angle, Angle] = Field(
+        (28.0, -60.0), title="[elevation, azimuth]", description=(
+            "view of the pictures and the animation, in degrees"))
+    fps: Annotated[float, Strict(), Field(gt=0, le=50, allow_inf_nan=False)] = Field(
+        15.0, description="frames per second of the animation (a GIF keeps hundredths of a "
+                          "second per frame)")
+    animate_modes: Optional[list[Annotated[int, Strict(), Field(ge=1, le=1000)]]] = Field(
+        None, title="mode numbers", description=(
+            "modes: the modes animated, mode 1 as `<name>.gif`, mode k as "
+            "`<name>_mode<k>.gif`"), json_schema_extra={"doc_default": "[1]"})
 
 
 class ScenarioFile(_Table):

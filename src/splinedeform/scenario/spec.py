@@ -128,6 +128,10 @@ class OutputSpec:
     resolution: int = 32
     probes: tuple[tuple[float, float], ...] = ()
     time: float | None = None
+    warp: str | float = "auto"
+    camera: tuple[float, float] = (28.0, -60.0)
+    fps: float = 15.0
+    animate_modes: tuple[int, ...] | None = None     # None: mode 1
 
 
 @dataclass(frozen=True)

@@ -8,6 +8,7 @@ from typing import Any, Iterable, Mapping
 
 from ..boundary import EDGES
 from .checks import Key, _Invalid
+from .geometry import length_problems
 from .keys import (BOUNDARY_KEYS, FORMAT_ALIASES, FREE_REGION_KEYS, LOAD_KEYS, LOAD_KIND_KEYS,
                    METHOD_SETTINGS, MATERIAL_KEYS, PROFILE_KEYS, SHAPE_PARAMETERS, SOLVE_KEYS,
                    SOLVE_KIND_KEYS, SURFACE_KEYS, TABLES, TOP_KEYS, OUTPUT_KEYS)
@@ -89,6 +90,9 @@ def _validate(raw: dict[str, Any], source: str, lines: Mapping[str, int],
                 problems.add(key, str(exc))
     surface = _validate_surface(raw, problems, directory, allow_outside_paths)
     material = _validate_material(raw, problems, surface)
+    if surface is not None and material is not None:
+        for key, message in length_problems(surface, material):
+            problems.add(key, message)
     physics = material.physics if material is not None else "parametric"
     boundary = _validate_boundary(raw, problems, physics)
     solve = _validate_solve(raw, problems, physics)
@@ -147,13 +151,39 @@ def _inside(directory: Path, written: str, allow_outside: bool, problems: _Probl
     written (never where a symbolic link points).
     """
     folder = directory.resolve()
-    path = (folder / written).resolve()
+    unusable = _unusable_path(written)
+    if unusable:
+        problems.add("surface.path", unusable)
+        return folder / "surface.path"     # never read: the problem stops the scenario
+    try:
+        path = (folder / written).resolve()
+    except (OSError, ValueError, RuntimeError) as exc:  # a loop of links, …
+        problems.add("surface.path", f"cannot be resolved: {exc}")
+        return folder / "surface.path"
     if not allow_outside and not path.is_relative_to(folder):
         problems.add("surface.path", f"{written!r} lies outside the scenario's folder; files "
                                      "are read only from that folder and its subfolders "
                                      "unless outside paths are allowed (command line: "
                                      "--allow-outside-paths, Python: allow_outside_paths=True)")
     return path
+
+
+#: longest file name, and path, accepted in a scenario (the usual file system limits)
+NAME_MAX, PATH_MAX = 255, 4096
+
+
+def _unusable_path(written: str) -> str:
+    """Why ``written`` cannot name a file (a NUL character, too long, empty), or ``""``."""
+    if not written.strip():
+        return "is empty; expected the name of a file"
+    if "\x00" in written:
+        return (f"contains a NUL character (at position {written.index(chr(0))}), which no "
+                "file name can hold")
+    longest = max(len(part.encode("utf-8", "surrogateescape")) for part in Path(written).parts)
+    if longest > NAME_MAX or len(written.encode("utf-8", "surrogateescape")) > PATH_MAX:
+        return (f"is too long ({len(written)} characters, longest part {longest} bytes); file "
+                f"names hold at most {NAME_MAX} bytes, paths {PATH_MAX}")
+    return ""
 
 
 def _validate_material(raw: Mapping[str, Any], problems: _Problems,
@@ -358,6 +388,14 @@ def _validate_output(raw: Mapping[str, Any], problems: _Problems,
         elif solve.t_end is not None and values["time"] > solve.t_end:
             problems.add("output.time", f"must be <= t_end = {solve.t_end:g}, got "
                                         f"{values['time']:g}")
+    if "animate_modes" in values and solve is not None:
+        if solve.kind != "modes":
+            problems.add("output.animate_modes",
+                         f"does not apply to a {solve.kind} solve (only modes)")
+        for i, k in enumerate(values["animate_modes"], start=1):
+            if k > solve.modes:
+                problems.add(f"output.animate_modes[{i}]",
+                             f"mode {k} is not computed: solve.modes = {solve.modes}")
     for i, (u, v) in enumerate(values.get("probes", ()), start=1):
         if u < 0 or v < 0:
             problems.add(f"output.probes[{i}]", f"parameters must be >= 0, got [{u:g}, {v:g}]")

@@ -20,6 +20,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
 
+from .._progress import simulated_time
 from .stepping import active_columns, stops_and_substeps
 
 Array = NDArray[np.float64]
@@ -73,6 +74,7 @@ def genalpha(M: sp.spmatrix, C: sp.spmatrix, K: sp.spmatrix, force: Callable[[fl
             a1 = lu.solve(rhs)
             d, v, a = d_pred + beta * h * h * a1, v_pred + gamma * h * a1, a1
         steps += n_sub
+        simulated_time(tb, t_end)
         while k_out < out_times.size and abs(out_times[k_out] - tb) <= atol:
             d_out[k_out][:, cols], v_out[k_out][:, cols] = d, v
             k_out += 1

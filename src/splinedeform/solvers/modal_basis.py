@@ -120,11 +120,32 @@ def separable_basis(factors: KroneckerFactors) -> SeparableBasis:
     return SeparableBasis(alpha, phi_u, beta, phi_v, factors.mass)
 
 
-def stiffness_factorisation(K: sp.spmatrix, shift: float = 0.0, M: sp.spmatrix | None = None
-                            ) -> Any:
-    """Sparse LU of ``K - shift M`` (fill-reducing ordering for symmetric matrices)."""
+class OrderedFactor:
+    """``A[order][:, order]`` factored without pivoting (symmetric positive definite
+    ``A``); :meth:`solve` takes and returns vectors in the original order."""
+
+    def __init__(self, A: sp.spmatrix, order: NDArray[np.int64]):
+        self.order = order
+        self.lu = spla.splu(sp.csc_matrix(A)[order][:, order].tocsc(), permc_spec="NATURAL",
+                            diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+
+    def solve(self, b: Array) -> Array:
+        out = np.empty_like(b, dtype=float)
+        out[self.order] = self.lu.solve(np.asarray(b, dtype=float)[self.order])
+        return out
+
+
+def stiffness_factorisation(K: sp.spmatrix, shift: float = 0.0, M: sp.spmatrix | None = None,
+                            order: NDArray[np.int64] | None = None) -> Any:
+    """Sparse LU of ``K - shift M`` (fill-reducing ordering for symmetric matrices).
+
+    ``order``: a fill-reducing order of the unknowns known to the caller (e.g. a nested
+    dissection of a tensor-product net), used as given without pivoting.
+    """
     A = K if shift == 0.0 else K - shift * M
     try:
+        if order is not None:
+            return OrderedFactor(A, order)
         return spla.splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A")
     except RuntimeError:
         raise SingularSystemError(
@@ -144,7 +165,8 @@ def _eigsh(K: sp.spmatrix, M: sp.spmatrix, k: int, shift: float, lu: Any) -> tup
 
 def sparse_basis(K: sp.spmatrix, M: sp.spmatrix, k: int | None = None,
                  omega_max: float | None = None, rigid: int | None = 0,
-                 advice: str = DEFAULT_ADVICE, guard: str = "condition") -> DenseBasis:
+                 advice: str = DEFAULT_ADVICE, guard: str = "condition",
+                 order: NDArray[np.int64] | None = None) -> DenseBasis:
     """Lowest modes by shift-invert Lanczos (``eigsh`` with a sparse LU of ``K - σM``).
 
     ``k`` modes, or all with ``ω <= omega_max`` (found by doubling the request). One mode more
@@ -154,6 +176,7 @@ def sparse_basis(K: sp.spmatrix, M: sp.spmatrix, k: int | None = None,
     round-off level behind a gap) ``K`` is singular, a small negative shift is used and
     there is no static solve. The ``rigid`` lowest eigenvalues are set to 0 and the rest
     checked against ``λ_max ≈ max K_ii/M_ii`` (``guard``, see :func:`_resolved`).
+    ``order`` is passed to :func:`stiffness_factorisation`.
     """
     n = K.shape[0]
     unconstrained = rigid != 0
@@ -162,7 +185,7 @@ def sparse_basis(K: sp.spmatrix, M: sp.spmatrix, k: int | None = None,
         shift = -1e-6 * scale
     else:
         shift = 0.0
-    lu = stiffness_factorisation(K, shift, M)
+    lu = stiffness_factorisation(K, shift, M, order)
     solve = None if unconstrained else lu.solve
     if omega_max is not None:
         want = min(32, n - 2)

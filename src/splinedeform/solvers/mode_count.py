@@ -24,7 +24,15 @@ at most 1 (its energy decays) and, with ``a = c/2``:
 :data:`DECADES` decades from ``λ_{k+1}`` (the bounds vary smoothly in ``log λ``). The number
 of modes must make ``max_t Σ_j ‖R_j‖_M E(t − t_j) ≤ tol · max_t ‖K⁻¹F(t)‖_M`` at the
 requested times: what it costs is set by the load's jumps and the damping, not by the net.
-The fewest modes meeting it are chosen in :mod:`.mode_select`.
+The fewest modes meeting it are chosen in :mod:`.mode_select`, which also states it for
+the largest control-point coordinate (``c_∞ Σ_j ‖R_j‖_M E(t − t_j) ≤ tol · max_t
+‖K⁻¹F(t)‖_∞``, ``c_∞ ≥ max_p √((M⁻¹)_pp)``).
+
+Each bound above is non-increasing in ``τ`` (the under-damped one has derivative
+``−a²τ e^{−aτ}`` before ``1/ω_d``; ``(1 + aτ)e^{−rτ}`` rises above 1 and falls back, so
+capped at 1 it never rises), hence so is ``E``: the bound at a time also holds at every
+later time up to the next jump, and only the time just after a jump (``E → 1``) is not
+covered by the bound at an earlier one.
 """
 
 from __future__ import annotations
@@ -47,7 +55,7 @@ def decay_bound(lam: Array, c: Array, tau: Array) -> Array:
     wd = np.sqrt(np.where(under, -d, 1.0))
     b_under = np.exp(-a * tau) * (1.0 + a * np.minimum(tau, 1.0 / wd))
     kappa = np.sqrt(np.where(under, 0.0, d))
-    rate = lam / np.maximum(a + kappa, 1e-300)
+    rate = lam / np.where(a + kappa > 0, a + kappa, 1.0)     # used where over-damped
     ratio = np.where(kappa > 0, (a + kappa) / (2.0 * np.where(kappa > 0, kappa, 1.0)), np.inf)
     b_over = np.exp(-rate * tau) * np.minimum(ratio, 1.0 + a * tau)
     out = np.minimum(out, np.where(under, b_under, b_over))

@@ -22,7 +22,9 @@ What makes choosing ``m`` cheap:
   row below it, the supremum over a larger set, so the bound is never lowered.
 
 So ``m`` is the smallest count whose bound meets the tolerance at the requested ``times``
-(one state: the fewest modes that time allows). When even all ``k`` computed modes miss it,
+(one state: the fewest modes that time allows), relative to ``max_t ‖K⁻¹F(t)‖_M`` or, with
+``pointwise = c_∞``, as ``c_∞ × bound`` relative to ``max_t ‖K⁻¹F(t)‖_∞`` — the largest
+control-point coordinate, since ``|x_p| ≤ c_∞ ‖x‖_M`` (:func:`pointwise_bound`). When even all ``k`` computed modes miss it,
 ``k`` grows to an estimate of the count needed (:func:`_grown`) and the same Krylov space
 is extended: the LU and every solve so far are kept. An estimate of ``n/2`` modes or more
 made from at least 64 computed ends the search: all modes are cheaper then (a frame a few
@@ -33,6 +35,7 @@ no faster than ``1/β``). From 16 modes the estimate is not trusted: a uniform l
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -42,7 +45,7 @@ from numpy.typing import NDArray
 from .bases import DenseBasis
 from .mode_acceleration import StaticCorrection
 from .modal_basis import DEFAULT_ADVICE
-from .mode_count import decay_bound
+from .mode_count import decay_bound, error_bound
 from .rigid import check_resolved
 from .sparse_eigen import BlockLanczos
 
@@ -51,6 +54,64 @@ GRID = 3500
 DECADES = 14.0
 START = 16
 """Modes computed first; the selection may keep fewer."""
+
+
+@dataclass(frozen=True)
+class ErrorEstimate:
+    """The a-priori bound of a chosen basis at any time:
+    ``relative(t) = weight · Σ_j ‖R_j‖_M E(λ_{m+1}, t − t_j)``.
+
+    ``weight`` is ``c_∞ / max_t ‖K⁻¹F(t)‖_∞`` (max norm, :func:`pointwise_bound`) or
+    ``1 / max_t ‖K⁻¹F(t)‖_M``. ``E`` is non-increasing in ``τ`` (each of its bounds is), so
+    the value at a time also bounds every later time up to the next jump.
+    """
+
+    jump_times: Array
+    norms: Array               # ‖R_j(m)‖_M, (J,)
+    lam_next: float            # λ_{m+1}
+    gamma: float
+    beta: float
+    weight: float
+
+    def relative(self, times: Array) -> Array:
+        """The bound at ``times`` (relative, in the measure the basis was chosen in)."""
+        return self.weight * error_bound(self.norms, self.jump_times, self.lam_next,
+                                         self.gamma, self.beta, np.asarray(times, dtype=float))
+
+
+def pointwise_bound(M: sp.spmatrix, T: sp.spmatrix | None = None,
+                    inverse_diagonal: Array | None = None) -> float:
+    """``c_∞`` with ``|x_p| ≤ c_∞ ‖x‖_M`` for every coordinate ``p`` of every ``x``.
+
+    ``|x_p| = |(M⁻¹e_p)ᵀ M x| ≤ √((M⁻¹)_pp) ‖x‖_M`` (Cauchy–Schwarz in the M inner product),
+    so ``c_∞ = max_p √((M⁻¹)_pp)``. ``inverse_diagonal``: the diagonal of the *unreduced*
+    mass matrix's inverse, valid when ``T`` only selects coordinates (``M_r`` is then a
+    principal submatrix and ``(M_r⁻¹)_pp ≤ (M⁻¹)_pp``, the Schur complement). Otherwise a
+    diagonal ``M`` gives ``1/M_pp`` and a general one ``1/λ_min(M)`` (``(M⁻¹)_pp ≤
+    λ_max(M⁻¹)``), ``λ_min`` from Lanczos less its residual norm (a lower bound).
+    """
+    if inverse_diagonal is not None and T is not None and _selects(T):
+        rows = np.asarray(T.tocsc().indices)
+        return float(np.sqrt(np.max(inverse_diagonal[rows])))
+    diagonal = M.diagonal()
+    if sp.issparse(M) and M.nnz == np.count_nonzero(diagonal):
+        return float(np.sqrt(np.max(1.0 / diagonal)))
+    import scipy.sparse.linalg as spla
+    n = M.shape[0]
+    if n <= 400:
+        low = float(np.linalg.eigvalsh(M.toarray() if sp.issparse(M) else M)[0])
+    else:
+        value, vector = spla.eigsh(M, k=1, which="SA", tol=1e-8)
+        residual = float(np.linalg.norm(M @ vector[:, 0] - value[0] * vector[:, 0]))
+        low = float(value[0]) - residual
+    return float(np.sqrt(1.0 / max(low, 1e-300)))
+
+
+def _selects(T: sp.spmatrix) -> bool:
+    """Whether ``T`` is a selection: one entry ``1`` per column, distinct rows."""
+    T = sp.csc_matrix(T)
+    return bool(T.nnz == T.shape[1] and np.all(np.diff(T.indptr) == 1)
+                and np.all(T.data == 1.0) and np.unique(T.indices).size == T.nnz)
 
 
 def envelope_table(lam_low: float, gamma: float, beta: float, tau: Array
@@ -97,10 +158,12 @@ def _m_norm2(M: sp.spmatrix, x: Array) -> float:
 
 def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Array]],
                     gamma: float, beta: float, times: Array, tolerance: float,
-                    start: int = START, advice: str = "", krylov: BlockLanczos | None = None
+                    start: int = START, advice: str = "", krylov: BlockLanczos | None = None,
+                    pointwise: float | None = None, best_effort: bool = False
                     ) -> tuple[Any, Any, dict[str, Any]]:
     """The fewest lowest modes whose a-priori bound (module docstring) meets ``tolerance``
-    relative to ``max_t ‖K⁻¹F(t)‖_M`` at ``times``.
+    at ``times``: relative to ``max_t ‖K⁻¹F(t)‖_M`` in the M-norm, or, with ``pointwise``,
+    in the largest control-point coordinate (:func:`pointwise_bound`).
 
     Parameters
     ----------
@@ -111,6 +174,11 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
     krylov : the Krylov space (and its LU of ``K``) of an earlier call on the same ``K``
         and ``M``, extended if more modes are needed; a further load case then costs its
         static solves and the bound, not a new eigen-solution.
+    best_effort : where all modes would be needed, return the computed ones instead (their
+        bound, above ``tolerance``, in the report with ``met = False``): for nets whose
+        complete eigen-solution is out of reach.
+    pointwise : ``c_∞ ≥ max_p √((M⁻¹)_pp)``: the bound becomes
+        ``c_∞ Σ_j ‖R_j‖_M E(t − t_j) / max_t ‖K⁻¹F(t)‖_∞`` (:func:`pointwise_bound`).
 
     Returns
     -------
@@ -138,7 +206,12 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
     flat = np.ascontiguousarray(F.transpose(1, 0, 2)).reshape(n, J * a)
     statics = (np.asarray(lu.solve(flat)).reshape(n, J, a).transpose(1, 0, 2) if J * a
                else np.zeros((J, n, a)))
-    scale = np.sqrt(max((_m_norm2(M, s) for s in np.cumsum(statics, axis=0)), default=0.0))
+    if pointwise is None:
+        scale = np.sqrt(max((_m_norm2(M, s) for s in np.cumsum(statics, axis=0)),
+                            default=0.0))
+        factor = 1.0
+    else:
+        scale, factor = float(np.abs(np.cumsum(statics, axis=0)).max(initial=0.0)), pointwise
     times = np.asarray(times, dtype=float)
     tau_all = times[:, None] - jump_times[None, :]
     tau, where = np.unique(np.where(tau_all > 0, tau_all, np.inf), return_inverse=True)
@@ -146,6 +219,7 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
     top = float(np.max(K.diagonal() / M.diagonal()))
     k = min(start, n // 2)
     table: tuple[Array, Array] | None = None
+    last: tuple | None = None
     while 1 <= k < n // 2:
         modes = krylov.lowest(k)
         lam = check_resolved(modes.lam, 0, "sparse eigen-solution",
@@ -167,9 +241,10 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
         bound = np.zeros((k + 1, times.size))
         for j in range(J):
             bound += norms[j, :, None] * E[rows][:, column[:, j]]
-        relative = bound.max(axis=1, initial=0.0) / max(scale, 1e-300)
+        relative = factor * bound.max(axis=1, initial=0.0) / max(scale, 1e-300)
         fits = np.flatnonzero(relative[1:] <= tolerance) + 1
         report.update(computed=k, solves=modes.solves)
+        last = (k, modes, lam, coef, norms, relative)
         if fits.size:
             m = int(fits[0])
             parts = statics - np.array([modes.combine(c[:m]) for c in coef])
@@ -181,13 +256,25 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
                        for p, s in zip(parts, statics)]
             residual = [np.linalg.norm(K @ s - f) / max(np.linalg.norm(f), 1e-300)
                         for s, f in zip(statics, F)]
-            report.update(modes=m, bound=float(relative[m]),
+            report.update(modes=m, bound=float(relative[m]), scale=float(scale),
                           omitted_static=float(max(omitted, default=0.0)),
-                          static_residual=float(max(residual, default=0.0)))
+                          static_residual=float(max(residual, default=0.0)),
+                          estimate=ErrorEstimate(jump_times, norms[:, m], float(lam[m]),
+                                                 gamma, beta, factor / max(scale, 1e-300)))
             return basis, StaticCorrection(jump_times, jump_parts, []), report
-        grown, needed = _grown(k, lam, norms, grid, E, column, tolerance * scale)
+        grown, needed = _grown(k, lam, norms, grid, E, column, tolerance * scale / factor)
         if k >= 64 and np.isfinite(needed) and needed >= n // 2:
             break                   # half the modes or more: all of them are cheaper
         k = grown
+    if best_effort and last is not None:
+        m, modes, lam, coef, norms, relative = last       # every mode computed, bound missed
+        parts = statics - np.array([modes.combine(c[:m]) for c in coef])
+        jump_parts = np.zeros((J, n, width))
+        jump_parts[:, :, active] = parts
+        basis = DenseBasis(lam[:m], modes.columns(m), "sparse", False, lu.solve, float(lam[m]))
+        report.update(modes=m, bound=float(relative[m]), scale=float(scale), met=False,
+                      estimate=ErrorEstimate(jump_times, norms[:, m], float(lam[m]), gamma,
+                                             beta, factor / max(scale, 1e-300)))
+        return basis, StaticCorrection(jump_times, jump_parts, []), report
     report.update(modes=n, bound=0.0)
     return None, None, report

@@ -26,6 +26,7 @@ import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import solve_ivp
 
+from .._progress import simulated_time
 from ..errors import InputError
 from .forcing import ReducedForcing  # noqa: F401 (public here too)
 from .genalpha import genalpha
@@ -128,6 +129,7 @@ def newmark(M: sp.spmatrix, C: sp.spmatrix, K: sp.spmatrix, forcing: Callable[[f
             v = v + 0.5 * h * (a + a1)
             d, a = d1, a1
         steps += n_sub
+        simulated_time(tb, t_end)
         while k_out < out_times.size and np.isclose(out_times[k_out], tb, rtol=0, atol=1e-12 * t_end):
             d_out[k_out], v_out[k_out] = d, v
             k_out += 1
@@ -149,6 +151,7 @@ def ivp(M: sp.spmatrix, C: sp.spmatrix, K: sp.spmatrix, forcing: Callable[[float
     m = len(cols)
 
     def rhs(t: float, y: Array) -> Array:
+        simulated_time(t, t_end)
         state = y.reshape(m, 2, n)
         d, v = state[:, 0].T, state[:, 1].T
         a = mass_lu.solve(forcing(t)[:, cols] - C @ v - K @ d)
@@ -179,6 +182,7 @@ def ivp(M: sp.spmatrix, C: sp.spmatrix, K: sp.spmatrix, forcing: Callable[[float
         v_out[filled:filled + inside.size][:, :, cols] = states[:, :, 1].transpose(0, 2, 1)
         filled += inside.size
         y = sol.y[:, -1]
+        simulated_time(tb, t_end)
     return d_out, v_out, stats
 
 

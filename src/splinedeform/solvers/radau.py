@@ -28,6 +28,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
 
+from .._progress import simulated_time
 from .stepping import active_columns, left_limit, stops_and_substeps
 
 Array = NDArray[np.float64]
@@ -142,6 +143,7 @@ def radau(M: sp.spmatrix, C: sp.spmatrix, K: sp.spmatrix, force: Callable[[float
                     zv += np.real(T[-1, k]) * wv
             d, v = d + zd, v + zv
         steps += n_sub
+        simulated_time(tb, t_end)
         while k_out < out_times.size and abs(out_times[k_out] - tb) <= atol:
             d_out[k_out][:, cols], v_out[k_out][:, cols] = d, v
             k_out += 1

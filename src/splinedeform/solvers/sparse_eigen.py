@@ -174,16 +174,25 @@ class BlockLanczos:
         self.lo, self.p = self.p, self.p + grow
 
     def _step(self) -> None:
-        """Apply ``S`` to the last block, orthogonalise (CGS twice), fill ``H``'s columns."""
+        """Apply ``S`` to the last block, orthogonalise, fill ``H``'s columns.
+
+        ``S = K⁻¹M`` is self-adjoint in the M inner product, so ``S V_j`` is M-orthogonal to
+        every block but the last two in exact arithmetic: the first Gram–Schmidt pass is
+        against those (the block three-term recurrence), the second against the whole basis
+        (full re-orthogonalisation, which removes what rounding left), half the work of two
+        full passes. The coefficients of both passes add up in ``H``.
+        """
         p, lo = self.p, self.lo
         V, MV = self.V[:, :p], self.MV[:, :p]
         W = self.lu.solve(self.MV[:, lo:p])
         self.solves += p - lo
-        C = MV.T @ W
-        W -= V @ C
+        near = max(0, lo - (p - lo))            # the last two blocks
+        C = MV[:, near:].T @ W
+        W -= V[:, near:] @ C
         C2 = MV.T @ W
         W -= V @ C2
-        self.H[:p, lo:p] = C + C2
+        C2[near:] += C
+        self.H[:p, lo:p] = C2
         self.next = _m_orthonormal(W, self.M @ W)
 
     def _advance(self) -> None:

@@ -12,7 +12,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import InputError
 from ..surface import Surface, grid_faces
 from .colour import MODE_COLORMAP
-from .figures import PANEL_INCHES, _axes3d, _bounds, _box, _collection, _figure, _save_png
+from .figures import CAMERA, _axes3d, _bounds, _box, _collection, _colorbar, _figure, _save_png
 
 
 def _check_histories(t: NDArray[np.float64], probes: Mapping[str, ArrayLike], what: str
@@ -140,12 +140,21 @@ def mode_geometry(surface: Surface, shape: ArrayLike, resolution: int = 40, scal
     return y.reshape(-1, 3), phi.ravel(), grid_faces(u.size, v.size)
 
 
+#: modes.png: each panel is MODE_PANEL_INCHES square, the colour bar's column is
+#: MODE_BAR_INCHES wide; white margins are cut down to MARGIN_PIXELS
+MODE_PANEL_INCHES = 3.2
+MODE_BAR_INCHES = 1.1
+
+
 def plot_modes(path: str | os.PathLike[str], surface: Surface, omegas: ArrayLike,
-               shapes: ArrayLike, resolution: int = 40) -> Path:
+               shapes: ArrayLike, resolution: int = 40,
+               camera: tuple[float, float] = CAMERA) -> Path:
     """modes.png: mode ``i`` drawn as ``x + s φ_i n`` (see :func:`mode_geometry`).
 
-    Coloured by ``φ_i`` on a symmetric diverging scale; the panel title gives ``ω_i``.
-    Up to three panels per row, 400 × 400 px each.
+    Coloured by ``φ_i / max |φ_i|`` on the diverging scale ``[-1, 1]`` shown by the colour
+    bar (blue: against the normal, red: along it); the panel title gives ``ω_i``. Up to
+    three panels per row, 320 × 320 px each, seen from ``camera = (elevation, azimuth)``;
+    the white margins of the figure are trimmed (:func:`~.figures._save_png`).
     """
     w = np.asarray(omegas, dtype=float)
     phis = np.asarray(shapes, dtype=float)
@@ -161,16 +170,23 @@ def plot_modes(path: str | os.PathLike[str], surface: Surface, omegas: ArrayLike
 
     cols = min(w.size, 3)
     rows = -(-w.size // cols)
-    fig = _figure(PANEL_INCHES * cols, PANEL_INCHES * rows)
+    width, height = MODE_PANEL_INCHES * cols + MODE_BAR_INCHES, MODE_PANEL_INCHES * rows
+    fig = _figure(width, height)
     cmap = matplotlib.colormaps[MODE_COLORMAP]
+    cell_w, cell_h = MODE_PANEL_INCHES / width, MODE_PANEL_INCHES / height
     for i in range(w.size):
         y, phi, faces = mode_geometry(surface, phis[i], resolution)
         peak = float(np.abs(phi).max()) or 1.0
         rgba = np.asarray(cmap(0.5 + 0.5 * phi[faces].mean(axis=1) / peak))
-        ax = _axes3d(fig, (rows, cols, i + 1))
+        r, c = divmod(i, cols)
+        ax = _axes3d(fig, [c * cell_w, 1 - (r + 1) * cell_h, cell_w, 0.9 * cell_h], camera)
         ax.add_collection3d(_collection(y, faces, rgba))
-        _box(ax, y, zoom=1.3)
+        _box(ax, y, zoom=1.2)
         ax.set_axis_off()
-        ax.set_title(f"mode {i + 1}: ω = {w[i]:.5g}", fontsize=11)
-    return _save_png(fig, path)
+        ax.set_title(f"mode {i + 1}: ω = {w[i]:.5g}", fontsize=11, pad=0)
+    bar_h = min(0.7, 2.6 / height)
+    _colorbar(fig, [(cols * MODE_PANEL_INCHES + 0.2) / width, 0.5 - bar_h / 2, 0.16 / width,
+                    bar_h], 1.0, label="φ / max |φ|  (along the normal)",
+              colormap=MODE_COLORMAP, vmin=-1.0)
+    return _save_png(fig, path, trim=True)
 

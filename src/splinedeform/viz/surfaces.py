@@ -19,14 +19,15 @@ from ..errors import InputError
 from ..export import check_net, tessellate_frames, weld, write_with
 from ..surface import Surface
 from .colour import COLORMAP
-from .figures import (COLORBAR_INCHES, DPI, PANEL_INCHES, REST_RGBA, _axes3d, _axis_labels, _box,
-                      _collection, _colorbar, _face_colors, _figure, _save_png)
+from .figures import (CAMERA, COLORBAR_INCHES, DPI, PANEL_INCHES, REST_RGBA, _axes3d, _axis_labels,
+                      _box, _collection, _colorbar, _face_colors, _figure, _save_png)
+from .warp import warp_caption
 
 
 def _displaced_meshes(surface: Surface, rest_net: ArrayLike, nets: Sequence[ArrayLike],
-                      resolution: int) -> tuple[NDArray[np.float64], NDArray[np.float64],
-                                                NDArray[np.int64]]:
-    """Vertices ``(F, N, 3)``, displacement magnitudes ``(F, N)`` and faces.
+                      resolution: int, warp: float = 1.0
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+    """Drawn vertices ``x_rest + w d`` ``(F, N, 3)``, true ``|d|`` ``(F, N)`` and faces.
 
     Welded (:func:`~splinedeform.export.weld`): seams and poles are one vertex and the
     zero-area triangles of a pole, whose normal is undefined, are not drawn.
@@ -37,7 +38,7 @@ def _displaced_meshes(surface: Surface, rest_net: ArrayLike, nets: Sequence[Arra
     X0, _ = tessellate_frames(surface, rest, resolution)
     keep, faces = weld(np.concatenate([X0[None], X]), faces)
     X, X0 = X[:, keep], X0[keep]
-    return X, np.linalg.norm(X - X0, axis=-1), faces
+    return X0 + warp * (X - X0), np.linalg.norm(X - X0, axis=-1), faces
 
 
 def _pyvista() -> Any:
@@ -50,7 +51,8 @@ def _pyvista() -> Any:
 
 
 def _render_pyvista(path: Path, X: NDArray[np.float64], mag: NDArray[np.float64],
-                    faces: NDArray[np.int64], titles: Sequence[str], vmax: float) -> Path:
+                    faces: NDArray[np.int64], titles: Sequence[str], vmax: float,
+                    caption: str = "") -> Path:
     pv = _pyvista()
     if pv is None:
         raise RuntimeError("pyvista is not installed")
@@ -66,6 +68,8 @@ def _render_pyvista(path: Path, X: NDArray[np.float64], mag: NDArray[np.float64]
             plotter.add_mesh(mesh, scalars="|displacement|", cmap=COLORMAP,
                              clim=(0.0, vmax if vmax > 0 else 1.0), show_scalar_bar=i == n - 1)
             plotter.add_text(titles[i], font_size=10)
+            if caption and i == n - 1:
+                plotter.add_text(caption, position="lower_left", font_size=8)
             plotter.view_isometric()
         plotter.link_views()
         return write_with(path, lambda tmp: plotter.screenshot(str(tmp)))
@@ -74,19 +78,21 @@ def _render_pyvista(path: Path, X: NDArray[np.float64], mag: NDArray[np.float64]
 
 
 def surfaces_figure(X: NDArray[np.float64], mag: NDArray[np.float64],
-                    faces: NDArray[np.int64], titles: Sequence[str], vmax: float) -> Any:
+                    faces: NDArray[np.int64], titles: Sequence[str], vmax: float,
+                    camera: tuple[float, float] = CAMERA, warp: float = 1.0) -> Any:
     """The matplotlib Figure of :func:`render_surfaces` (one 3-D axes per panel).
 
     Each surface is one collection of triangles, drawn far to near in the order of the
     depth of their projected centroids (painter's order), shaded by
     :func:`~splinedeform.viz.colour.shade`. A panel without displacement (the rest shape)
     is drawn in a neutral grey, so its shading shows the shape rather than a flat navy.
+    A warp factor ``warp`` other than 1 is written under the colour bar.
     """
     n = X.shape[0]
     width = PANEL_INCHES * n + COLORBAR_INCHES
     fig = _figure(width, PANEL_INCHES)
     for i in range(n):
-        ax = _axes3d(fig, [i * PANEL_INCHES / width, 0.02, PANEL_INCHES / width, 0.9])
+        ax = _axes3d(fig, [i * PANEL_INCHES / width, 0.02, PANEL_INCHES / width, 0.9], camera)
         at_rest = not mag[i].max() > 1e-12 * vmax
         rgba = np.tile(REST_RGBA, (faces.shape[0], 1)) if at_rest \
             else _face_colors(mag[i], faces, vmax)
@@ -95,22 +101,29 @@ def surfaces_figure(X: NDArray[np.float64], mag: NDArray[np.float64],
         _axis_labels(ax)
         ax.set_title(titles[i], fontsize=10)
     _colorbar(fig, [(n * PANEL_INCHES + 0.45) / width, 0.12, 0.18 / width, 0.72], vmax)
+    if warp != 1:
+        fig.text((n * PANEL_INCHES + 0.54) / width, 0.015, f"displacement\ndrawn × {warp:g}",
+                 fontsize=8, ha="center", va="bottom")
     return fig
 
 
 def _render_matplotlib(path: Path, X: NDArray[np.float64], mag: NDArray[np.float64],
-                       faces: NDArray[np.int64], titles: Sequence[str], vmax: float) -> Path:
-    return _save_png(surfaces_figure(X, mag, faces, titles, vmax), path)
+                       faces: NDArray[np.int64], titles: Sequence[str], vmax: float,
+                       camera: tuple[float, float], warp: float) -> Path:
+    return _save_png(surfaces_figure(X, mag, faces, titles, vmax, camera, warp), path)
 
 
 def render_surfaces(path: str | os.PathLike[str], surface: Surface, rest_net: ArrayLike,
-                    nets: Sequence[ArrayLike], titles: Sequence[str], resolution: int = 48
-                    ) -> Path:
+                    nets: Sequence[ArrayLike], titles: Sequence[str], resolution: int = 48,
+                    warp: float = 1.0, camera: tuple[float, float] = CAMERA) -> Path:
     """PNG with one panel per control net, coloured by ``|x - x_rest|`` on a shared scale.
 
     All panels share the colour scale ``[0, max |d|]`` and the same equal-aspect box, so
     sizes and colours compare across panels; a panel with no displacement is grey. With
-    matplotlib the picture is ``(400 n + 150) × 400`` pixels for ``n`` panels.
+    matplotlib the picture is ``(400 n + 150) × 400`` pixels for ``n`` panels. Each panel
+    draws ``x_rest + w d`` with the warp factor ``w`` (stated under the colour bar when it
+    is not 1; colours keep the true ``|d|``), seen from ``camera = (elevation, azimuth)``
+    in degrees (matplotlib; PyVista keeps its isometric view).
     """
     target = Path(path)
     if target.suffix.lower() != ".png":
@@ -120,13 +133,16 @@ def render_surfaces(path: str | os.PathLike[str], surface: Surface, rest_net: Ar
     if len(nets) == 0 or len(nets) != len(titles):
         raise InputError(f"give one title per net and at least one net; got {len(nets)} net(s) "
                          f"and {len(titles)} title(s)")
-    X, mag, faces = _displaced_meshes(surface, rest_net, nets, resolution)
+    if not (isinstance(warp, (int, float)) and np.isfinite(warp) and warp > 0):
+        raise InputError(f"warp must be finite and > 0, got {warp!r}")
+    X, mag, faces = _displaced_meshes(surface, rest_net, nets, resolution, float(warp))
     vmax = float(mag.max())
     titles = [str(t) for t in titles]
+    caption = warp_caption(float(warp))
     if _pyvista() is not None:
         try:
-            return _render_pyvista(target, X, mag, faces, titles, vmax)
+            return _render_pyvista(target, X, mag, faces, titles, vmax, caption)
         except Exception:   # noqa: BLE001  (no off-screen context: draw with matplotlib)
             pass
-    return _render_matplotlib(target, X, mag, faces, titles, vmax)
+    return _render_matplotlib(target, X, mag, faces, titles, vmax, camera, float(warp))
 

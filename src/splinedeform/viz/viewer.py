@@ -43,15 +43,19 @@ def viewer_data(surface: Surface, rest_net: ArrayLike, times: ArrayLike, nets: A
 
     ``frames`` holds float32 vertex positions ``(F, N, 3)`` and ``nets`` the control
     nets ``(F, n_u, n_v, 3)`` as base64; ``rest`` the rest mesh for ``|d|``; ``title``
-    (default: the surface's name) heads the page.
+    (default: the surface's name) heads the page. The page opens at ``startFrame``, the
+    frame of largest displacement ``argmax_f max |x_f - x_rest|`` over the tessellation
+    (the first such), as ``surfaces.png`` shows it.
     """
     t, P = check_frames(surface, times, nets)
     rest = check_net(surface, rest_net, "rest net")
     X, faces = tessellate_frames(surface, P, resolution)
     X0, _ = tessellate_frames(surface, rest, resolution)
-    vmax = float(np.linalg.norm(X - X0, axis=-1).max())
+    largest = np.linalg.norm(X - X0, axis=-1).max(axis=-1)
+    vmax = float(largest.max())
     return {"name": surface.name, "title": surface.name if title is None else str(title),
-            "times": t.tolist(), "vertexCount": int(X.shape[1]),
+            "times": t.tolist(), "startFrame": int(np.argmax(largest)),
+            "vertexCount": int(X.shape[1]),
             "frames": _b64(X, "<f4"), "rest": _b64(X0, "<f4"), "faces": _b64(faces, "<u4"),
             "faceCount": int(faces.shape[0]), "netShape": list(surface.shape),
             "periodic": [surface.basis_u.periodic, surface.basis_v.periodic],

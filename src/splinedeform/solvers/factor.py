@@ -1,0 +1,137 @@
+"""One symmetric factorisation of a constrained stiffness (or any SPD) matrix.
+
+Once constrained, ``K_r`` is symmetric positive definite, so ``K_r = Lᵀ L`` (Cholesky) and
+every solve is two triangular sweeps. Which factorisation is fastest was measured on
+the bench plate (docs/cost.md, "where the time goes"):
+
+``"banded"``
+    LAPACK's band Cholesky (``dpbtrf``, :func:`scipy.linalg.cholesky_banded`) in the
+    natural order of the free coordinates. The Kronecker ordering of a tensor-product
+    net keeps the half bandwidth at ``b = n (m_v + 1)`` for degree ``n`` and ``m_v`` free
+    coordinates along v, so the cost is ``N b²`` flops of dense, blocked level-3 BLAS and
+    ``N (b + 1)`` numbers of storage. Chosen while that storage is at most
+    :data:`BAND_BYTES`.
+``"superlu"``
+    SuperLU (:func:`scipy.sparse.linalg.splu`) with the symmetric options: the minimum
+    degree ordering of ``Kᵀ + K`` (``MMD_AT_PLUS_A``), no threshold pivoting
+    (``diag_pivot_thresh = 0``: the diagonal of an SPD matrix is a stable pivot) and
+    ``SymmetricMode``. The default column ordering (``COLAMD``) ignores the symmetry and
+    fills in several times more. The fallback for any matrix.
+``"cholmod"``
+    CHOLMOD's supernodal Cholesky (scikit-sparse, not a dependency: it has no wheel and
+    builds only against a SuiteSparse installation); used by ``"auto"`` only where it is
+    installed and the band is too wide.
+
+``factorise(K)`` returns an object with ``solve(b)`` for ``b`` of shape ``(N,)`` or
+``(N, k)`` and the name of the method used.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from numpy.typing import NDArray
+
+from ..errors import InputError
+
+Array = NDArray[np.float64]
+
+METHODS = ("auto", "banded", "superlu", "cholmod")
+
+BAND_BYTES = 128 * 2**20
+"""Largest band storage ``8 N (b + 1)`` bytes for which ``"auto"`` takes the band Cholesky."""
+
+
+@dataclass(frozen=True)
+class Factorisation:
+    """A factorised matrix: ``solve(b)`` returns ``K⁻¹ b``; ``method`` names how."""
+
+    method: str
+    solve: Callable[[Array], Array]
+
+
+def half_bandwidth(K: sp.spmatrix) -> int:
+    """``max |i - j|`` over the stored entries of ``K`` (0 for a diagonal or empty matrix)."""
+    coo = K.tocoo()
+    return int(np.abs(coo.row - coo.col).max()) if coo.nnz else 0
+
+
+def factorise(K: sp.spmatrix, method: str = "auto") -> Factorisation:
+    """Factorise the symmetric matrix ``K`` once.
+
+    Parameters
+    ----------
+    K : sparse matrix, shape ``(N, N)``
+        Symmetric; positive definite for the Cholesky methods.
+    method : {"auto", "banded", "superlu", "cholmod"}
+        ``"auto"``: the band Cholesky while its storage is at most :data:`BAND_BYTES`,
+        else CHOLMOD where installed, else SuperLU. A Cholesky method that finds ``K``
+        not positive definite falls back to SuperLU (which then solves an indefinite
+        but regular ``K`` or raises ``RuntimeError`` for a singular one, as ``splu`` does).
+
+    Returns
+    -------
+    Factorisation
+    """
+    if method not in METHODS:
+        raise InputError(f"factorisation method must be one of {METHODS}, got {method!r}")
+    if K.shape[0] != K.shape[1]:
+        raise InputError(f"a factorised matrix must be square, got shape {K.shape}")
+    if method == "auto":
+        n, b = K.shape[0], half_bandwidth(K)
+        if 8 * n * (b + 1) <= BAND_BYTES:
+            method = "banded"
+        else:
+            method = "cholmod" if _cholmod() is not None else "superlu"
+    try:
+        if method == "banded":
+            return _banded(K)
+        if method == "cholmod":
+            module = _cholmod()
+            if module is None:
+                raise InputError("factorisation 'cholmod' needs scikit-sparse, which is not "
+                                 "installed (it builds from source against SuiteSparse: e.g. "
+                                 "Debian's libsuitesparse-dev with scikit-sparse 0.4.16)")
+            factor = module.cholesky(sp.csc_matrix(K))
+            return Factorisation("cholmod", factor)
+    except np.linalg.LinAlgError:
+        pass                                   # not positive definite: the general LU below
+    except Exception as error:                 # CHOLMOD's NotPositiveDefiniteError
+        if type(error).__name__ != "CholmodNotPositiveDefiniteError":
+            raise
+    return _superlu(K)
+
+
+def _banded(K: sp.spmatrix) -> Factorisation:
+    """LAPACK band Cholesky ``K = Uᵀ U`` on the upper band (``dpbtrf`` / ``dpbtrs``)."""
+    n, b = K.shape[0], half_bandwidth(K)
+    upper = sp.triu(K, format="coo")
+    band = np.zeros((b + 1, n))
+    band[b + upper.row - upper.col, upper.col] = upper.data   # LAPACK upper band storage
+    U = sla.cholesky_banded(band, overwrite_ab=True, lower=False, check_finite=False)
+
+    def solve(rhs: Array) -> Array:
+        return sla.cho_solve_banded((U, False), np.asarray(rhs, dtype=float),
+                                    check_finite=False)
+
+    return Factorisation("banded", solve)
+
+
+def _superlu(K: sp.spmatrix) -> Factorisation:
+    """SuperLU with the symmetric ordering ``MMD_AT_PLUS_A`` and diagonal pivots."""
+    lu = spla.splu(sp.csc_matrix(K), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                   options={"SymmetricMode": True})
+    return Factorisation("superlu", lu.solve)
+
+
+def _cholmod():  # pragma: no cover - only with the optional extra
+    try:
+        from sksparse import cholmod
+    except ImportError:
+        return None
+    return cholmod

@@ -1,0 +1,60 @@
+"""Kronecker assembly (assembly.py) against scipy's kron and the reduction T^T K T."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+import splinedeform as sd
+from splinedeform.assembly import full_matrices, kronecker_sum, reduced_matrices
+
+PLATE = sd.Material(mass=1.3, damping=0.8, rayleigh=5e-4, w10=10.0, w01=7.0, w20=1.0,
+                    w11=0.5, w02=2.0)
+
+
+@pytest.mark.parametrize("format", ["csr", "csc"])
+def test_kronecker_sum_equals_the_sum_of_scipy_krons(format):
+    """Different patterns per term (the union is taken), rectangular factors, both layouts."""
+    rng = np.random.default_rng(0)
+    terms = [(w, sp.random(5, 4, 0.5, random_state=rng), sp.random(3, 6, 0.4, random_state=rng))
+             for w in (1.5, -2.0, 0.25)]
+    expected = sum(w * sp.kron(A, B) for w, A, B in terms).toarray()
+    K = kronecker_sum(terms, format=format)
+    assert K.format == format and K.shape == (15, 24) and K.has_sorted_indices
+    K.check_format(full_check=True)
+    # sums of three products of O(1) numbers: a few roundings
+    np.testing.assert_allclose(K.toarray(), expected, rtol=0, atol=1e-15 * np.abs(expected).max())
+
+
+BOUNDARIES = ["clamped", "pinned", {"u0": "clamped", "v1": "pinned"}]
+
+
+@pytest.mark.parametrize("boundary", BOUNDARIES)
+@pytest.mark.parametrize("lumped", [False, True])
+def test_reduced_matrices_equal_the_reduction_of_the_full_ones(boundary, lumped):
+    """(T_u ⊗ T_v)ᵀ (A ⊗ B) (T_u ⊗ T_v) = (T_uᵀ A T_u) ⊗ (T_vᵀ B T_v), to rounding (1e-12)."""
+    model = sd.Model(sd.shapes.plane(cells=(7, 5)), PLATE, boundary=boundary)
+    K, M = full_matrices(model.gram_u, model.gram_v, PLATE, lumped)
+    terms = [(PLATE.w10, 1, 0), (PLATE.w01, 0, 1), (PLATE.w20, 2, 0), (2 * PLATE.w11, 1, 1),
+             (PLATE.w02, 0, 2)]
+    K_kron = sum(w * sp.kron(model.gram_u[a], model.gram_v[b]) for w, a, b in terms)
+    np.testing.assert_allclose(K.toarray(), K_kron.toarray(), rtol=0,
+                               atol=1e-12 * abs(K_kron).max())
+    T = model.constraints.T
+    K_r, M_r = reduced_matrices(model.gram_u, model.gram_v, PLATE, lumped, M, model.constraints)
+    for got, full in ((K_r, K_kron), (M_r, M)):
+        expected = (T.T @ full @ T).toarray()
+        np.testing.assert_allclose(got.toarray(), expected, rtol=0,
+                                   atol=1e-12 * np.abs(expected).max())
+
+
+def test_fixed_points_off_the_tensor_structure_take_the_general_reduction():
+    fixed = np.zeros((10, 8), bool)
+    fixed[3, 4] = True
+    model = sd.Model(sd.shapes.plane(cells=(7, 5)), PLATE, boundary="clamped", fixed=fixed)
+    assert model.constraints.T_u is None
+    assert reduced_matrices(model.gram_u, model.gram_v, PLATE, False, model.M_full,
+                            model.constraints) is None
+    T = model.constraints.T
+    expected = (T.T @ model.K_full @ T).toarray()
+    np.testing.assert_allclose(model.matrices()[2].toarray(), expected, rtol=0,
+                               atol=1e-12 * np.abs(expected).max())
