@@ -125,6 +125,7 @@ def test_two_grabs_held_at_once_superpose(page):
     for step in range(1, 5):
         page.mouse.move(first["x"], first["y"] + 10 * step)
         page.wait_for_timeout(40)
+    page.wait_for_function("sculptState.grabbed && sculptState.grabbed.force", timeout=30000)
     page.keyboard.down("Shift")
     page.mouse.up()                               # shift: the grab stays held
     page.keyboard.up("Shift")
@@ -138,6 +139,9 @@ def test_two_grabs_held_at_once_superpose(page):
         page.mouse.move(second["x"] + 8 * step, second["y"] - 6 * step)
         page.wait_for_timeout(40)
     page.wait_for_timeout(300)
+    # a frame has pulled with both and the status line (redone every 250 ms) says so
+    page.wait_for_function("sculptState.grabs.length === 2 && sculptState.grabs.every((g) => g.force)"
+                           " && sculptState.hud.includes('more held')", timeout=30000)
     page.evaluate("sculptState.setPaused(true)")
     grabs = page.evaluate("sculptState.grabs")
     snap = page.evaluate("sculptState.snapshot()")
