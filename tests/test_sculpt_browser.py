@@ -330,7 +330,9 @@ def test_the_grab_is_seen_and_named_in_words(page, server):
     start = page.evaluate(f"sculptState.screen({sample})")
     index = grab_and_pull(page, sample, 40)          # the pointer ends 40 px below the start
     page.evaluate("sculptState.setPaused(true)")
-    page.wait_for_timeout(400)                       # a frame drawn and the status line redone
+    page.wait_for_timeout(300)                       # a frame drawn and the status line redone
+    page.wait_for_function("sculptState.grabView && sculptState.hud.includes('pulling the point')",
+                           timeout=30000)
     view = page.evaluate("sculptState.grabView")
     rest = np.array(page.evaluate(f"sculptState.rest({index})"))
     disp = np.array(page.evaluate(f"sculptState.displacement({index})"))

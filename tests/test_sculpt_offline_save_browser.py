@@ -58,8 +58,7 @@ def _runs_alone(page) -> None:
     index = (R // 2) * R + R // 2
     assert page.evaluate(f"sculptState.correction({index}) !== null")   # computed in the page
     page.evaluate(f"sculptState.hold({index}, [0, 0, -1])")
-    page.wait_for_timeout(300)
-    assert page.evaluate(f"sculptState.displacement({index})[2]") < 0
+    page.wait_for_function(f"sculptState.displacement({index})[2] < 0", timeout=30000)
     page.evaluate("sculptState.release()")
     assert not page.problems
 

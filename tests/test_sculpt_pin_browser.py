@@ -43,8 +43,8 @@ def page(tmp_path_factory, browser):
 def test_a_pinned_point_stays_where_it_was_while_another_is_pulled(page):
     page.click("#show-net")                       # the net's displacement is computed
     centre, other = (R // 2) * R + R // 2, 3 * R + 8
-    page.evaluate(f"sculptState.hold({centre}, [0, 0, -2])")
-    page.wait_for_timeout(500)
+    t0 = page.evaluate(f"sculptState.hold({centre}, [0, 0, -2]); sculptState.time")
+    page.wait_for_function(f"sculptState.time > {t0 + 0.4}", timeout=30000)
     page.evaluate("sculptState.setPaused(true)")  # the shape holds still for the pin
     k = page.evaluate(f"sculptState.nearestNet({centre})")
     before = np.array(page.evaluate(f"sculptState.netPosition({k})"))
@@ -62,8 +62,9 @@ def test_a_pinned_point_stays_where_it_was_while_another_is_pulled(page):
     page.evaluate("sculptState.setPaused(false)")
     page.evaluate(f"sculptState.hold({other}, [0, 0.5, -3])")
     moved, neighbour = [], []
-    for _ in range(6):
-        page.wait_for_timeout(100)
+    for _ in range(6):                            # six moments 0.1 s of page time apart
+        t0 = page.evaluate("sculptState.time")
+        page.wait_for_function(f"sculptState.time > {t0 + 0.1}", timeout=30000)
         net = np.array(page.evaluate("sculptState.netDisplacement()")).reshape(-1, 3)
         moved.append(np.abs(net[k]).max())
         neighbour.append(np.abs(net[k + 1]).max())
@@ -86,8 +87,8 @@ def test_export_buttons_download_the_shape_shown(page, tmp_path):
 
     if not page.evaluate("document.getElementById('show-net').checked"):
         page.click("#show-net")                   # the net's displacement is computed
-    page.evaluate(f"sculptState.hold({(R // 2) * R + 3}, [0, 0, -2])")
-    page.wait_for_timeout(400)
+    t0 = page.evaluate(f"sculptState.hold({(R // 2) * R + 3}, [0, 0, -2]); sculptState.time")
+    page.wait_for_function(f"sculptState.time > {t0 + 0.3}", timeout=30000)
     page.evaluate("sculptState.setPaused(true)")
     files = {}
     for fmt in ("3dm", "json", "obj"):
