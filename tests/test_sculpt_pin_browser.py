@@ -2,7 +2,7 @@
 Chromium or Playwright is missing): an alt-click on a pulled sheet pins the control point
 nearest to the clicked point where it is now (a bake with that point taken out of the free
 set), and it stays there while another point is pulled; the export buttons download the
-shape shown."""
+shape shown; two grabs held at once (shift, or two fingers) superpose."""
 
 from __future__ import annotations
 
@@ -170,3 +170,34 @@ def test_two_grabs_held_at_once_superpose(page):
     # every mode kept (no correction): the same closed form summed in another order, 1e-6
     assert np.max(np.abs(both - alone[0] - alone[1])) <= 1e-6 * scale
     assert not page.problems and page.evaluate("sculptState.errors") == []
+
+
+def test_two_fingers_grab_two_points(page, browser):
+    """On a touch screen each finger grabs on its own: two touches dragged apart pull two
+    points, one down and one up, and lifting them lets both go."""
+    context = browser.new_context(viewport={"width": 900, "height": 600}, has_touch=True)
+    touch = context.new_page()
+    touch.goto(page.url)
+    touch.wait_for_function("window.sculptState !== undefined && sculptState.time > 0.1", timeout=60000)
+    cdp = context.new_cdp_session(touch)
+    a, c = (touch.evaluate(f"sculptState.screen({n})") for n in (3 * R + 4, 6 * R + 5))
+
+    def points(dy: float) -> list[dict]:
+        return [{"x": a["x"], "y": a["y"] + dy, "id": 1}, {"x": c["x"], "y": c["y"] - dy, "id": 2}]
+
+    cdp.send("Input.dispatchTouchEvent", {"type": "touchStart", "touchPoints": points(0)[:1]})
+    cdp.send("Input.dispatchTouchEvent", {"type": "touchStart", "touchPoints": points(0)})
+    for step in range(1, 5):
+        cdp.send("Input.dispatchTouchEvent", {"type": "touchMove", "touchPoints": points(8 * step)})
+        touch.wait_for_timeout(50)
+    touch.wait_for_function("sculptState.grabs.length === 2 && sculptState.grabs.every((g) => g.force)",
+                            timeout=30000)
+    grabs = touch.evaluate("sculptState.grabs")
+    cdp.send("Input.dispatchTouchEvent", {"type": "touchEnd", "touchPoints": []})
+    touch.wait_for_function("sculptState.grabs.length === 0", timeout=30000)
+    problems = touch.evaluate("sculptState.errors")
+    context.close()
+    assert grabs[0]["index"] != grabs[1]["index"]
+    # dragged down the screen (camera above, z up): pulled down; the other finger up: up
+    assert grabs[0]["force"][2] < 0 < grabs[1]["force"][2]
+    assert problems == []
