@@ -119,6 +119,8 @@ def test_two_grabs_held_at_once_superpose(page):
     With both held the page's displacement is the sum of its own closed-form responses to
     each grab's force history alone (linearity), to 1e-6 of the largest."""
     page.evaluate("sculptState.reset()")
+    t0 = page.evaluate("sculptState.time")
+    page.wait_for_function(f"sculptState.time > {t0 + 0.1}", timeout=30000)   # drawn at rest
     a, b = 3 * R + 4, 6 * R + 5
     first = page.evaluate(f"sculptState.screen({a})")
     page.mouse.move(first["x"], first["y"])

@@ -165,6 +165,7 @@
     q.fill(0); v.fill(0); f.fill(0); t = 0; tEvent = 0; pushes = []; grab = null; extra = []; carriedMotion = false;
     lagged.clear();
     controls.enabled = true;
+    modalSum();                        // at rest now, not at the next frame (picking reads it)
     dirty = true;
   }
 
