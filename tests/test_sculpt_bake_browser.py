@@ -95,3 +95,39 @@ def test_bake_then_undo_and_redo_restore_each_state_exactly(page):
     page.wait_for_function(f"sculptState.time > {t0 + 0.2}", timeout=30000)
     assert np.abs(_shape(page)[1]).max() > 0
     assert not page.problems and page.evaluate("sculptState.errors") == []
+
+
+def test_keys_bake_undo_redo_pause_and_the_help(page):
+    """B bakes, Ctrl-Z undoes it, Ctrl-Y and Ctrl-Shift-Z redo, Space pauses, ? shows the
+    help; every control carries a tooltip in physical words."""
+    page.evaluate("sculptState.setPaused(false)")
+    page.mouse.click(5, 300)                        # the view has the keyboard
+    start = page.evaluate("sculptState.version")
+    grab_and_pull(page, (R // 2) * R + 3, 30, steps=3)
+    page.mouse.up()
+    page.keyboard.press("b")
+    page.wait_for_function(f"sculptState.version > {start}", timeout=30000)
+    baked = page.evaluate("sculptState.version")
+    page.keyboard.press("Control+z")
+    page.wait_for_function(f"sculptState.version === {start}", timeout=30000)
+    page.keyboard.press("Control+y")
+    page.wait_for_function(f"sculptState.version === {baked}", timeout=30000)
+    page.keyboard.press("Control+z")
+    page.wait_for_function(f"sculptState.version === {start}", timeout=30000)
+    page.keyboard.press("Control+Shift+z")
+    page.wait_for_function(f"sculptState.version === {baked}", timeout=30000)
+    paused = page.evaluate("sculptState.paused")
+    page.keyboard.press(" ")
+    assert page.evaluate("sculptState.paused") is (not paused)
+    page.keyboard.press(" ")
+    assert page.evaluate("sculptState.paused") is paused
+    page.keyboard.press("?")
+    assert page.is_visible("#help-overlay") and "Ctrl" in page.inner_text("#help-overlay")
+    page.keyboard.press("Escape")
+    assert not page.is_visible("#help-overlay")
+    tips = page.evaluate("Object.fromEntries(Array.from(document.querySelectorAll("
+                         "'#panel input, #panel select, #panel button')).map((n) => [n.id, n.title]))")
+    assert all(tips.values()), [k for k, v in tips.items() if not v]
+    assert "tension" in tips["material-w10"] and "bending" in tips["material-w20"]
+    assert "stiffness-proportional" in tips["material-rayleigh"]
+    assert not page.problems and page.evaluate("sculptState.errors") == []

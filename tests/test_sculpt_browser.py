@@ -114,11 +114,11 @@ def test_drag_down_moves_the_point_down_and_release_rings_down(page):
 def test_held_push_on_the_page_equals_python_with_static_correction(page, server):
     """While a push is held (page paused), the drawn displacement of every sample equals
     the Python twin of the page's pushes plus the static correction of the 19 omitted
-    modes (Model.dynamic's mode acceleration), to 1e-5 of the largest value (float32 Φ_s
+    modes (mode acceleration, reached at the pace of the highest kept mode), to 1e-5 of the largest value (float32 Φ_s
     and correction columns)."""
     from splinedeform.scenario import build, load_scenario
     from splinedeform.sculpt import Push, sculpt_basis
-    from splinedeform.sculpt.correction import static_correction
+    from splinedeform.sculpt.correction import follower, static_correction
     from splinedeform.sculpt.state import modal_history
 
     _, folder = server
@@ -140,8 +140,14 @@ def test_held_push_on_the_page_equals_python_with_static_correction(page, server
                                       tuple(p["force"]), p["t_on"],
                                       np.inf if p["t_off"] is None else p["t_off"])
                                  for p in pushes], [snap["time"]])[0]
-    held = {pushes[-1]["index"]: tuple(pushes[-1]["force"])}
-    expect = basis.phi_samples @ twin + static_correction(basis).displacement(held)
+    # the correction reached so far: r_a ⊗ z_a(t), z_a the pushes at a seen through the
+    # highest kept mode (correction.follower)
+    correction = static_correction(basis)
+    expect = basis.phi_samples @ twin
+    for a in {p["index"] for p in pushes}:
+        steps = [(tuple(p["force"]), p["t_on"], np.inf if p["t_off"] is None else p["t_off"])
+                 for p in pushes if p["index"] == a]
+        expect = expect + correction.column(a)[:, None] * follower(basis, steps, snap["time"])[None, :]
     got = np.asarray(snap["displacement"]).reshape(-1, 3)
     scale = np.max(np.abs(expect))
     assert scale > 1e-3
@@ -312,3 +318,40 @@ def test_a_released_surface_comes_to_rest_and_is_no_longer_drawn(page):
     finally:
         page.evaluate("sculptState.setSpeed(1)")
     assert not page.problems
+
+
+def test_the_grab_is_seen_and_named_in_words(page, server):
+    """While a point is pulled the page draws a marker at it and the spring to the pointer,
+    and the status line names the point by its parameters (u, v)."""
+    import re
+
+    page.evaluate("sculptState.reset()")
+    sample = (R // 2) * R + 5
+    start = page.evaluate(f"sculptState.screen({sample})")
+    index = grab_and_pull(page, sample, 40)          # the pointer ends 40 px below the start
+    page.evaluate("sculptState.setPaused(true)")
+    page.wait_for_timeout(300)                       # a frame drawn and the status line redone
+    page.wait_for_function("sculptState.grabView && sculptState.hud.includes('pulling the point')",
+                           timeout=30000)
+    view = page.evaluate("sculptState.grabView")
+    rest = np.array(page.evaluate(f"sculptState.rest({index})"))
+    disp = np.array(page.evaluate(f"sculptState.displacement({index})"))
+    end = np.array(page.evaluate(f"sculptState.pointerWorld({start['x']}, {start['y'] + 40})"))
+    hud = page.evaluate("sculptState.hud")
+    u, v = page.evaluate(f"sculptState.uv({index})")
+    page.mouse.up()
+    page.evaluate("sculptState.setPaused(false)")
+    assert view["marker"] and view["spring"]
+    # the marker is the drawn point x0 + d: the same float64 sums (1e-12 of |x| ~ 1)
+    assert np.max(np.abs(np.array(view["point"]) - (rest + disp))) <= 1e-12
+    # the spring ends at the pointer: the mouse position passes through the browser's event
+    # coordinates (observed 1e-8 off, about 1e-5 px; 1 px is ~3e-3 here): 1e-6
+    assert np.max(np.abs(np.array(view["pointer"]) - end)) <= 1e-6
+    assert np.linalg.norm(end - view["point"]) > 1e-3
+    words = re.search(r"pulling the point at u = ([0-9.e-]+), v = ([0-9.e-]+)", hud)
+    assert words, hud
+    # three significant digits of the sample's parameters in [0, 1]: 5e-3
+    assert abs(float(words.group(1)) - u) <= 5e-3 and abs(float(words.group(2)) - v) <= 5e-3
+    assert "sample" not in hud.split("\n")[-1]      # the grab line: no sample number
+    page.wait_for_timeout(100)
+    assert page.evaluate("sculptState.grabView") is None       # released: nothing drawn

@@ -107,7 +107,7 @@ def test_a_foreign_origin_post_is_refused_and_the_save_file_untouched(served, or
 def test_a_missing_or_wrong_token_is_refused(served, token):
     client, guard, session = served
     headers = {"Origin": ORIGIN} if token is None else {"Origin": ORIGIN, TOKEN_HEADER: token}
-    for method, path in (("GET", "/api/basis"), ("GET", "/api/status"),
+    for method, path in (("GET", "/api/basis"), ("GET", "/api/status"), ("GET", "/api/page"),
                          ("POST", "/api/save"), ("POST", "/api/resolve"),
                          ("POST", "/api/correction")):
         reply = client.request(method, path, headers=headers,

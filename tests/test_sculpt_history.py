@@ -124,3 +124,39 @@ def test_a_malformed_bake_is_refused_and_changes_nothing(served, body, status):
     reply = client.post("/api/bake", json=body)
     assert reply.status_code == status, reply.text
     assert session.version == 1 and session.scenario.surface.shape == "plane"
+
+
+def test_a_pin_bakes_and_holds_the_control_point_where_the_bake_put_it(served):
+    """A pin is a bake with the free set less one control point: that point is at P + d
+    (the shape at the pin) and a push elsewhere no longer moves it at all."""
+    client, session = served
+    d, q = _static_state(session)
+    nu, nv = session.basis.model.surface.shape
+    pinned = (2, 3)
+    free = [[i, j] for i in range(nu) for j in range(nv) if (i, j) != pinned]
+    reply = client.post("/api/bake", json={"version": 1, "q": q.ravel().tolist(), "free_points": free})
+    assert reply.status_code == 200, reply.text
+    model = session.basis.model
+    start = build(parse_scenario(SHEET, source="sheet.toml")).surface.control_points
+    # where the pin put it: P + d, d a sparse solve through its modal round trip (as above)
+    assert np.abs(d[pinned]).max() > 1e-3
+    assert np.max(np.abs(model.surface.control_points[pinned] - start[pinned] - d[pinned])) \
+        <= 1e-10 * np.abs(d).max()
+    # a push at another point moves the net but not the pinned point: its row of T is empty
+    moved = model.static(sd.Point(0.3, 0.6, (0.2, 0.0, -1.0))).control_points() \
+        - model.surface.control_points
+    assert np.abs(moved).max() > 1e-3
+    assert np.abs(moved[pinned]).max() == 0.0      # held exactly: no coordinate maps to it
+    assert session.scenario.boundary.free_points is not None
+    assert tuple(pinned) not in session.scenario.boundary.free_points
+
+
+def test_a_pin_outside_the_net_is_refused_and_changes_nothing(served):
+    client, session = served
+    _, q = _static_state(session)
+    reply = client.post("/api/bake", json={"version": 1, "q": q.ravel().tolist(),
+                                           "free_points": [[0, 0], [40, 1]]})
+    assert reply.status_code == 400, reply.text
+    assert "Free set" in reply.json()["error"]
+    assert session.version == 1 and session.scenario.surface.shape == "plane"
+    assert not list(session.save_path.parent.glob("*baked*"))

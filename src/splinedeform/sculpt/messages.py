@@ -132,11 +132,25 @@ def describe_error(exc: ValidationError) -> str:
 
 class BakeMessage(_Message):
     """Make the shape of modal state ``q`` (``3 k`` numbers, mode-major ``[q_1x, q_1y, q_1z,
-    q_2x, …]``) on basis ``version`` the rest shape."""
+    q_2x, …]``) on basis ``version`` the rest shape, with the free set ``free_points`` if
+    given (a pin)."""
 
     version: Annotated[Count, Field(ge=0)]
     q: Annotated[list[Annotated[Real, Field(ge=-1e12, le=1e12)]],
                  Field(min_length=3, max_length=3 * MAX_NET_POINTS)]
+    #: the free set of the baked model (a pin: the set less the pinned control point, which
+    #: stays where the bake put it); None keeps the free set
+    free_points: Annotated[list[tuple[NetIndex, NetIndex]],
+                           Field(max_length=MAX_NET_POINTS)] | None = None
+
+
+class ExportMessage(_Message):
+    """Download the shape of modal state ``q`` on basis ``version`` as ``format``."""
+
+    version: Annotated[Count, Field(ge=0)]
+    q: Annotated[list[Annotated[Real, Field(ge=-1e12, le=1e12)]],
+                 Field(min_length=3, max_length=3 * MAX_NET_POINTS)]
+    format: Literal["3dm", "obj", "json"]
 
 
 class HistoryMessage(_Message):

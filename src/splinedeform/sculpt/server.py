@@ -5,12 +5,19 @@ page shows it):
 
 - ``GET /``: the page, with the current modal basis inside (it keeps working offline);
 - ``GET /api/basis``: the current modal data (after a re-solve);
+- ``GET /api/page``: the page for the current basis without the session token, to be kept
+  as a file ("Save offline page");
 - ``GET /api/status``: progress of a re-solve ``{busy, stage, elapsed, error, version}``;
 - ``POST /api/resolve``: ``{material, boundary, free_region | free_points}`` → new modes,
   answered with the new data and ``carry``, the map of the old modal state onto the new
   modes (:mod:`.carry`);
 - ``POST /api/correction``: ``{version, index}`` → the static correction column of a sample;
 - ``POST /api/save``: ``{version, t_end, pushes}`` → the scenario written to the save path;
+- ``POST /api/export``: ``{version, q, format}`` → the shape of modal state ``q`` as a
+  ``.3dm``, OBJ or net JSON file (:mod:`.shape_files`);
+- ``POST /api/load``: the bytes of a ``.3dm``, net or scenario file (its name in the
+  header ``X-Sculpt-File-Name``, at most 16 MiB) → a new surface, answered like a
+  re-solve without ``carry`` (:mod:`.upload`);
 - ``POST /api/bake``: ``{version, q}`` → the shape of modal state ``q`` becomes the rest
   shape, modes solved again (answered like a re-solve, with ``baked: true``);
 - ``POST /api/undo``, ``POST /api/redo``: ``{version}`` → back to the basis before, or
@@ -38,8 +45,8 @@ from starlette.routing import Route
 from ..errors import InputError
 from .export import _b64
 from .guard import ASGIApp, Guard, guarded
-from .messages import (MAX_BODY, BakeMessage, CorrectionMessage, HistoryMessage,
-                       ResolveMessage, SaveMessage, describe_error)
+from .messages import (MAX_BODY, BakeMessage, CorrectionMessage, ExportMessage,
+                       HistoryMessage, ResolveMessage, SaveMessage, describe_error)
 from .page import sculpt_page
 from .session import Busy, Session
 
@@ -102,6 +109,13 @@ def create_app(session: Session, guard: Guard) -> ASGIApp:
         html = await run_in_threadpool(sculpt_page, data, guard.token)
         return HTMLResponse(html, headers={"Cache-Control": "no-store"})
 
+    async def offline_page(request: Request) -> Response:
+        # "Save offline page": the page for the current basis, carrying what a page on its
+        # own needs, without the session token
+        data = await run_in_threadpool(session.page_payload)
+        html = await run_in_threadpool(sculpt_page, data, "")
+        return HTMLResponse(html, headers={"Cache-Control": "no-store"})
+
     async def basis(request: Request) -> Response:
         return JSONResponse(await run_in_threadpool(session.payload))
 
@@ -157,14 +171,49 @@ def create_app(session: Session, guard: Guard) -> ASGIApp:
               file=sys.stderr)
         return JSONResponse({"path": str(path), "loads": loads, "steps": len(message.pushes)})
 
+    async def export(request: Request) -> Response:
+        message = await _message(request, ExportMessage)
+        if isinstance(message, JSONResponse):
+            return message
+        assert isinstance(message, ExportMessage)
+        content, name, media = await run_in_threadpool(session.export, message)
+        return Response(content, media_type=media,
+                        headers={"Content-Disposition": f'attachment; filename="{name}"',
+                                 "Cache-Control": "no-store"})
+
+    async def load(request: Request) -> Response:
+        from urllib.parse import unquote
+
+        from .upload import MAX_UPLOAD, loadable
+
+        name = unquote(request.headers.get("x-sculpt-file-name", ""))
+        if not name or "/" in name or "\\" in name or len(name) > 255:
+            return _error("a loaded file needs its name (header X-Sculpt-File-Name, no folders)")
+        loadable(name)
+        declared = request.headers.get("content-length")
+        if declared is not None and (not declared.isdigit() or int(declared) > MAX_UPLOAD):
+            return _error(f"{name}: too large (at most {MAX_UPLOAD} bytes)", 413)
+        body = b""
+        async for chunk in request.stream():
+            body += chunk
+            if len(body) > MAX_UPLOAD:
+                return _error(f"{name}: too large (at most {MAX_UPLOAD} bytes)", 413)
+        await run_in_threadpool(session.load, name, body)
+        data = await run_in_threadpool(session.page_payload)
+        data.pop("offline", None)
+        return JSONResponse({**data, "loaded": name})
+
     async def no_icon(request: Request) -> Response:
         return Response(status_code=204)
 
     routes = [Route("/", _guarded(page)), Route("/favicon.ico", no_icon), Route("/api/basis", _guarded(basis)),
+              Route("/api/page", _guarded(offline_page)),
               Route("/api/status", _guarded(status)),
               Route("/api/resolve", _guarded(resolve), methods=["POST"]),
               Route("/api/correction", _guarded(correction), methods=["POST"]),
               Route("/api/save", _guarded(save), methods=["POST"]),
+              Route("/api/export", _guarded(export), methods=["POST"]),
+              Route("/api/load", _guarded(load), methods=["POST"]),
               Route("/api/bake", _guarded(bake), methods=["POST"]),
               Route("/api/undo", _guarded(history("undo")), methods=["POST"]),
               Route("/api/redo", _guarded(history("redo")), methods=["POST"])]

@@ -11,7 +11,6 @@ named relative to the saved scenario, copied beside it when it lies outside its 
 from __future__ import annotations
 
 import dataclasses
-import re
 import shutil
 import threading
 import time
@@ -28,8 +27,9 @@ from .correction import StaticCorrection, offline_data, static_correction
 from .export import _b64, payload
 from .grabs import chain_tables, grab_chains
 from .history import BasisState, History, baked_net, baked_scenario
-from .messages import BakeMessage, PushMessage, ResolveMessage, SaveMessage
+from .messages import BakeMessage, ExportMessage, PushMessage, ResolveMessage, SaveMessage
 from .modal import SculptBasis, sculpt_basis
+from .wording import in_page_words, page_field  # noqa: F401  (page_field: re-exported)
 
 MATERIAL_FIELDS = ("mass", "damping", "rayleigh", "w10", "w01", "w20", "w11", "w02")
 EDGE_NAMES = ("u0", "u1", "v0", "v1")
@@ -83,15 +83,15 @@ class Session:
     def _stage(self, stage: str, start: float) -> None:
         self.progress.update(stage=stage, elapsed=time.perf_counter() - start)
 
-    def _solve(self, scenario: Scenario) -> None:
+    def _solve(self, scenario: Scenario, carry: bool = True) -> None:
         from threadpoolctl import threadpool_limits
 
         # one BLAS thread: the machine's other core draws the page (and oversubscribed
         # BLAS threads make a dense eigensolve several times slower, not faster)
         with threadpool_limits(1):
-            self._solve_now(scenario)
+            self._solve_now(scenario, carry)
 
-    def _solve_now(self, scenario: Scenario) -> None:
+    def _solve_now(self, scenario: Scenario, carry: bool = True) -> None:
         start = time.perf_counter()
         self._stage("assembling the matrices", start)
         model = build(scenario).model
@@ -101,9 +101,11 @@ class Session:
         self._stage("static correction", start)
         correction = static_correction(basis)
         old = getattr(self, "basis", None)
-        if old is not None:
+        if old is not None and carry:
             self._stage("carrying the motion over", start)
             self.transfer = (self.version, transfer(old, basis))
+        elif old is not None:
+            self.transfer = None            # another surface: nothing to carry over
         with self._state_lock:          # readers see one basis with its version, never a mix
             if old is not None:
                 self.history.replaced(self._state())
@@ -164,10 +166,45 @@ class Session:
             baked, path = baked_scenario(scenario, basis, net, folder,
                                          f"{self.save_path.stem}-baked-{self._versions + 1}")
             try:
+                if message.free_points is not None:   # a pin: the set less the pinned point
+                    baked = with_overrides(baked, {
+                        "boundary.free_region": None,
+                        "boundary.free_points": [list(p) for p in message.free_points]},
+                        origin="sculpt page")
                 self._solve(baked)
+            except ScenarioError as exc:
+                path.unlink(missing_ok=True)
+                raise InputError(in_page_words(str(exc), scenario.source)) from None
             except Exception:
                 path.unlink(missing_ok=True)        # refused: no file of a shape never used
                 raise
+        except Exception as exc:
+            self.progress.update(error=str(exc), stage="failed")
+            raise
+        finally:
+            self.progress["busy"] = False
+            self._lock.release()
+
+    def export(self, message: ExportMessage) -> tuple[bytes, str, str]:
+        """The shape of ``message.q`` as a file (:func:`.shape_files.shape_file`)."""
+        from .shape_files import shape_file
+
+        with self._state_lock:
+            self._check_version(message.version)
+            basis, title = self.basis, self.scenario.title or self.scenario.name
+        return shape_file(basis, np.asarray(message.q, dtype=float), message.format, title)
+
+    def load(self, name: str, content: bytes) -> None:
+        """A surface (or a whole scenario) from a file the page sent (:mod:`.upload`)."""
+        from .upload import loaded
+
+        if not self._lock.acquire(blocking=False):
+            raise Busy("a re-solve is already running")
+        try:
+            self.progress.update(busy=True, error=None, stage="reading " + name, elapsed=0.0)
+            stem = f"{self.save_path.stem}-loaded-{self._versions + 1}"
+            with loaded(self.scenario, name, content, self.save_path.parent, stem) as scenario:
+                self._solve(scenario, carry=False)
         except Exception as exc:
             self.progress.update(error=str(exc), stage="failed")
             raise
@@ -342,35 +379,6 @@ class Session:
         relative = Path(source.relative_to(folder).as_posix())
         return dataclasses.replace(scenario,
                                    surface=dataclasses.replace(scenario.surface, path=relative))
-
-
-PAGE_FIELDS = {"material": "Material", "boundary": "Boundary",
-               "boundary.free_region": "Free set: the free region box",
-               "boundary.free_points": "Free set: the painted control points"}
-"""What the page calls a key of the scenario (material weights and edges: ``Material
-w10``, ``Boundary u0``)."""
-
-
-def page_field(key: str) -> str:
-    """The page's name of a scenario key path (``material.w10`` → ``Material w10``)."""
-    for prefix in sorted(PAGE_FIELDS, key=len, reverse=True):
-        if key == prefix or key.startswith(prefix + ".") or key.startswith(prefix + "["):
-            rest = key[len(prefix):].lstrip(".")
-            return PAGE_FIELDS[prefix] + (f" {rest}" if rest else "")
-    return key
-
-
-def in_page_words(message: str, source: str) -> str:
-    """A scenario error about the page's settings, worded for the page: each
-    ``file:line: key: text`` (or ``file (sculpt page): key: text``) becomes
-    ``<page field>: text``; the file and its lines are not the page's."""
-    where = re.compile(rf"^(\s*){re.escape(source)}(?::\d+| \([^)]*\))?: ([\w.\[\]]+): ")
-    head = re.compile(rf"^{re.escape(source)}: (\d+) problems in the scenario$")
-    lines = []
-    for line in message.splitlines():
-        line = head.sub(r"\1 problems with the page's settings:", line)
-        lines.append(where.sub(lambda m: m.group(1) + page_field(m.group(2)) + ": ", line))
-    return "\n".join(lines)
 
 
 def _same_file(a: Path, b: Path) -> bool:

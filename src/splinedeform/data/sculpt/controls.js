@@ -10,7 +10,7 @@
     last = now;
     updateGrab(interval);                           // force switched at the old t
     settle();                                       // rung down: rest, nothing more to draw
-    const moving = !paused && (grab || q.some((x) => x !== 0) || v.some((x) => x !== 0));
+    const moving = !paused && (grab || extra.length || q.some((x) => x !== 0) || v.some((x) => x !== 0));
     if (!paused) t += Math.min(interval, 100) / 1000 * speed;
     let sum = 0;
     if (moving || dirty) {
@@ -45,9 +45,18 @@
       "   " + (mean > 0 ? (1000 / mean).toFixed(0) : "-") + " fps, " + work.toFixed(1) + " ms per frame" +
       "\n" + K + (data.complete ? " modes (all)" : " of " + data.n_free + " modes" +
       (online || data.offline ? " + static correction" : "")) + ", " + ru + "×" + rv + " samples, max |d| = " + (dmax > 0 ? dmax.toPrecision(3) : "0") +
-      (grab ? "\ngrabbed sample " + grab.index : "");
+      (grab || extra.length ? "\n" + grabWords() : "");
   }
 
+  // the grab in words: where on the surface (its parameters) and the force held there
+  function grabWords() {
+    const g = grab || extra[extra.length - 1], n = g.index, u = data.u[Math.floor(n / rv)], v = data.v[n % rv], F = g.force;
+    const how = g !== grab || !pointer ? "holding" : grabMode.value === "normal" ? "pushing" : "pulling";
+    const others = grab ? extra.length : extra.length - 1;
+    return how + " the point at u = " + u.toPrecision(3) + ", v = " + v.toPrecision(3) +
+      (F ? " with |F| = " + Math.hypot(F[0], F[1], F[2]).toPrecision(3) : "") +
+      (others > 0 ? " (+ " + others + " more held; Esc lets go of all)" : "");
+  }
   // -- controls ---------------------------------------------------------------------------------
   const pauseButton = document.getElementById("pause");
   const speedBox = document.getElementById("speed"), springBox = document.getElementById("spring");
@@ -116,6 +125,7 @@
       document.getElementById("region-" + key + "0").value = String(Number(a.toPrecision(6)));
       document.getElementById("region-" + key + "1").value = String(Number(b.toPrecision(6)));
     });
+    applyTips();                          // the help part's tooltips on the new fields
   }
   const regionOn = () => document.getElementById("region-on");
   function freeRegion() {
@@ -139,7 +149,7 @@
   async function resolve() {
     if (solving) return;
     solving = true;
-    if (grab) release(null);          // the held push ends now (as when the new modes arrive)
+    releaseAll();                     // the held pushes end now (as when the new modes arrive)
     const material = {}, boundary = {};
     for (const key of WEIGHTS) material[key] = Number(document.getElementById("material-" + key).value);
     for (const edge of EDGES) boundary[edge] = document.getElementById("boundary-" + edge).value;
@@ -203,7 +213,7 @@
   let lastSwitch = null, carriedMotion = false;
   function load(d) {
     const sameGrid = d.grid[0] === ru && d.grid[1] === rv;
-    if (grab) release(null);
+    releaseAll();
     propagate(q, v, f, t - tEvent, q, v);
     tEvent = t;
     modalSum();
@@ -225,8 +235,9 @@
       if (d.baked) q.fill(0);          // the shape now is the rest shape: only the velocity goes on
     }
     corrections.clear();
+    lagged.clear();
     offlineFactor = null;
-    t = 0; tEvent = 0; pushes = []; grab = null; controls.enabled = true; dirty = true;
+    t = 0; tEvent = 0; pushes = []; grab = null; extra = []; controls.enabled = true; dirty = true;
     freeEdited = false;
     if (!sameGrid || !geometry) buildGeometry();
     buildForms();
@@ -271,7 +282,7 @@
     get grabbed() { return grab ? { index: grab.index, force: grab.force && grab.force.slice() } : null; },
     get pushes() { return pushes.map((p) => Object.assign({}, p)); },
     get errors() { return errors.slice(); },
-    get resting() { return !grab && !q.some((x) => x !== 0) && !v.some((x) => x !== 0); },
+    get resting() { return !grab && !extra.length && lagged.size === 0 && !q.some((x) => x !== 0) && !v.some((x) => x !== 0); },
     get corrections() { return Array.from(corrections.keys()).filter((k) => corrections.get(k)); },
     get freeMask() { return Array.from(freeMask); },
     correction(n) { requestCorrection(n); const c = corrections.get(n); return c ? Array.from(c) : null; },
@@ -289,7 +300,16 @@
     pick(x, y) { return pick(x, y); },
     frames() { return frameLog.slice(); },
     latencies() { return latencies.slice(); },
-    setPaused, reset, save, resolve, bake, undo, redo,
+    setPaused, reset, save, resolve, bake() { return bake(); }, pin, undo, redo, hold, release: releaseAll,
+    get grabs() { return allGrabs().map((g) => ({ index: g.index, force: g.force && g.force.slice(), held: Boolean(g.anchor || g.fixed) })); },
+    netPosition(k) { return [netRest[3 * k] + netDisp[3 * k], netRest[3 * k + 1] + netDisp[3 * k + 1], netRest[3 * k + 2] + netDisp[3 * k + 2]]; },
+    uv(n) { return [data.u[Math.floor(n / rv)], data.v[n % rv]]; },
+    nearestNet(n) { return nearestNetPoint(data.u[Math.floor(n / rv)], data.v[n % rv]); },
+    get grabView() { return grabEnds && { point: grabEnds.point.slice(), pointer: grabEnds.pointer && grabEnds.pointer.slice(),
+                                          marker: grabMarker.visible, spring: springLine.visible }; },
+    get hud() { return hudBox.textContent; },
+    pointerWorld(x, y) { const p = pointerWorld(x, y, grab ? grab.depth : 0.5); return [p.x, p.y, p.z]; },
+    get progress() { return document.getElementById("progress").textContent; },
     modalState() { return { q: Array.from(q), v: Array.from(v), f: Array.from(f), t, tEvent }; },
     get history() { return [undoStack.length, redoStack.length]; },
     setSpeed(s) { speed = s; speedBox.value = String(s); },

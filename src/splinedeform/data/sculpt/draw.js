@@ -101,12 +101,49 @@
     paintNet();
   }
 
+  // -- the grab, seen: a marker at the grabbed point and the spring drawn to the pointer -----
+  const GRAB_COLOUR = 0xd0302a, MAX_SHOWN = 16;
+  const markerPositions = new THREE.BufferAttribute(new Float32Array(3 * MAX_SHOWN), 3);
+  const springPositions = new THREE.BufferAttribute(new Float32Array(6 * MAX_SHOWN), 3);
+  const markerGeometry = new THREE.BufferGeometry(), springGeometry = new THREE.BufferGeometry();
+  markerGeometry.setAttribute("position", markerPositions);
+  springGeometry.setAttribute("position", springPositions);
+  const grabMarker = new THREE.Points(markerGeometry, new THREE.PointsMaterial(
+    { color: GRAB_COLOUR, size: 11, sizeAttenuation: false, depthTest: false }));
+  const springLine = new THREE.LineSegments(springGeometry, new THREE.LineBasicMaterial(
+    { color: GRAB_COLOUR, depthTest: false }));
+  for (const o of [grabMarker, springLine]) { o.frustumCulled = false; o.visible = false; o.renderOrder = 10; scene.add(o); }
+  // where the main grab's point is drawn and where its spring ends (null: no spring, e.g. a
+  // held force); every grab held gets its marker and its spring (to its pointer or anchor)
+  let grabEnds = null;
+  function showGrab() {
+    grabEnds = null;
+    const shown = allGrabs().slice(0, MAX_SHOWN);
+    let points = 0, lines = 0;
+    for (const g of shown) {
+      const n = g.index, at = [rest[3 * n] + disp[3 * n], rest[3 * n + 1] + disp[3 * n + 1], rest[3 * n + 2] + disp[3 * n + 2]];
+      markerPositions.array.set(at, 3 * points++);
+      let end = null;
+      if (g === grab ? pointer : (g.pointer || g.anchor)) {
+        const p = springTarget(g);
+        end = [p.x, p.y, p.z];
+        springPositions.array.set(at, 6 * lines); springPositions.array.set(end, 6 * lines + 3);
+        lines++;
+      }
+      if (g === grab) grabEnds = { point: at, pointer: end };
+    }
+    markerGeometry.setDrawRange(0, points); springGeometry.setDrawRange(0, 2 * lines);
+    markerPositions.needsUpdate = springPositions.needsUpdate = true;
+    grabMarker.visible = points > 0; springLine.visible = lines > 0;
+  }
+
   // -- per frame: x = x0 + Φ_s q(t) (+ r_a ⊗ P held) ---------------------------------------------
   let vmax = 0, dmax = 0, dirty = true;   // colour scale (never 0), largest |d| drawn
   // out[3n + c] = Σ_i A[n K + i] q_c,i for the rows n of a (rows × K) float32 matrix A
   // (Φ_s or the net's), float64 sums in the order i = 0 … K-1; two rows at a time, so that
   // each modal coordinate is loaded once for both (the loop is bound by its loads)
   let qx = null, qy = null, qz = null;
+  const lagZ = new Float64Array(3), lagV = new Float64Array(3);
   function superpose(A, rows, out) {
     let n = 0;
     for (; n + 1 < rows; n += 2) {
@@ -131,13 +168,16 @@
     if (!qx || qx.length !== K) { qx = new Float64Array(K); qy = new Float64Array(K); qz = new Float64Array(K); }
     for (let i = 0; i < K; i++) { qx[i] = qt[3 * i]; qy[i] = qt[3 * i + 1]; qz[i] = qt[3 * i + 2]; }
     superpose(phi, N, disp);
-    if (grab && grab.force) {
-      const col = corrections.get(grab.index), F = grab.force;
-      if (col) for (let n = 0; n < N; n++) {
+    lagged.forEach((entry, index) => {           // r_a ⊗ z_a(t), the correction reached so far
+      const col = corrections.get(index);
+      if (!col) return;
+      lagAdvance(entry, t - tEvent, lagZ, null);
+      const zx = lagZ[0], zy = lagZ[1], zz = lagZ[2];
+      for (let n = 0; n < N; n++) {
         const r = col[n];
-        disp[3 * n] += r * F[0]; disp[3 * n + 1] += r * F[1]; disp[3 * n + 2] += r * F[2];
+        disp[3 * n] += r * zx; disp[3 * n + 1] += r * zy; disp[3 * n + 2] += r * zz;
       }
-    }
+    });
     if (showNet.checked) superpose(phiNet, NN, netDisp);
   }
   // Released and rung down: once no mode can move any sample by more than 1e-6 of the
@@ -147,7 +187,8 @@
   // √(2E/λ_min), hence |d| ≤ √(2E/λ_min) Σ_i max_n |Φ_s[n, i]|.
   let phiPeak = -1;
   function settle() {
-    if (grab || paused || f.some((x) => x !== 0) || !(q.some((x) => x !== 0) || v.some((x) => x !== 0))) return;
+    const lagging = lagged.size > 0;
+    if (grab || extra.length || paused || f.some((x) => x !== 0) || !(lagging || q.some((x) => x !== 0) || v.some((x) => x !== 0))) return;
     if (phiPeak < 0) {
       phiPeak = 0;
       const top = new Float64Array(K);
@@ -160,8 +201,18 @@
       lmin = Math.min(lmin, lam[i]);
       for (let j = 3 * i; j < 3 * i + 3; j++) energy += (eV[j] * eV[j] + lam[i] * qt[j] * qt[j]) / 2;
     }
-    if (Math.sqrt(2 * energy / lmin) * phiPeak < 1e-6 * radius) {
-      q.fill(0); v.fill(0); tEvent = t; dirty = true;
+    // the correction's follower: |r_a z_a| ≤ max |r_a| √(2 E_z / λ*), E_z = (z'² + λ* z²) / 2
+    let lagBound = 0;
+    lagged.forEach((entry, index) => {
+      const col = corrections.get(index);
+      lagAdvance(entry, t - tEvent, lagZ, lagV);
+      let e = 0, top = 0;
+      for (let j = 0; j < 3; j++) e += (lagV[j] * lagV[j] + lam[K - 1] * lagZ[j] * lagZ[j]) / 2;
+      if (col) for (let n = 0; n < N; n++) top = Math.max(top, Math.abs(col[n]));
+      lagBound += top * Math.sqrt(2 * e / lam[K - 1]);
+    });
+    if (Math.sqrt(2 * energy / lmin) * phiPeak + lagBound < 1e-6 * radius) {
+      q.fill(0); v.fill(0); lagged.clear(); tEvent = t; dirty = true;
     }
   }
   // normals of the sample grid: x_u × x_v by differences along the grid (one-sided at the
@@ -258,6 +309,7 @@
       for (let k = 0; k < NN * 3; k++) np[k] = netRest[k] + netDisp[k];
       netPositions.needsUpdate = true;
     }
+    showGrab();
     renderer.render(scene, camera);
   }
 

@@ -111,86 +111,190 @@
       .catch((err) => { corrections.delete(index); showMessage("static correction: " + err.message); });
   }
   let pendingInput = [];    // event timestamps not yet shown in a frame
-  let pointer = null;       // last pointer position while grabbing
+  let pointer = null;       // last position of the main pointer while grabbing
   container.addEventListener("pointerdown", (event) => {
-    if (event.button !== 0 || grab || paintBox.checked) return;
+    const pinning = event.altKey || grabMode.value === "pin";
+    if (event.button !== 0 || paintBox.checked) return;
+    if (grab && !pinning && grab.pointerId === event.pointerId) return;
     const index = pick(event.clientX, event.clientY);
     if (index < 0) return;                       // background: OrbitControls rotates
     event.stopPropagation();
+    if (pinning) { pin(index); return; }         // pin (a bake: it ends the grabs held), no grab
     controls.enabled = false;
     container.setPointerCapture && container.setPointerCapture(event.pointerId);
     requestCorrection(index);
-    const proj = projectSample(index);
-    grab = { index, force: null, push: null, depth: proj.z, normal: vertexNormal(index) };
-    pointer = { x: event.clientX, y: event.clientY };
+    const proj = projectSample(index), at = { x: event.clientX, y: event.clientY };
+    const g = { index, force: null, push: null, depth: proj.z, normal: vertexNormal(index), pointerId: event.pointerId };
+    if (grab) { g.pointer = at; extra.push(g); }  // a second finger: a grab of its own
+    else { grab = g; pointer = at; }
     pendingInput.push(event.timeStamp);
     dirty = true;
   }, { capture: true });
   container.addEventListener("pointermove", (event) => {
-    if (!grab) return;
-    pointer = { x: event.clientX, y: event.clientY };
-    pendingInput.push(event.timeStamp);
-  });
-  function release(event) {
-    if (!grab) return;
-    if (grab.push) {                     // a step of no duration (paused) is no push at all
-      if (grab.push.t_on === t) pushes.splice(pushes.indexOf(grab.push), 1); else grab.push.t_off = t;
+    const at = { x: event.clientX, y: event.clientY };
+    if (grab && grab.pointerId === event.pointerId) pointer = at;
+    else {
+      const g = extra.find((e) => e.pointer && e.pointerId === event.pointerId);
+      if (!g) return;
+      g.pointer = at;
     }
-    setForce(0, null);
-    grab = null; pointer = null;
-    controls.enabled = true;
+    pendingInput.push(event.timeStamp);
+    dirty = true;                        // the spring drawn follows the pointer, paused too
+  });
+  function endPush(g) {                  // a step of no duration (paused) is no push at all
+    if (!g.push) return;
+    if (g.push.t_on === t) pushes.splice(pushes.indexOf(g.push), 1); else g.push.t_off = t;
+    g.push = null;
+  }
+  // a pointer let go: its grab ends, or, with shift held, stays held by its spring to the
+  // place the pointer left (a second grab can then be added)
+  function release(event) {
+    const id = event && event.pointerId !== undefined ? event.pointerId : null;
+    let g = grab && (id === null || grab.pointerId === id) ? grab : null;
+    if (!g && id !== null) g = extra.find((e) => e.pointer && e.pointerId === id) || null;
+    if (!g) return;
+    const keep = Boolean(event && event.shiftKey && g.force);
+    const at = g === grab ? pointer : g.pointer;
+    if (g === grab) { grab = null; pointer = null; } else extra.splice(extra.indexOf(g), 1);
+    if (keep) {
+      g.anchor = pointerWorld(at.x, at.y, g.depth);
+      g.pointer = null; g.pointerId = null;
+      extra.push(g);
+    } else endPush(g);
+    setForce();
+    if (!grab) controls.enabled = true;
     if (event) pendingInput.push(event.timeStamp);
     dirty = true;
   }
+  // every grab ends (Esc, a bake, a re-solve, undo)
+  function releaseAll() {
+    if (!grab && !extra.length) return;
+    for (const g of allGrabs()) endPush(g);
+    grab = null; pointer = null; extra = [];
+    setForce();
+    controls.enabled = true;
+    dirty = true;
+  }
+  // a force held at a sample without a spring (for tests and scripts), beside the other
+  // grabs, until they are all let go
+  function hold(index, force) {
+    requestCorrection(index);
+    const F = force.slice();
+    const g = { index, force: F, push: { index, force: F.slice(), t_on: t, t_off: null }, depth: 0,
+                normal: vertexNormal(index), fixed: true };
+    extra.push(g);
+    pushes.push(g.push);
+    setForce();
+  }
   container.addEventListener("pointerup", release);
   container.addEventListener("pointercancel", release);
-  // the spring (or the push along the normal) from the grabbed point to the pointer, held
+  // The springs (or pushes along the normal) from the grabbed points to their pointers, held
   // constant over one frame: each change is a new step of force at the current time.
-  // The spring is implicit in the frame: the force F held over the coming step τ obeys
-  // F = k (x_pointer - x_a(t + τ)) with x_a(t + τ) = x⁰_a(t + τ) + α(τ) F, where x⁰ is the
-  // motion with no force from now and α(τ) = Σ_i φ_i(a)² g_i(τ) (+ r_a(a), the static
-  // correction) the point's answer to a unit force held from now (g_i: the step response).
-  // So F = k (x_pointer - x⁰_a(t + τ)) / (1 + k α(τ)): stable for any spring and frame
+  // They are implicit in the frame: the forces F_g held over the coming step τ obey
+  // F_g = k_g (x_pointer,g - x_g(t + τ)) with x_g(t + τ) = x⁰_g(t + τ) + Σ_h A_gh(τ) F_h, where
+  // x⁰ is the motion with no force from now and A_gh(τ) = Σ_i φ_i(a_g) φ_i(a_h) g_i(τ)
+  // (+ r_{a_h}(a_g) (1 - C* - σ* S*), the static correction reached at the pace of its
+  // follower mode) the answer at a_g to a unit force at a_h held from now (g_i: the step
+  // response). So (A + diag(1/k)) F = x_pointer - x⁰ - A F_fixed, one small symmetric
+  // positive definite system (the same for x, y and z); for one grab
+  // F = k (x_pointer - x⁰_a(t + τ)) / (1 + k α(τ)), α = A_aa: stable for any spring and frame
   // time (the force computed from the displacement at t alone overshoots by k α each frame
   // and diverges once k α > 1: a stiff small free set at a low frame rate).
-  function grabPrediction(n, tau) {
-    propagate(q, v, f, t - tEvent, gq, gv);              // the state now
-    dampedCS(tau);
-    const base = n * K, x = [0, 0, 0];
-    let alpha = 0;
-    for (let i = 0; i < K; i++) {
-      const p = phi[base + i], sigma = damp[i] / 2, c = eC[i], sn = eS[i];
-      for (let j = 0; j < 3; j++) {
-        const a = gq[3 * i + j];
-        x[j] += p * (a * c + (gv[3 * i + j] + sigma * a) * sn);
-      }
-      alpha += p * p * (1 - c - sigma * sn) / lam[i];
-    }
-    const col = corrections.get(n);
-    return { x, alpha: alpha + (col ? col[n] : 0) };
+  const gz = new Float64Array(3), gzv = new Float64Array(3);
+  function springTarget(g) {
+    if (g === grab) return pointerWorld(pointer.x, pointer.y, g.depth);
+    return g.pointer ? pointerWorld(g.pointer.x, g.pointer.y, g.depth) : g.anchor.clone();
   }
   function updateGrab(interval) {
-    if (!grab || !pointer) return;
-    const n = grab.index, tau = paused ? 0 : Math.min(interval, 100) / 1000 * speed;
-    const target = pointerWorld(pointer.x, pointer.y, grab.depth);
-    const { x, alpha } = grabPrediction(n, tau);
-    const next = new THREE.Vector3(rest[3 * n] + x[0], rest[3 * n + 1] + x[1], rest[3 * n + 2] + x[2]);
-    let pull = target.sub(next);
-    if (grabMode.value === "normal") pull = grab.normal.clone().multiplyScalar(pull.dot(grab.normal));
-    const spring = Number(springBox.value) / Math.max(flexibility(n), 1e-300);
-    const k = spring / (1 + spring * Math.max(alpha, 0));
-    const F = [k * pull.x, k * pull.y, k * pull.z];
-    const old = grab.force;
-    if (old) {
-      const change = Math.hypot(F[0] - old[0], F[1] - old[1], F[2] - old[2]);
-      if (change <= 1e-3 * Math.hypot(old[0], old[1], old[2])) return;
+    const springs = [];
+    if (grab && pointer) springs.push(grab);
+    for (const g of extra) if (!g.fixed && (g.pointer || g.anchor)) springs.push(g);
+    if (!springs.length) return;
+    const tau = paused ? 0 : Math.min(interval, 100) / 1000 * speed;
+    const fixed = extra.filter((g) => g.fixed && g.force), all = springs.concat(fixed);
+    const m = springs.length, n = all.length;
+    propagate(q, v, f, t - tEvent, gq, gv);              // the state now
+    const free = springs.map(() => [0, 0, 0]);
+    lagged.forEach((entry, index) => {                   // the followers' free motion
+      const col = corrections.get(index);
+      if (!col) return;
+      lagAdvance(entry, t - tEvent, gz, gzv);
+      followerCS(tau);
+      const sigma = damp[K - 1] / 2, c = lagCS[0], sn = lagCS[1];
+      springs.forEach((g, r) => {
+        const w = col[g.index];
+        for (let j = 0; j < 3; j++) free[r][j] += w * (gz[j] * c + (gzv[j] + sigma * gz[j]) * sn);
+      });
+    });
+    followerCS(tau);
+    const lagStep = 1 - lagCS[0] - damp[K - 1] / 2 * lagCS[1];
+    dampedCS(tau);
+    const A = springs.map(() => new Float64Array(n));
+    for (let i = 0; i < K; i++) {
+      const sigma = damp[i] / 2, c = eC[i], sn = eS[i], step = (1 - c - sigma * sn) / lam[i];
+      for (let r = 0; r < m; r++) {
+        const p = phi[springs[r].index * K + i];
+        for (let j = 0; j < 3; j++) {
+          const a = gq[3 * i + j];
+          free[r][j] += p * (a * c + (gv[3 * i + j] + sigma * a) * sn);
+        }
+        for (let h = 0; h < n; h++) A[r][h] += p * phi[all[h].index * K + i] * step;
+      }
     }
-    if (grab.push) {
-      if (grab.push.t_on === t) pushes.pop(); else grab.push.t_off = t;
+    if (!data.complete) for (let r = 0; r < m; r++) for (let h = 0; h < n; h++) {
+      const col = corrections.get(all[h].index);
+      if (col) A[r][h] += col[springs[r].index] * lagStep;
     }
-    grab.force = F;
-    grab.push = { index: n, force: F.slice(), t_on: t, t_off: null };
-    pushes.push(grab.push);
-    setForce(n, F);
+    // (A_ss + diag(1/k)) F = x_pointer - x⁰ - A_sf F_fixed, by Gaussian elimination
+    // a point that cannot move (held by an edge: no mode moves it) takes no force
+    const still = springs.map((g) => !(flexibility(g.index) > 0));
+    const M = springs.map((g, r) => {
+      const row = Array.from(A[r].subarray(0, m));
+      if (still[r]) return row.map((_, h) => (h === r ? 1 : 0));
+      const k = Number(springBox.value) / flexibility(g.index);
+      row[r] = Math.max(row[r], 0) + 1 / k;
+      return row;
+    });
+    const b = springs.map((g, r) => {
+      if (still[r]) return [0, 0, 0];
+      const target = springTarget(g), x = free[r], rhs = [target.x - rest[3 * g.index] - x[0],
+        target.y - rest[3 * g.index + 1] - x[1], target.z - rest[3 * g.index + 2] - x[2]];
+      for (let h = m; h < n; h++) for (let j = 0; j < 3; j++) rhs[j] -= A[r][h] * all[h].force[j];
+      return rhs;
+    });
+    for (let c = 0; c < m; c++) {
+      let piv = c;
+      for (let r = c + 1; r < m; r++) if (Math.abs(M[r][c]) > Math.abs(M[piv][c])) piv = r;
+      [M[c], M[piv]] = [M[piv], M[c]]; [b[c], b[piv]] = [b[piv], b[c]];
+      for (let r = c + 1; r < m; r++) {
+        const e = M[r][c] / M[c][c];
+        for (let k = c; k < m; k++) M[r][k] -= e * M[c][k];
+        for (let j = 0; j < 3; j++) b[r][j] -= e * b[c][j];
+      }
+    }
+    const F = springs.map(() => [0, 0, 0]);
+    for (let r = m - 1; r >= 0; r--) for (let j = 0; j < 3; j++) {
+      let s = b[r][j];
+      for (let k = r + 1; k < m; k++) s -= M[r][k] * F[k][j];
+      F[r][j] = s / M[r][r];
+    }
+    let changed = false;
+    springs.forEach((g, r) => {
+      let force = F[r];
+      if (grabMode.value === "normal") {
+        const nn = g.normal, dot = force[0] * nn.x + force[1] * nn.y + force[2] * nn.z;
+        force = [dot * nn.x, dot * nn.y, dot * nn.z];
+      }
+      const old = g.force;
+      if (old) {
+        const change = Math.hypot(force[0] - old[0], force[1] - old[1], force[2] - old[2]);
+        if (change <= 1e-3 * Math.hypot(old[0], old[1], old[2])) return;
+      }
+      endPush(g);
+      g.force = force;
+      g.push = { index: g.index, force: force.slice(), t_on: t, t_off: null };
+      pushes.push(g.push);
+      changed = true;
+    });
+    if (changed) setForce();
   }
-

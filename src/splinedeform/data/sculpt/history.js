@@ -10,7 +10,12 @@
     return { data, q: Float64Array.from(q), v: Float64Array.from(v), f: Float64Array.from(f),
              t, tEvent, pushes: pushes.map((p) => Object.assign({}, p, { force: p.force.slice() })),
              freeMask: freeMask.slice(), freeSource, freeEdited, carriedMotion,
-             corrections: new Map(corrections) };
+             corrections: new Map(corrections), lagged: copyLagged(lagged) };
+  }
+  function copyLagged(from) {
+    const out = new Map();
+    from.forEach((e, k) => out.set(k, { z: Float64Array.from(e.z), zv: Float64Array.from(e.zv), fz: Float64Array.from(e.fz) }));
+    return out;
   }
   function showHistory() {
     undoButton.disabled = !online || undoStack.length === 0;
@@ -23,7 +28,7 @@
     showHistory();
   }
   function restore(state) {
-    if (grab) release(null);
+    releaseAll();
     const sameGrid = state.data.grid[0] === ru && state.data.grid[1] === rv;
     data = state.data;
     unpack(data);
@@ -35,7 +40,9 @@
     carriedMotion = state.carriedMotion;
     corrections.clear();
     state.corrections.forEach((c, k) => { if (c) corrections.set(k, c); });
-    offlineFactor = null; grab = null; controls.enabled = true; lastSwitch = null;
+    lagged.clear();
+    copyLagged(state.lagged).forEach((e, k) => lagged.set(k, e));
+    offlineFactor = null; grab = null; extra = []; controls.enabled = true; lastSwitch = null;
     if (!sameGrid || !geometry) buildGeometry();
     buildForms();
     paintNet();
@@ -65,29 +72,54 @@
   }
   function undo() { return switchBasis("api/undo", undoStack, redoStack); }
   function redo() { return switchBasis("api/redo", redoStack, undoStack); }
-  async function bake() {
+  // bake; with `pinned` (a control point, row-major) also a pin: the free set less that
+  // point, which then stays where the bake put it (its displaced place) whatever is pulled
+  async function bake(pinned) {
     if (solving) return;
+    const pinning = pinned !== undefined && pinned !== null;
+    let extra = {};
+    if (pinning) {
+      if (!freeMask[pinned] || stillMask[pinned]) {
+        showMessage("control point " + netName(pinned) + " is held already", true);
+        return;
+      }
+      const mask = freeMask.slice(), nv = gV.length, points = [];
+      mask[pinned] = 0;
+      for (let k = 0; k < NN; k++) if (mask[k]) points.push([Math.floor(k / nv), k % nv]);
+      extra = { free_points: points };
+    }
     solving = true;
-    progressBox.textContent = "baking…";
+    progressBox.textContent = pinning ? "pinning…" : "baking…";
     const wasPaused = paused;
     setPaused(true);                  // the shape sent is the shape when the new modes arrive
     try {
-      if (grab) release(null);
+      releaseAll();
       const earlier = pageState();
       const now = new Float64Array(K * 3);
       propagate(q, v, f, t - tEvent, now, null);   // the shape now: x = x0 + Φ q(t)
-      const reply = await post("api/bake", { version: data.version, q: Array.from(now) });
+      const reply = await post("api/bake", Object.assign({ version: data.version, q: Array.from(now) }, extra));
       remember(earlier);
       load(reply);
-      progressBox.textContent = "baked in " + reply.solve_seconds + " s: this shape is the rest shape (" + K + " modes)";
+      progressBox.textContent = pinning
+        ? "pinned control point " + netName(pinned) + " where it is (shape baked in " + reply.solve_seconds + " s, " + K + " modes)"
+        : "baked in " + reply.solve_seconds + " s: this shape is the rest shape (" + K + " modes)";
     } catch (err) {
       progressBox.textContent = "";
-      showMessage("bake refused: " + err.message);
+      showMessage((pinning ? "pin" : "bake") + " refused: " + err.message);
     } finally {
       setPaused(wasPaused);
       solving = false;
       showHistory();
     }
+  }
+  function netName(k) {
+    const nv = gV.length, i = Math.floor(k / nv), j = k % nv;
+    return "[" + i + ", " + j + "] (u = " + gU[i].toPrecision(3) + ", v = " + gV[j].toPrecision(3) + ")";
+  }
+  // pin the control point nearest (Greville points, parameter domain) to sample n
+  function pin(n) {
+    const cu = data.u[Math.floor(n / rv)], cv = data.v[n % rv];
+    return bake(nearestNetPoint(cu, cv));
   }
   document.getElementById("bake").addEventListener("click", () => { bake(); });
   undoButton.addEventListener("click", () => { undo(); });

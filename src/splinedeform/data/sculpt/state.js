@@ -1,5 +1,15 @@
 // sculpt page, part state: the modal data, the modal state (q, q', f) per mode carried in closed form from event to event, the session (time, pushes, the held grab).
 // The parts are concatenated in order inside one function scope (see sculpt/page.py).
+  // Start-up is idempotent: a page saved from the browser ("Webpage, Complete", or the DOM as
+  // it is) carries the canvas of its last run, its banners and status lines; they go, and the
+  // page is drawn afresh. What is left then is the page as served, kept for "Save offline page".
+  document.querySelectorAll("#view > *").forEach((node) => node.remove());
+  for (const id of ["message", "hud", "progress", "saved", "paint-info"]) {
+    const node = document.getElementById(id);
+    if (node) node.textContent = "";
+  }
+  document.getElementById("message").style.display = "none";
+  const pristinePage = document.documentElement.cloneNode(true);
   let data = JSON.parse(document.getElementById("splinedeform-data").textContent);
   const online = location.protocol === "http:" || location.protocol === "https:";
   // the session token of the server that served this page: sent with every API call
@@ -82,28 +92,80 @@
     }
   }
 
+  // -- the static correction follows the dynamics ---------------------------------------------
+  // r_a ⊗ z_a, not r_a ⊗ P_a: the omitted modes reach their static part r_a P_a only as fast as
+  // their dynamics lets them, so z_a obeys z'' + c* z' + λ* z = λ* P_a(t) (static limit z = P,
+  // mode acceleration's exact static answer) with (λ*, c*) = (λ_K, c_K), the highest kept mode:
+  // no omitted mode is slower (λ_j ≥ λ_K; over-damped, a step reaches λ_j g_j(τ) ≥ λ_K g_K(τ)),
+  // so the correction never adds a static part the dynamics has not reached (damping 1e8: a
+  // held push dents the sheet at the pace of the modes, not at once). Kept per grabbed
+  // sample as (z, z', force λ* P) at tEvent, like the modes; dropped when the page settles.
+  const lagged = new Map();          // sample index -> {z, zv, fz: Float64Array(3)}
+  const lagCS = new Float64Array(2); // e^{-στ} C(τ), e^{-στ} S(τ) of the follower mode
+  function followerCS(tau) {
+    const l = lam[K - 1], sigma = damp[K - 1] / 2, s = sigma * sigma - l, x = s * tau * tau;
+    const decay = Math.exp(-sigma * tau);
+    if (Math.abs(x) < 1e-3) {
+      lagCS[0] = decay * (1 + x * (1 / 2 + x * (1 / 24 + x / 720)));
+      lagCS[1] = decay * tau * (1 + x * (1 / 6 + x * (1 / 120 + x / 5040)));
+    } else if (s < 0) {
+      const w = Math.sqrt(-s);
+      lagCS[0] = decay * Math.cos(w * tau); lagCS[1] = decay * Math.sin(w * tau) / w;
+    } else {
+      const d = Math.sqrt(s), grow = Math.exp((d - sigma) * tau), fall = Math.exp((-d - sigma) * tau);
+      lagCS[0] = (grow + fall) / 2; lagCS[1] = (grow - fall) / (2 * d);
+    }
+  }
+  // the follower's state of `entry` after tau (from tEvent) into (outZ, outV)
+  function lagAdvance(entry, tau, outZ, outV) {
+    followerCS(tau);
+    const l = lam[K - 1], sigma = damp[K - 1] / 2, c = lagCS[0], sn = lagCS[1];
+    for (let j = 0; j < 3; j++) {
+      const r = entry.fz[j] / l, a = entry.z[j] - r, b = entry.zv[j];
+      outZ[j] = r + a * c + (b + sigma * a) * sn;
+      if (outV) outV[j] = b * c - (l * a + sigma * b) * sn;
+    }
+  }
+
   // -- session: time, pushes, the held grab --------------------------------------------------
   let t = 0, tEvent = 0, paused = false, speed = 1;
   let pushes = [];           // {index, force: [3], t_on, t_off|null}: what "Save" sends
-  let grab = null;           // {index, force: [3], push, flex, normal, depth, pointer}
+  let grab = null;           // the grab of the main pointer: {index, force: [3], push, normal, depth, pointerId}
+  // the other grabs held at once: a second finger's ({pointerId, pointer}), a grab released
+  // with shift that stays held by its spring to where the pointer was ({anchor}), or a force
+  // held without a spring ({fixed}); the forces of all superpose
+  let extra = [];
   const corrections = new Map();   // sample index -> Float32Array(N) static correction column
-  // a change of the held force at the current time: carry the state to t, then switch
-  function setForce(index, force) {
+  function allGrabs() { return (grab ? [grab] : []).concat(extra); }
+  // a change of the held forces at the current time: carry the state to t, then switch to
+  // f = Σ_g φ(a_g) F_g (and the followers of the static correction to λ* Σ F at each point)
+  function setForce() {
     propagate(q, v, f, t - tEvent, q, v);
+    lagged.forEach((entry) => { lagAdvance(entry, t - tEvent, entry.z, entry.zv); entry.fz.fill(0); });
     tEvent = t;
     dirty = true;                      // redraw even when paused (the static part changes)
     f.fill(0);
-    if (force) {
-      const base = index * K;
+    const l = lam[K - 1];
+    for (const g of allGrabs()) {
+      const force = g.force;
+      if (!force) continue;
+      if (!data.complete) {
+        if (!lagged.has(g.index)) lagged.set(g.index, { z: new Float64Array(3), zv: new Float64Array(3), fz: new Float64Array(3) });
+        const fz = lagged.get(g.index).fz;
+        fz[0] += l * force[0]; fz[1] += l * force[1]; fz[2] += l * force[2];
+      }
+      const base = g.index * K;
       for (let i = 0; i < K; i++) {
         const p = phi[base + i];
-        f[3 * i] = p * force[0]; f[3 * i + 1] = p * force[1]; f[3 * i + 2] = p * force[2];
+        f[3 * i] += p * force[0]; f[3 * i + 1] += p * force[1]; f[3 * i + 2] += p * force[2];
       }
     }
   }
   function reset() {
-    q.fill(0); v.fill(0); f.fill(0); t = 0; tEvent = 0; pushes = []; grab = null; carriedMotion = false;
+    q.fill(0); v.fill(0); f.fill(0); t = 0; tEvent = 0; pushes = []; grab = null; extra = []; carriedMotion = false;
+    lagged.clear();
     controls.enabled = true;
+    modalSum();                        // at rest now, not at the next frame (picking reads it)
     dirty = true;
   }
 
