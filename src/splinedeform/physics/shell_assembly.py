@@ -120,8 +120,10 @@ def assemble_cells(pattern: Pattern, cells_u: Index, cells_v: Index,
     step = max(1, CHUNK_ENTRIES // max(1, cells_v.shape[0] * m * m * 4))
     for a in range(0, cells_u.shape[0], step):
         rows = slice(a, min(a + step, cells_u.shape[0]))
-        where = pattern.positions(cells_u[rows], cells_v)
-        data += np.bincount(where.ravel(), blocks(rows).ravel(), minlength=data.size)
+        where = pattern.positions(cells_u[rows], cells_v).ravel()
+        # a chunk's rows are a contiguous stretch of the data: sum into that stretch only
+        lo, hi = int(where.min()), int(where.max()) + 1
+        data[lo:hi] += np.bincount(where - lo, blocks(rows).ravel(), minlength=hi - lo)
     # ½(K + Kᵀ) entry by entry: the pattern is symmetric, so K's transpose has the same
     # structure and its data are K's read at the transposed positions (exactly symmetric)
     data = 0.5 * (data + data[transposed(indptr, indices)])
