@@ -146,9 +146,7 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
         LV = np.concatenate([np.einsum("...ij,...jcs->...ics", Lt[..., :3, :], V[..., :3, :, :]),
                              np.einsum("...ij,...jcs->...ics", Lt[..., 3:, :], V[..., 3:, :, :])],
                             axis=-3)
-        # (18, 5) @ (5, k) per point; einsum's optimised path is ~3× numpy's stacked matmul
-        C = np.einsum("...is,...sk->...ik", LV.reshape(LV.shape[:3] + (18, 5)), S,
-                      optimize=True)                                # (A, B, qu qv, 18, k)
+        C = LV.reshape(LV.shape[:3] + (18, 5)) @ S                  # (A, B, qu qv, 18, k)
         C = C.reshape(C.shape[:2] + (-1, 3 * C.shape[-1]))          # rows (q, i), cols (c, k)
         return np.swapaxes(C, -1, -2) @ C
 
