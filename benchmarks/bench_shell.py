@@ -14,7 +14,9 @@ process (its own peak memory, ``ru_maxrss``): the full pinched cylinder (radius 
 length 600, thickness 3, E = 3e6, ν = 0.3, rigid diaphragms, two opposite unit loads;
 ``w = 1.8248e-5`` under each) on 128 × 64 cubic cells, the assembly of the roof on 64²
 cubic cells and its lowest 20 modes, against the goals 10 s and 1.5 GB, 1 s and 10 s.
-The machine's load average is printed beside the figures.
+The shell's calls run with the library's BLAS threads (one unless ``SPLINEDEFORM_THREADS``
+says otherwise, :mod:`splinedeform.threads`). The machine's load average is printed
+beside the figures.
 """
 
 from __future__ import annotations
