@@ -1,5 +1,5 @@
-"""The residual guard's bound ``η = ‖Kφ − λMφ‖_{M⁻¹}`` against an independent dense solve,
-and the shell's solves under the library's BLAS thread limit."""
+"""The residual guard's bound ``η = ‖Kφ − λMφ‖_{M⁻¹}`` against an independent dense
+solve, and the shell's solves under the library's BLAS thread limit."""
 
 import numpy as np
 import scipy.linalg as sla
