@@ -166,7 +166,7 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
 
 def cell_shapes(G: metric.Grid, points: slice, q: tuple[int, int]) -> Array:
     """``N_,1, N_,2, N_,11, N_,12, N_,22`` at the grid rows ``points`` by cells,
-    ``(A, B, q_u q_v, 5, k)`` (the layout of :func:`by_cell`, built in it directly):
+    ``(A, B, q_u q_v, 5, k)``, the layout of :func:`by_cell` without its copy:
     ``N_{,u^p v^r}[(x, y), (k_u, k_v)] = B_u^(p)[x, k_u] B_v^(r)[y, k_v]``."""
     (qu, qv), (_, Qa, pu), (_, Qv, pv) = q, G.values_u[:, points].shape, G.values_v.shape
     Bu = G.values_u[:, points].reshape(3, Qa // qu, 1, qu, 1, pu, 1)
