@@ -134,7 +134,7 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
 
     def stiffness(rows: slice) -> Array:
         points = slice(rows.start * q[0], rows.stop * q[0])
-        S = by_cell(point_shapes(G, points), q)                     # (A, B, qu qv, 5, k)
+        S = cell_shapes(G, points, q)                               # (A, B, qu qv, 5, k)
         V = by_cell(strain_vectors(G, points), q)                   # (A, B, qu qv, 6, 3, 5)
         H = by_cell(constitutive(G.g_inv[points], nu), q)
         w = by_cell(dA[points], q)[..., None, None]
@@ -142,10 +142,10 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
         L = np.linalg.cholesky(H)
         Lt = np.concatenate([np.swapaxes(L, -1, -2) * np.sqrt(membrane * w),
                              np.swapaxes(L, -1, -2) * np.sqrt(bending * w)], axis=-2)
-        LV = np.concatenate([sum(Lt[..., :3, j, None, None] * V[..., j, None, :, :]
-                                 for j in range(3)),
-                             sum(Lt[..., 3:, j, None, None] * V[..., 3 + j, None, :, :]
-                                 for j in range(3))], axis=-3)
+        # (Lᵀ V)[i, c, s] = Σ_j Lᵀ[i, j] V[j, c, s], membrane and bending rows apart
+        LV = np.concatenate([np.einsum("...ij,...jcs->...ics", Lt[..., :3, :], V[..., :3, :, :]),
+                             np.einsum("...ij,...jcs->...ics", Lt[..., 3:, :], V[..., 3:, :, :])],
+                            axis=-3)
         C = LV.reshape(LV.shape[:3] + (18, 5)) @ S                  # (A, B, qu qv, 18, k)
         C = C.reshape(C.shape[:2] + (-1, 3 * C.shape[-1]))          # rows (q, i), cols (c, k)
         return np.swapaxes(C, -1, -2) @ C
@@ -164,13 +164,16 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
     return K, sp.kron(scalar, sp.identity(3), format="csr")
 
 
-def point_shapes(G: metric.Grid, points: slice) -> Array:
-    """``N_,1, N_,2, N_,11, N_,12, N_,22`` at the grid rows ``points``, ``(Qa, Qv, 5, k)``."""
-    Bu, Bv = G.values_u[:, points], G.values_v
-    out = [Bu[p][:, None, :, None] * Bv[r][None, :, None, :]
-           for p, r in ((1, 0), (0, 1), (2, 0), (1, 1), (0, 2))]
-    S = np.stack(out, axis=2)
-    return S.reshape(S.shape[:3] + (-1,))
+def cell_shapes(G: metric.Grid, points: slice, q: tuple[int, int]) -> Array:
+    """``N_,1, N_,2, N_,11, N_,12, N_,22`` at the grid rows ``points`` by cells,
+    ``(A, B, q_u q_v, 5, k)``, the layout of :func:`by_cell` without its copy:
+    ``N_{,u^p v^r}[(x, y), (k_u, k_v)] = B_u^(p)[x, k_u] B_v^(r)[y, k_v]``."""
+    (qu, qv), (_, Qa, pu), (_, Qv, pv) = q, G.values_u[:, points].shape, G.values_v.shape
+    Bu = G.values_u[:, points].reshape(3, Qa // qu, 1, qu, 1, pu, 1)
+    Bv = G.values_v.reshape(3, 1, Qv // qv, 1, qv, 1, pv)
+    S = np.stack([Bu[p] * Bv[r] for p, r in ((1, 0), (0, 1), (2, 0), (1, 1), (0, 2))],
+                 axis=4)                                   # (A, B, qu, qv, 5, pu, pv)
+    return S.reshape(S.shape[:2] + (qu * qv, 5, pu * pv))
 
 
 def strain_vectors(G: metric.Grid, points: slice) -> Array:

@@ -111,16 +111,31 @@ def assemble_cells(pattern: Pattern, cells_u: Index, cells_v: Index,
     """Sum the symmetric cell blocks ``blocks(rows)`` (``(A, B, m, m)``) into ``pattern``.
 
     ``blocks`` is called on slices of cell rows in u, a bounded number of cells at a time;
-    each block is symmetrised (``½(Kₑ + Kₑᵀ)``) before it is scattered.
+    the sum is symmetrised once, ``½(K + Kᵀ)`` on the CSR data (the same as symmetrising
+    each block, ``Σ ½(Kₑ + Kₑᵀ)``, up to the order of the additions).
     """
     m = pattern.components * cells_u.shape[1] * cells_v.shape[1]
-    indptr = pattern.indptr()
+    indptr, indices = pattern.indptr(), pattern.indices()
     data = np.zeros(indptr[-1])
     step = max(1, CHUNK_ENTRIES // max(1, cells_v.shape[0] * m * m * 4))
     for a in range(0, cells_u.shape[0], step):
         rows = slice(a, min(a + step, cells_u.shape[0]))
-        block = blocks(rows)
-        block = 0.5 * (block + np.swapaxes(block, -1, -2))
-        where = pattern.positions(cells_u[rows], cells_v)
-        data += np.bincount(where.ravel(), block.ravel(), minlength=data.size)
-    return sp.csr_matrix((data, pattern.indices(), indptr), shape=(pattern.size,) * 2)
+        where = pattern.positions(cells_u[rows], cells_v).ravel()
+        # a chunk's rows are a contiguous stretch of the data: sum into that stretch only
+        lo, hi = int(where.min()), int(where.max()) + 1
+        data[lo:hi] += np.bincount(where - lo, blocks(rows).ravel(), minlength=hi - lo)
+    # ½(K + Kᵀ) entry by entry: the pattern is symmetric, so K's transpose has the same
+    # structure and its data are K's read at the transposed positions (exactly symmetric)
+    data = 0.5 * (data + data[transposed(indptr, indices)])
+    return sp.csr_matrix((data, indices, indptr), shape=(pattern.size,) * 2)
+
+
+def transposed(indptr: Index, indices: Index) -> Index:
+    """Position of entry ``(j, i)`` for every stored ``(i, j)`` of a symmetric CSR pattern."""
+    n = indptr.size - 1
+    order = sp.csr_matrix((np.arange(1, indices.size + 1), indices, indptr),
+                          shape=(n, n)).T.tocsr()            # 1-based: no stored zero
+    order.sort_indices()
+    if order.nnz != indices.size or not np.array_equal(order.indices, indices):
+        raise ValueError("the pattern is not symmetric")
+    return order.data - 1

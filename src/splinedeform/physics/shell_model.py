@@ -29,6 +29,7 @@ from ..solvers import modal_basis
 from ..solvers.analytic import ModalResponse
 from ..solvers.rigid import UnresolvedSpectrum
 from ..surface import Surface
+from ..threads import owned
 from . import metric
 from .shell import ShellMaterial, matrices
 from .shell_edges import EDGES, KINDS, check_edges, constraint_matrix  # noqa: F401
@@ -74,6 +75,7 @@ class ShellModel:
         Individual displacement components (or whole control points) that do not move.
     """
 
+    @owned
     def __init__(self, surface: Surface, material: ShellMaterial,
                  boundary: Mapping[str, str] | None = None, fixed: ArrayLike | None = None):
         start = time.perf_counter()
@@ -112,6 +114,7 @@ class ShellModel:
         """Reduced generalised force ``Tᵀ F(t)`` over the interleaved unknowns."""
         return np.asarray(self.T.T @ as_load(load).vector(self.surface, t).ravel())
 
+    @owned
     def static(self, load: Load | None, t: float | None = None) -> ShellStaticSolution:
         """Equilibrium of the shell under ``load`` (at time ``t`` for a time-varying profile).
 
@@ -179,6 +182,7 @@ class ShellModel:
         return {"advice": self.spectrum_advice(),
                 "guard": "residual" if check_spectrum else "off"}
 
+    @owned
     def eigen(self, k: int, check_spectrum: bool = True) -> tuple[Array, Array]:
         """Lowest ``k`` eigenpairs of ``K_r φ = λ M_r φ`` (``Φᵀ M_r Φ = I``, rigid ``λ = 0``).
 
@@ -244,6 +248,7 @@ class ShellModel:
                              "conditions fix or tie")
         return np.asarray(free)
 
+    @owned
     def dynamic(self, load: Load | None, t_end: float, method: str = "analytic",
                 modes: int | None = None, initial_displacement: ArrayLike | None = None,
                 initial_velocity: ArrayLike | None = None,

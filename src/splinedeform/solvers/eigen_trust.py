@@ -16,16 +16,18 @@ Problem*, §15):
   frequencies' own tolerance.
 
 The residual is evaluated in floating point, so its own round-off (``ε |K| |φ|``, the
-condition number's fear) is part of what is measured.
+condition number's fear) is part of what is measured. The norm ``‖r‖_{M⁻¹}`` takes one
+Cholesky factorisation of the positive definite ``M`` (:func:`.factor.factorise`: the band
+Cholesky where the tensor-product net's Kronecker order keeps ``M`` banded).
 """
 
 from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
 
+from .factor import factorise
 from .rigid import ROUNDOFF, TRUST, UnresolvedSpectrum
 
 Array = NDArray[np.float64]
@@ -48,8 +50,7 @@ def residual_bounds(K: sp.spmatrix, M: sp.spmatrix, lam: Array, phi: Array
     Mphi = M @ phi
     phi = phi / np.sqrt(np.einsum("ik,ik->k", phi, Mphi))[None, :]
     r = K @ phi - (M @ phi) * lam[None, :]
-    Mlu = spla.splu(sp.csc_matrix(M))
-    eta = np.sqrt(np.maximum(np.einsum("ik,ik->k", r, Mlu.solve(r)), 0.0))
+    eta = np.sqrt(np.maximum(np.einsum("ik,ik->k", r, factorise(M).solve(r)), 0.0))
     order = np.argsort(lam)
     ls, es = lam[order], eta[order]
     # a cluster: neighbours closer than TRUST of ω² (mixing them changes K Φ by no more
