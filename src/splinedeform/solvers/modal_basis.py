@@ -36,7 +36,7 @@ from ..errors import InputError, SingularSystemError
 from . import kronecker_eigen
 from .bases import DenseBasis, ModalBasis, SeparableBasis, _zero_small  # noqa: F401 (public here too)
 from .mode_acceleration import StaticCorrection, mode_acceleration  # noqa: F401 (public here too)
-from .eigen_trust import GUARDS, check_by_residual
+from .eigen_trust import CHECKED, GUARDS, check_by_residual, refine_pairs
 from .rigid import check_resolved, count_by_gap
 from .system import KroneckerFactors
 
@@ -156,7 +156,9 @@ def stiffness_factorisation(K: sp.spmatrix, shift: float = 0.0, M: sp.spmatrix |
 def _eigsh(K: sp.spmatrix, M: sp.spmatrix, k: int, shift: float, lu: Any) -> tuple[Array, Array]:
     n = K.shape[0]
     op = spla.LinearOperator((n, n), matvec=lu.solve, dtype=float)
-    lam, phi = spla.eigsh(K, k=k, M=M, sigma=shift, which="LM", OPinv=op)
+    # a seeded start: ARPACK's own depends on the calls made before in the process
+    v0 = np.random.default_rng(0).standard_normal(n)
+    lam, phi = spla.eigsh(K, k=k, M=M, sigma=shift, which="LM", OPinv=op, v0=v0)
     order = np.argsort(lam)
     lam, phi = lam[order], phi[:, order]
     phi = phi / np.sqrt(np.einsum("ik,ik->k", phi, M @ phi))[None, :]
@@ -176,7 +178,8 @@ def sparse_basis(K: sp.spmatrix, M: sp.spmatrix, k: int | None = None,
     round-off level behind a gap) ``K`` is singular, a small negative shift is used and
     there is no static solve. The ``rigid`` lowest eigenvalues are set to 0 and the rest
     checked against ``λ_max ≈ max K_ii/M_ii`` (``guard``, see :func:`_resolved`).
-    ``order`` is passed to :func:`stiffness_factorisation`.
+    ``order`` is passed to :func:`stiffness_factorisation`. Under ``guard="residual"`` the
+    lowest vectors are refined first (:func:`.eigen_trust.refine_pairs`).
     """
     n = K.shape[0]
     unconstrained = rigid != 0
@@ -202,6 +205,8 @@ def sparse_basis(K: sp.spmatrix, M: sp.spmatrix, k: int | None = None,
         assert k is not None
         lam, phi = _eigsh(K, M, min(k + 1, n - 1), shift, lu)
     top = float(np.max(K.diagonal() / M.diagonal()))       # a Rayleigh quotient <= λ_max
+    if guard == "residual":         # the residuals judged: first rid them of the solves' rounding
+        phi = refine_pairs(K, M, lam, phi, lu.solve, min(rigid or 0, lam.size) + CHECKED)
     if rigid is None:
         rigid = count_by_gap(lam, "sparse eigen-solution", top)
     lam = _resolved(K, M, lam, phi, min(rigid, lam.size), "sparse eigen-solution", advice,
