@@ -101,8 +101,8 @@ def test_refinement_rids_the_pole_mode_of_the_solves_rounding():
 
 def test_an_unresolved_thin_shell_is_refused_in_its_own_words():
     model, unit = pinned_disk(1e-7)
-    # t = 1e-7: the lowest residual bounds 7 % of ω² after the refinement (the eigenvalue's true error is
-    # 5e-4, the bound is rigorous, not tight)
+    # t = 1e-7: the lowest residual bounds 7 % of ω² after the refinement (the eigenvalue's
+    # true error is 5e-4, the bound is rigorous, not tight)
     with pytest.raises(UnresolvedSpectrum) as info:
         model.frequencies(3)
     message = str(info.value)
