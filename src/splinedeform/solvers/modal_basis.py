@@ -36,7 +36,7 @@ from ..errors import InputError, SingularSystemError
 from . import kronecker_eigen
 from .bases import DenseBasis, ModalBasis, SeparableBasis, _zero_small  # noqa: F401 (public here too)
 from .mode_acceleration import StaticCorrection, mode_acceleration  # noqa: F401 (public here too)
-from .eigen_trust import GUARDS, check_by_residual
+from .eigen_trust import GUARDS, check_by_residual, refine_doubtful
 from .rigid import check_resolved, count_by_gap
 from .system import KroneckerFactors
 
@@ -52,7 +52,8 @@ DEFAULT_ADVICE = "Raise the smallest weight, or use fewer cells or a lower degre
 
 
 def _resolved(K: sp.spmatrix, M: sp.spmatrix, lam: Array, phi: Array, rigid: int,
-              what: str, advice: str, top: float | None, guard: str) -> Array:
+              what: str, advice: str, top: float | None, guard: str,
+              mass_solve: Any | None = None) -> Array:
     """``lam`` with its rigid part zeroed, checked by ``guard`` (:data:`GUARDS`):
     ``condition`` (:func:`.rigid.check_resolved`), ``residual`` or ``off``
     (:func:`.eigen_trust.check_by_residual`)."""
@@ -60,7 +61,7 @@ def _resolved(K: sp.spmatrix, M: sp.spmatrix, lam: Array, phi: Array, rigid: int
         raise InputError(f"guard must be one of {GUARDS}, got {guard!r}")
     if guard == "condition":
         return check_resolved(lam, rigid, what, advice, top)
-    return check_by_residual(K, M, lam, phi, rigid, what, advice, top, guard)
+    return check_by_residual(K, M, lam, phi, rigid, what, advice, top, guard, mass_solve)
 
 
 def dense_basis(K: sp.spmatrix, M: sp.spmatrix, rigid: int | None = None,
@@ -156,7 +157,9 @@ def stiffness_factorisation(K: sp.spmatrix, shift: float = 0.0, M: sp.spmatrix |
 def _eigsh(K: sp.spmatrix, M: sp.spmatrix, k: int, shift: float, lu: Any) -> tuple[Array, Array]:
     n = K.shape[0]
     op = spla.LinearOperator((n, n), matvec=lu.solve, dtype=float)
-    lam, phi = spla.eigsh(K, k=k, M=M, sigma=shift, which="LM", OPinv=op)
+    # a seeded start: ARPACK's own depends on the calls made before in the process
+    v0 = np.random.default_rng(0).standard_normal(n)
+    lam, phi = spla.eigsh(K, k=k, M=M, sigma=shift, which="LM", OPinv=op, v0=v0)
     order = np.argsort(lam)
     lam, phi = lam[order], phi[:, order]
     phi = phi / np.sqrt(np.einsum("ik,ik->k", phi, M @ phi))[None, :]
@@ -176,7 +179,8 @@ def sparse_basis(K: sp.spmatrix, M: sp.spmatrix, k: int | None = None,
     round-off level behind a gap) ``K`` is singular, a small negative shift is used and
     there is no static solve. The ``rigid`` lowest eigenvalues are set to 0 and the rest
     checked against ``λ_max ≈ max K_ii/M_ii`` (``guard``, see :func:`_resolved`).
-    ``order`` is passed to :func:`stiffness_factorisation`.
+    ``order`` is passed to :func:`stiffness_factorisation`. Under ``guard="residual"`` the
+    lowest vectors near refusal are refined first (:func:`.eigen_trust.refine_doubtful`).
     """
     n = K.shape[0]
     unconstrained = rigid != 0
@@ -204,8 +208,11 @@ def sparse_basis(K: sp.spmatrix, M: sp.spmatrix, k: int | None = None,
     top = float(np.max(K.diagonal() / M.diagonal()))       # a Rayleigh quotient <= λ_max
     if rigid is None:
         rigid = count_by_gap(lam, "sparse eigen-solution", top)
+    mass_solve = None
+    if guard == "residual":         # the residuals judged: first rid them of the solves' rounding
+        phi, mass_solve = refine_doubtful(K, M, lam, phi, min(rigid, lam.size), lu.solve)
     lam = _resolved(K, M, lam, phi, min(rigid, lam.size), "sparse eigen-solution", advice,
-                    top, guard)
+                    top, guard, mass_solve)
     first = lam[k] if k < lam.size else np.inf
     return DenseBasis(lam[:k], phi[:, :k], "sparse", k == n, solve, first)
 
