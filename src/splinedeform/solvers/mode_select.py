@@ -48,6 +48,7 @@ from .modal_basis import DEFAULT_ADVICE
 from .mode_count import decay_bound, error_bound
 from .rigid import check_resolved
 from .sparse_eigen import BlockLanczos
+from .transient_correction import DEGREE, TransientCorrection, fitted, over_damped_from
 
 Array = NDArray[np.float64]
 GRID = 3500
@@ -72,11 +73,31 @@ class ErrorEstimate:
     gamma: float
     beta: float
     weight: float
+    degree: int = 0            # > 0: the transient correction's E_d (.transient_correction)
 
     def relative(self, times: Array) -> Array:
         """The bound at ``times`` (relative, in the measure the basis was chosen in)."""
-        return self.weight * error_bound(self.norms, self.jump_times, self.lam_next,
-                                         self.gamma, self.beta, np.asarray(times, dtype=float))
+        times = np.asarray(times, dtype=float)
+        if not self.degree:
+            return self.weight * error_bound(self.norms, self.jump_times, self.lam_next,
+                                             self.gamma, self.beta, times)
+        return self.weight * transient_bound(self.norms[None, :], self.jump_times,
+                                             self.lam_next, self.gamma, self.beta, times,
+                                             self.degree)[0]
+
+
+def transient_bound(norms: Array, jump_times: Array, lam_next: float, gamma: float,
+                    beta: float, times: Array, degree: int = DEGREE) -> Array:
+    """``Σ_j ‖R_j‖_M E_d(λ_{m+1}, t − t_j) H(t − t_j)`` for rows of ``norms`` (``(r, J)``)
+    at ``times`` → ``(r, T)``: the bound of :class:`.transient_correction.TransientCorrection`."""
+    tau = times[None, :] - np.asarray(jump_times, dtype=float)[:, None]       # (J, T)
+    out = np.zeros((norms.shape[0], times.size))
+    on = tau > 0
+    if np.any(on):
+        E = np.zeros(tau.shape)
+        E[on] = fitted(lam_next, gamma, beta, tau[on], degree)[1]
+        out += norms @ E
+    return out
 
 
 def pointwise_bound(M: sp.spmatrix, T: sp.spmatrix | None = None,
@@ -149,6 +170,45 @@ def _grown(k: int, lam: Array, norms: Array, grid: Array, E: Array, column: Arra
     ok = np.flatnonzero((at_grid.max(axis=1) * decay <= limit) & (grid >= lam[k]))
     grow = np.inf if not ok.size else 1.1 * (grid[ok[0]] / lam[k]) ** count
     return int(np.ceil(min(max(grow, 1.25), 4.0) * k)), grow * k
+
+
+def _transient_count(upto: int, lam: Array, norms: Array, jump_times: Array, gamma: float,
+                     beta: float, times: Array, weight: float, tolerance: float
+                     ) -> tuple[int, float] | None:
+    """Fewer modes than ``upto + 1`` whose bound with the transient correction
+    (:func:`transient_bound`) meets ``tolerance`` at ``times``: ``(m, bound)``, or ``None``.
+
+    Only counts whose omitted modes are all over-damped are tried (below, the correction
+    is the static one); ten counts spaced geometrically up to ``upto``, then a bisection
+    between the last that missed and the first that met, to within 1/16 of it. Every count
+    returned has its bound evaluated (the bound need not fall monotonically with ``m``).
+    """
+    first = int(np.searchsorted(lam, over_damped_from(gamma, beta), side="left"))
+    first = max(first, 1)
+    if upto < first:
+        return None
+
+    def bound(m: int) -> float:
+        return float(weight * transient_bound(norms[:, m][None, :], jump_times, float(lam[m]),
+                                              gamma, beta, times)[0].max(initial=0.0))
+
+    low = first - 1
+    for m in np.unique(np.geomspace(first, upto, 10).astype(int)):
+        value = bound(int(m))
+        if value <= tolerance:
+            high, best = int(m), value
+            break
+        low = int(m)
+    else:
+        return None
+    while high - low > max(1, high // 16):
+        mid = (low + high) // 2
+        value = bound(mid)
+        if value <= tolerance:
+            high, best = mid, value
+        else:
+            low = mid
+    return high, best
 
 
 def _m_norm2(M: sp.spmatrix, x: Array) -> float:
@@ -245,8 +305,11 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
         fits = np.flatnonzero(relative[1:] <= tolerance) + 1
         report.update(computed=k, solves=modes.solves)
         last = (k, modes, lam, coef, norms, relative)
-        if fits.size:
-            m = int(fits[0])
+        weight = factor / max(scale, 1e-300)
+        dynamic = _transient_count(int(fits[0]) - 1 if fits.size else k, lam, norms,
+                                   jump_times, gamma, beta, times, weight, tolerance)
+        if fits.size or dynamic is not None:
+            m, bound_m = dynamic if dynamic is not None else (int(fits[0]), relative[fits[0]])
             parts = statics - np.array([modes.combine(c[:m]) for c in coef])
             jump_parts = np.zeros((J, n, width))
             jump_parts[:, :, active] = parts
@@ -256,16 +319,25 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
                        for p, s in zip(parts, statics)]
             residual = [np.linalg.norm(K @ s - f) / max(np.linalg.norm(f), 1e-300)
                         for s, f in zip(statics, F)]
-            report.update(modes=m, bound=float(relative[m]), scale=float(scale),
+            degree = DEGREE if dynamic is not None else 0
+            report.update(modes=m, bound=float(bound_m), scale=float(scale),
                           omitted_static=float(max(omitted, default=0.0)),
                           static_residual=float(max(residual, default=0.0)),
+                          correction_degree=degree,
                           estimate=ErrorEstimate(jump_times, norms[:, m], float(lam[m]),
-                                                 gamma, beta, factor / max(scale, 1e-300)))
-            return basis, StaticCorrection(jump_times, jump_parts, []), report
+                                                 gamma, beta, weight, degree))
+            if dynamic is not None:
+                correction: Any = TransientCorrection(lu.solve, M, basis.phi, float(lam[m]),
+                                                      gamma, beta, jump_times, jump_parts)
+            else:
+                correction = StaticCorrection(jump_times, jump_parts, [])
+            return basis, correction, report
         grown, needed = _grown(k, lam, norms, grid, E, column, tolerance * scale / factor)
         if k >= 64 and np.isfinite(needed) and needed >= n // 2:
-            break                   # half the modes or more: all of them are cheaper
-        k = grown
+            if lam[k] >= over_damped_from(gamma, beta):
+                break               # half the modes or more: all of them are cheaper
+            grown = max(grown, int(1.5 * k))    # the transient correction applies higher up
+        k = min(grown, n // 2 - 1) if grown < n // 2 or k < n // 2 - 1 else grown
     if best_effort and last is not None:
         m, modes, lam, coef, norms, relative = last       # every mode computed, bound missed
         parts = statics - np.array([modes.combine(c[:m]) for c in coef])
