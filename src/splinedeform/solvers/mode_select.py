@@ -29,7 +29,10 @@ control-point coordinate, since ``|x_p| ≤ c_∞ ‖x‖_M`` (:func:`pointwise_
 is extended: the LU and every solve so far are kept. An estimate of ``n/2`` modes or more
 made from at least 64 computed ends the search: all modes are cheaper then (a frame a few
 milliseconds after a jump of the bench plate needs them, as its over-damped modes relax
-no faster than ``1/β``). From 16 modes the estimate is not trusted: a uniform load's
+no faster than ``1/β``) — unless the omitted modes are all over-damped and the transient
+correction (:mod:`.transient_correction`, bound ``Σ_j ‖R_j‖_M E_d``) meets the tolerance
+with fewer modes than the static one: then it is taken (:func:`_transient_count`), and the
+search does not stop before the computed modes reach the over-damped range. From 16 modes the estimate is not trusted: a uniform load's
 ``‖R‖``, flat over the symmetric modes it does not excite, predicted 2 400 where 33 did.
 """
 
@@ -244,7 +247,9 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
     -------
     basis, correction, report
         A truncated :class:`~.modal_basis.DenseBasis` (its static solve is the LU), the
-        :class:`~.mode_acceleration.StaticCorrection` and a report (``modes``, ``bound``,
+        :class:`~.mode_acceleration.StaticCorrection` (or the
+        :class:`~.transient_correction.TransientCorrection`, ``correction_degree`` > 0 in
+        the report) and a report (``modes``, ``bound``,
         ``tolerance``, ``omitted_static``, ``static_residual``, ``computed``: modes found,
         ``solves``). ``(None, None, report)`` when ``n/2`` modes or more would be needed:
         all modes are cheaper then.
