@@ -33,7 +33,8 @@ no faster than ``1/β``) — unless the omitted modes are all over-damped and th
 correction (:mod:`.transient_correction`, bound ``Σ_j ‖R_j‖_M E_d``) meets the tolerance
 with fewer modes than the static one: then it is taken (:func:`_transient_count`), and the
 search does not stop before the computed modes reach the over-damped range. From 16
-modes the estimate is not trusted: a uniform load's ``‖R‖``, flat over the symmetric modes it does not excite, predicted 2 400 where 33 did.
+modes the estimate is not trusted: a uniform load's ``‖R‖``, flat over the symmetric
+modes it does not excite, predicted 2 400 where 33 did.
 """
 
 from __future__ import annotations
