@@ -89,3 +89,32 @@ def test_cholmod_without_scikit_sparse_says_how_to_get_it(monkeypatch):
     monkeypatch.setattr(factor, "_cholmod", lambda: None)
     with pytest.raises(InputError, match="scikit-sparse"):
         factorise(plate_stiffness(), "cholmod")
+
+
+def test_the_eigen_solutions_factorise_the_plate_by_band_cholesky_and_solve_like_dense():
+    """The shift-invert Lanczos and the sparse bases take the band Cholesky for a plate in
+    the Kronecker order, and still report a singular stiffness by name."""
+    from splinedeform.errors import SingularSystemError
+    from splinedeform.solvers.modal_basis import stiffness_factorisation
+    from splinedeform.solvers.sparse_eigen import factorise as eigen_factorise
+
+    K = plate_stiffness()
+    F = np.random.default_rng(1).normal(size=(K.shape[0], 4))
+    expected = np.linalg.solve(K.toarray(), F)
+    for made in (eigen_factorise(K), stiffness_factorisation(K)):
+        assert made.method == "banded"
+        # cond(K) ≈ 1e4: 1e-10 relative is 1e2 above cond · eps
+        np.testing.assert_allclose(made.solve(F), expected, rtol=0,
+                                   atol=1e-10 * np.abs(expected).max())
+    singular = sp.csr_matrix(np.diag([1.0, 2.0, 0.0, 3.0]))
+    assert factor.band_cholesky(singular) is None
+    with pytest.raises(SingularSystemError, match="singular"):
+        eigen_factorise(singular)
+    with pytest.raises(SingularSystemError, match="singular"):
+        stiffness_factorisation(singular)
+
+
+def test_band_cholesky_declines_a_band_too_costly_for_its_ordering(monkeypatch):
+    K = plate_stiffness()
+    monkeypatch.setattr(factor, "BAND_FLOPS", K.shape[0] * half_bandwidth(K) ** 2 - 1)
+    assert factor.band_cholesky(K) is None

@@ -100,7 +100,8 @@ def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
         correction, truncation = _truncation(model, basis, spatial, d0, v0, correction)
     if report:
         truncation.update({key: report[key] for key in ("tolerance", "bound", "omitted_static",
-                                                        "static_residual", "met")
+                                                        "static_residual", "met",
+                                                        "correction_degree")
                            if key in report})
     timings = dict(model.timings)
     timings["modal setup"] = time.perf_counter() - start

@@ -45,6 +45,9 @@ METHODS = ("auto", "banded", "superlu", "cholmod")
 
 BAND_BYTES = 128 * 2**20
 """Largest band storage ``8 N (b + 1)`` bytes for which ``"auto"`` takes the band Cholesky."""
+BAND_FLOPS = 1e10
+"""Largest work ``N b²`` of :func:`band_cholesky` (a few seconds): a matrix whose band
+is wide because of its ordering goes to the sparse LU instead (128² cubic: 2.5·10⁹)."""
 
 
 @dataclass(frozen=True)
@@ -105,6 +108,25 @@ def factorise(K: sp.spmatrix, method: str = "auto") -> Factorisation:
         if type(error).__name__ != "CholmodNotPositiveDefiniteError":
             raise
     return _superlu(K)
+
+
+def band_cholesky(K: sp.spmatrix) -> Factorisation | None:
+    """The band Cholesky of ``K`` where its storage ``8 N (b + 1)`` fits :data:`BAND_BYTES`
+    and ``K`` is positive definite; ``None`` otherwise (the caller's own fallback then).
+
+    The first choice of every factorisation of a stiffness in the Kronecker order (the
+    static solve, the shift-invert Lanczos of :mod:`.sparse_eigen`, the sparse bases of
+    :mod:`.modal_basis`): at 64² it factorises in 0.023 s against SuperLU's 0.057 s and
+    solves a vector in 0.43 ms against 0.84 ms in blocks of 8, 1.7 ms alone (CPU, one run,
+    load average 5).
+    """
+    n, b = K.shape[0], half_bandwidth(K)
+    if 8 * n * (b + 1) > BAND_BYTES or n * b * b > BAND_FLOPS:
+        return None
+    try:
+        return _banded(K)
+    except np.linalg.LinAlgError:
+        return None
 
 
 def _banded(K: sp.spmatrix) -> Factorisation:

@@ -36,6 +36,7 @@ from ..errors import InputError, SingularSystemError
 from . import kronecker_eigen
 from .bases import DenseBasis, ModalBasis, SeparableBasis, _zero_small  # noqa: F401 (public here too)
 from .mode_acceleration import StaticCorrection, mode_acceleration  # noqa: F401 (public here too)
+from .factor import band_cholesky
 from .eigen_trust import GUARDS, check_by_residual, refine_doubtful
 from .rigid import check_resolved, count_by_gap
 from .system import KroneckerFactors
@@ -138,12 +139,19 @@ class OrderedFactor:
 
 def stiffness_factorisation(K: sp.spmatrix, shift: float = 0.0, M: sp.spmatrix | None = None,
                             order: NDArray[np.int64] | None = None) -> Any:
-    """Sparse LU of ``K - shift M`` (fill-reducing ordering for symmetric matrices).
+    """A factorisation of ``A = K - shift M`` with ``solve``.
 
     ``order``: a fill-reducing order of the unknowns known to the caller (e.g. a nested
-    dissection of a tensor-product net), used as given without pivoting.
+    dissection of a tensor-product net), used as given without pivoting (the shell's
+    path). Otherwise the band Cholesky (:func:`.factor.band_cholesky`) where the band fits
+    and ``A`` is positive definite, else a sparse LU (minimum-degree ordering of
+    ``Aᵀ + A``, threshold pivoting: a singular ``A`` raises).
     """
     A = K if shift == 0.0 else K - shift * M
+    if order is None:
+        band = band_cholesky(A)
+        if band is not None:
+            return band
     try:
         if order is not None:
             return OrderedFactor(A, order)

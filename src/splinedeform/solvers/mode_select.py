@@ -29,8 +29,12 @@ control-point coordinate, since ``|x_p| ≤ c_∞ ‖x‖_M`` (:func:`pointwise_
 is extended: the LU and every solve so far are kept. An estimate of ``n/2`` modes or more
 made from at least 64 computed ends the search: all modes are cheaper then (a frame a few
 milliseconds after a jump of the bench plate needs them, as its over-damped modes relax
-no faster than ``1/β``). From 16 modes the estimate is not trusted: a uniform load's
-``‖R‖``, flat over the symmetric modes it does not excite, predicted 2 400 where 33 did.
+no faster than ``1/β``) — unless the omitted modes are all over-damped and the transient
+correction (:mod:`.transient_correction`, bound ``Σ_j ‖R_j‖_M E_d``) meets the tolerance
+with fewer modes than the static one: then it is taken (:func:`_transient_count`), and the
+search does not stop before the computed modes reach the over-damped range. From 16
+modes the estimate is not trusted: a uniform load's ``‖R‖``, flat over the symmetric
+modes it does not excite, predicted 2 400 where 33 did.
 """
 
 from __future__ import annotations
@@ -48,6 +52,7 @@ from .modal_basis import DEFAULT_ADVICE
 from .mode_count import decay_bound, error_bound
 from .rigid import check_resolved
 from .sparse_eigen import BlockLanczos
+from .transient_correction import DEGREE, TransientCorrection, fitted, over_damped_from
 
 Array = NDArray[np.float64]
 GRID = 3500
@@ -72,11 +77,31 @@ class ErrorEstimate:
     gamma: float
     beta: float
     weight: float
+    degree: int = 0            # > 0: the transient correction's E_d (.transient_correction)
 
     def relative(self, times: Array) -> Array:
         """The bound at ``times`` (relative, in the measure the basis was chosen in)."""
-        return self.weight * error_bound(self.norms, self.jump_times, self.lam_next,
-                                         self.gamma, self.beta, np.asarray(times, dtype=float))
+        times = np.asarray(times, dtype=float)
+        if not self.degree:
+            return self.weight * error_bound(self.norms, self.jump_times, self.lam_next,
+                                             self.gamma, self.beta, times)
+        return self.weight * transient_bound(self.norms[None, :], self.jump_times,
+                                             self.lam_next, self.gamma, self.beta, times,
+                                             self.degree)[0]
+
+
+def transient_bound(norms: Array, jump_times: Array, lam_next: float, gamma: float,
+                    beta: float, times: Array, degree: int = DEGREE) -> Array:
+    """``Σ_j ‖R_j‖_M E_d(λ_{m+1}, t − t_j) H(t − t_j)`` for rows of ``norms`` (``(r, J)``)
+    at ``times`` → ``(r, T)``: the bound of :class:`.transient_correction.TransientCorrection`."""
+    tau = times[None, :] - np.asarray(jump_times, dtype=float)[:, None]       # (J, T)
+    out = np.zeros((norms.shape[0], times.size))
+    on = tau > 0
+    if np.any(on):
+        E = np.zeros(tau.shape)
+        E[on] = fitted(lam_next, gamma, beta, tau[on], degree)[1]
+        out += norms @ E
+    return out
 
 
 def pointwise_bound(M: sp.spmatrix, T: sp.spmatrix | None = None,
@@ -151,6 +176,45 @@ def _grown(k: int, lam: Array, norms: Array, grid: Array, E: Array, column: Arra
     return int(np.ceil(min(max(grow, 1.25), 4.0) * k)), grow * k
 
 
+def _transient_count(upto: int, lam: Array, norms: Array, jump_times: Array, gamma: float,
+                     beta: float, times: Array, weight: float, tolerance: float
+                     ) -> tuple[int, float] | None:
+    """Fewer modes than ``upto + 1`` whose bound with the transient correction
+    (:func:`transient_bound`) meets ``tolerance`` at ``times``: ``(m, bound)``, or ``None``.
+
+    Only counts whose omitted modes are all over-damped are tried (below, the correction
+    is the static one); ten counts spaced geometrically up to ``upto``, then a bisection
+    between the last that missed and the first that met, to within 1/16 of it. Every count
+    returned has its bound evaluated (the bound need not fall monotonically with ``m``).
+    """
+    first = int(np.searchsorted(lam, over_damped_from(gamma, beta), side="left"))
+    first = max(first, 1)
+    if upto < first:
+        return None
+
+    def bound(m: int) -> float:
+        return float(weight * transient_bound(norms[:, m][None, :], jump_times, float(lam[m]),
+                                              gamma, beta, times)[0].max(initial=0.0))
+
+    low = first - 1
+    for m in np.unique(np.geomspace(first, upto, 10).astype(int)):
+        value = bound(int(m))
+        if value <= tolerance:
+            high, best = int(m), value
+            break
+        low = int(m)
+    else:
+        return None
+    while high - low > max(1, high // 16):
+        mid = (low + high) // 2
+        value = bound(mid)
+        if value <= tolerance:
+            high, best = mid, value
+        else:
+            low = mid
+    return high, best
+
+
 def _m_norm2(M: sp.spmatrix, x: Array) -> float:
     """``Σ_c x_cᵀ M x_c`` for ``x`` of shape ``(n, c)``."""
     return float(max(np.sum(x * (M @ x)), 0.0))
@@ -184,7 +248,9 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
     -------
     basis, correction, report
         A truncated :class:`~.modal_basis.DenseBasis` (its static solve is the LU), the
-        :class:`~.mode_acceleration.StaticCorrection` and a report (``modes``, ``bound``,
+        :class:`~.mode_acceleration.StaticCorrection` (or the
+        :class:`~.transient_correction.TransientCorrection`, ``correction_degree`` > 0 in
+        the report) and a report (``modes``, ``bound``,
         ``tolerance``, ``omitted_static``, ``static_residual``, ``computed``: modes found,
         ``solves``). ``(None, None, report)`` when ``n/2`` modes or more would be needed:
         all modes are cheaper then.
@@ -245,8 +311,11 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
         fits = np.flatnonzero(relative[1:] <= tolerance) + 1
         report.update(computed=k, solves=modes.solves)
         last = (k, modes, lam, coef, norms, relative)
-        if fits.size:
-            m = int(fits[0])
+        weight = factor / max(scale, 1e-300)
+        dynamic = _transient_count(int(fits[0]) - 1 if fits.size else k, lam, norms,
+                                   jump_times, gamma, beta, times, weight, tolerance)
+        if fits.size or dynamic is not None:
+            m, bound_m = dynamic if dynamic is not None else (int(fits[0]), relative[fits[0]])
             parts = statics - np.array([modes.combine(c[:m]) for c in coef])
             jump_parts = np.zeros((J, n, width))
             jump_parts[:, :, active] = parts
@@ -256,16 +325,25 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
                        for p, s in zip(parts, statics)]
             residual = [np.linalg.norm(K @ s - f) / max(np.linalg.norm(f), 1e-300)
                         for s, f in zip(statics, F)]
-            report.update(modes=m, bound=float(relative[m]), scale=float(scale),
+            degree = DEGREE if dynamic is not None else 0
+            report.update(modes=m, bound=float(bound_m), scale=float(scale),
                           omitted_static=float(max(omitted, default=0.0)),
                           static_residual=float(max(residual, default=0.0)),
+                          correction_degree=degree,
                           estimate=ErrorEstimate(jump_times, norms[:, m], float(lam[m]),
-                                                 gamma, beta, factor / max(scale, 1e-300)))
-            return basis, StaticCorrection(jump_times, jump_parts, []), report
+                                                 gamma, beta, weight, degree))
+            if dynamic is not None:
+                correction: Any = TransientCorrection(lu.solve, M, basis.phi, float(lam[m]),
+                                                      gamma, beta, jump_times, jump_parts)
+            else:
+                correction = StaticCorrection(jump_times, jump_parts, [])
+            return basis, correction, report
         grown, needed = _grown(k, lam, norms, grid, E, column, tolerance * scale / factor)
         if k >= 64 and np.isfinite(needed) and needed >= n // 2:
-            break                   # half the modes or more: all of them are cheaper
-        k = grown
+            if lam[k] >= over_damped_from(gamma, beta):
+                break               # half the modes or more: all of them are cheaper
+            grown = max(grown, int(1.5 * k))    # the transient correction applies higher up
+        k = min(grown, n // 2 - 1) if grown < n // 2 or k < n // 2 - 1 else grown
     if best_effort and last is not None:
         m, modes, lam, coef, norms, relative = last       # every mode computed, bound missed
         parts = statics - np.array([modes.combine(c[:m]) for c in coef])
