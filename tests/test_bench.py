@@ -78,13 +78,15 @@ def test_quick_run_errors_are_within_the_target(quick):
     for r in automatic + numerical:
         if r["status"] == "ok":
             assert float(r["error"]) <= target
-    # ratios are against the fastest finished run of the same net (6 significant digits)
+    # ratios are against the fastest finished run of the same net; the CSV holds the ratio and
+    # both times to 6 significant digits, each rounded by up to 5e-6 of itself, so the ratio
+    # recomputed from them may differ by up to 1.5e-5 of itself (2e-5 allowed)
     for r in rows:
         line = [x for x in rows if (x["family"], x["cells"]) == (r["family"], r["cells"])
                 and x["status"] in ("ok", "exact")]
         best = min(float(x["seconds"]) for x in line)
         if r["status"] in ("ok", "exact"):
-            assert math.isclose(float(r["ratio"]), float(r["seconds"]) / best, rel_tol=1e-5)
+            assert math.isclose(float(r["ratio"]), float(r["seconds"]) / best, rel_tol=2e-5)
 
 
 def test_free_counts_match_the_families(quick):
