@@ -5,22 +5,11 @@ control net P + T Φ_net q of the modal state sent, computed here in float64."""
 from __future__ import annotations
 
 import io
-import warnings
-
 import numpy as np
 import pytest
 
-pytest.importorskip("starlette", reason="the sculpt server needs the extra 'sculpt'")
-pytest.importorskip("httpx", reason="starlette's TestClient needs httpx")
-with warnings.catch_warnings():
-    warnings.simplefilter("ignore")
-    from starlette.testclient import TestClient  # noqa: E402
-
+from sculpt_client import serve_sheet  # noqa: E402 (skips without the extra)
 import splinedeform as sd  # noqa: E402
-from splinedeform.scenario import parse_scenario  # noqa: E402
-from splinedeform.sculpt.guard import TOKEN_HEADER, Guard  # noqa: E402
-from splinedeform.sculpt.server import create_app  # noqa: E402
-from splinedeform.sculpt.session import Session  # noqa: E402
 
 pytestmark = pytest.mark.filterwarnings("ignore:Using `httpx`")
 SHEET = """
@@ -37,17 +26,11 @@ u0 = "clamped"
 [solve]
 kind = "modes"
 """
-ORIGIN = "http://127.0.0.1:8765"
 
 
 @pytest.fixture()
 def served(tmp_path):
-    session = Session(parse_scenario(SHEET, source="sheet.toml", directory=tmp_path),
-                      resolution=6, modes=None, save_path=tmp_path / "saved.toml")
-    app = create_app(session, Guard.for_address("127.0.0.1", 8765, "t"))
-    client = TestClient(app, base_url=ORIGIN, raise_server_exceptions=False,
-                        headers={"Origin": ORIGIN, TOKEN_HEADER: "t"})
-    return client, session
+    return serve_sheet(tmp_path, SHEET, resolution=6)
 
 
 def _shape(session):
