@@ -88,3 +88,17 @@ def grab_and_pull(page, index: int, dy: float, steps: int = 6) -> int:
         page.mouse.move(at["x"], at["y"] + dy * step / steps)
         page.wait_for_timeout(40)
     return grabbed["index"]
+
+
+@contextmanager
+def sheet_page(browser: object, folder: Path, scenario: str, resolution: int) -> Iterator[object]:
+    """The sculpting page of ``scenario`` (served from ``folder`` at ``resolution``, saving to
+    ``saved.toml``), closed on leaving."""
+    with sculpt_server(folder, "sheet.toml", scenario, "--resolution", str(resolution),
+                       "--save", "saved.toml") as url:
+        page = sculpt_page(browser, url)
+        try:
+            yield page
+        finally:
+            page.close()
+

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 # skips this module, saying why, without Chromium or Playwright
-from chromium import grab_and_pull, sculpt_page, sculpt_server  # noqa: E402
+from chromium import grab_and_pull, sheet_page  # noqa: E402
 
 SHEET = """
 title = "bake sheet"
@@ -35,12 +35,8 @@ R = 9
 
 @pytest.fixture(scope="module")
 def page(tmp_path_factory, browser):
-    folder = tmp_path_factory.mktemp("bake")
-    with sculpt_server(folder, "sheet.toml", SHEET, "--resolution", str(R),
-                       "--save", "saved.toml") as url:
-        page = sculpt_page(browser, url)
+    with sheet_page(browser, tmp_path_factory.mktemp("bake"), SHEET, R) as page:
         yield page
-        page.close()
 
 
 def _shape(page) -> tuple[np.ndarray, np.ndarray]:

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 # skips this module, saying why, without Chromium or Playwright
-from chromium import sculpt_page, sculpt_server  # noqa: E402
+from chromium import sheet_page  # noqa: E402
 
 SHEET = """
 title = "pin sheet"
@@ -32,12 +32,8 @@ R = 11
 
 @pytest.fixture(scope="module")
 def page(tmp_path_factory, browser):
-    folder = tmp_path_factory.mktemp("pin")
-    with sculpt_server(folder, "sheet.toml", SHEET, "--resolution", str(R),
-                       "--save", "saved.toml") as url:
-        page = sculpt_page(browser, url)
+    with sheet_page(browser, tmp_path_factory.mktemp("pin"), SHEET, R) as page:
         yield page
-        page.close()
 
 
 def test_a_pinned_point_stays_where_it_was_while_another_is_pulled(page):
