@@ -105,13 +105,11 @@ def _surface_from_cad(scenario: Scenario) -> tuple[Any, str | None]:
     """Surface ``face`` of a CAD file, as a deformable NURBS surface (trimming dropped),
     and its unit: ``surface.units`` if given, else the file's."""
     from ..cad import read_cad, surface_from_patch
-    from ..input_files import open_input
 
     path = scenario.surface.path
     assert path is not None
     face = scenario.surface.parameters["face"]
     with _located(scenario, "surface.path"):
-        open_input(path, "CAD file").close()     # a regular file, not a pipe or device
         patch = read_cad(path, face)
         surface = surface_from_patch(patch, name=f"{path.stem} face {face}",
                                      source=f"{path} face {face}")
