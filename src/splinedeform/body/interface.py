@@ -1,0 +1,47 @@
+"""An interface: where an edge of one patch meets an edge of another (or of itself).
+
+Edges are named as everywhere in the package: ``u0`` is the edge ``u = u_min`` (it runs
+along v), ``u1`` is ``u = u_max``, ``v0`` is ``v = v_min`` (it runs along u), ``v1`` is
+``v = v_max``.  Along the shared curve, edge ``a`` at its parameter ``s`` meets edge ``b`` at
+``s`` (``reversed = False``) or at the opposite end's ``s`` (``reversed = True``), both edges'
+parameters taken in increasing order.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+EDGES = ("u0", "u1", "v0", "v1")
+
+
+@dataclass(frozen=True)
+class Interface:
+    """Edge ``edge_a`` of patch ``a`` meets edge ``edge_b`` of patch ``b``.
+
+    Attributes
+    ----------
+    a, b : int
+        Patch indices in the body (``a == b`` for a seam of a closed patch).
+    edge_a, edge_b : str
+        ``"u0" | "u1" | "v0" | "v1"``.
+    reversed : bool
+        Whether ``b``'s edge parameter runs opposite to ``a``'s along the curve.
+    conforming : bool
+        Whether both edges have the same degree and knots (after aligning the parameters
+        and, if reversed, mirroring them), so that their control points can be merged.
+    """
+
+    a: int
+    edge_a: str
+    b: int
+    edge_b: str
+    reversed: bool = False
+    conforming: bool = True
+
+    def __post_init__(self) -> None:
+        for edge in (self.edge_a, self.edge_b):
+            if edge not in EDGES:
+                raise ValueError(f"an edge is one of {EDGES}, got {edge!r}")
+        if self.a == self.b and self.edge_a == self.edge_b:
+            raise ValueError(f"an interface joins two different edges, got {self.edge_a} twice "
+                             f"on patch {self.a}")
