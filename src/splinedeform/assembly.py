@@ -19,7 +19,12 @@ from typing import Any, Sequence
 import numpy as np
 import scipy.sparse as sp
 
+from .errors import InputError
+from .knots import c0_refusal
 from .material import Material
+from .physics import intrinsic
+from .quadrature import gram_matrix
+from .surface import Surface
 
 
 def stiffness_terms(gram_u: Sequence[sp.spmatrix], gram_v: Sequence[sp.spmatrix],
@@ -133,6 +138,44 @@ def kronecker_sums(sums: Sequence[Sequence[tuple[float, sp.spmatrix, sp.spmatrix
         matrix.has_sorted_indices = True
         out.append(matrix)
     return out
+
+
+def check_bending(surface: Surface, material: Material) -> None:
+    """Refuse bending weights that a patch's bases cannot carry.
+
+    ``w20`` (``w02``) needs degree ``>= 2`` in ``u`` (``v``) and a ``C^1`` basis there: at a
+    ``C^0`` knot line the surface may kink and ``d_uu`` is not square integrable.
+    """
+    for name, basis, weight in (("u", surface.basis_u, material.w20),
+                                ("v", surface.basis_v, material.w02)):
+        if weight and basis.degree < 2:
+            raise InputError(f"bending weight w{'20' if name == 'u' else '02'} needs degree "
+                             f">= 2 in {name} (second derivatives), got {basis.degree}")
+        if weight and getattr(basis, "continuity", basis.degree - 1) < 1:
+            key = f"w{'20' if name == 'u' else '02'}"
+            error = InputError(c0_refusal(basis, name, f"bending weight {key}")
+                               + "; or use tension weights only (w10, w01)")
+            error.key = f"material.{key}"  # type: ignore[attr-defined]
+            raise error
+
+
+def patch_matrices(surface: Surface, material: Material, physics: str, lumped: bool
+                   ) -> tuple[list[sp.csr_matrix], list[sp.csr_matrix], sp.csr_matrix,
+                              sp.csr_matrix]:
+    """One patch's 1-D Gram matrices and full ``(K, M)`` (``n_u n_v`` square).
+
+    ``parametric``: ``K = Σ w G_a^u ⊗ G_b^v``, ``M = μ G_0^u ⊗ G_0^v`` (module docstring);
+    ``intrinsic``: :func:`splinedeform.physics.intrinsic.matrices`. ``lumped`` replaces
+    ``M`` by its row sums on the diagonal. Returns ``(gram_u, gram_v, K, M)``.
+    """
+    top = lambda b: min(2, b.degree)  # noqa: E731
+    gram_u = [gram_matrix(surface.basis_u, a) for a in range(top(surface.basis_u) + 1)]
+    gram_v = [gram_matrix(surface.basis_v, a) for a in range(top(surface.basis_v) + 1)]
+    if physics == "intrinsic":
+        K, M = intrinsic.matrices(surface, material, lumped)
+    else:
+        K, M = full_matrices(gram_u, gram_v, material, lumped)
+    return gram_u, gram_v, K, M
 
 
 def _table(pattern: sp.spmatrix, entries: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

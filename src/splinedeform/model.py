@@ -21,15 +21,13 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
-from .assembly import (_largest, full_matrices, mass, reduced_matrices,  # noqa: F401
-                       stiffness)
+from .assembly import (_largest, check_bending, full_matrices, mass,  # noqa: F401
+                       patch_matrices, reduced_matrices, stiffness)
 from .boundary import Constraints, build_constraints
 from .errors import InputError, SingularSystemError
-from .knots import c0_refusal
 from .loads import Load, as_load, static_time
 from .material import Material, check_scales
-from .physics import PHYSICS, intrinsic
-from .quadrature import gram_matrix
+from .physics import PHYSICS
 from . import modal_solve
 from .modal_solve import check_count as _check_count
 from .solution import ModalSolution, Readout, SampledSolution, StaticSolution
@@ -101,17 +99,7 @@ class Model:
                              "density), boundary)")
         if physics not in PHYSICS:
             raise InputError(f"physics must be one of {PHYSICS}, got {physics!r}")
-        for name, basis, weight in (("u", surface.basis_u, material.w20),
-                                    ("v", surface.basis_v, material.w02)):
-            if weight and basis.degree < 2:
-                raise InputError(f"bending weight w{'20' if name == 'u' else '02'} needs degree "
-                                 f">= 2 in {name} (second derivatives), got {basis.degree}")
-            if weight and getattr(basis, "continuity", basis.degree - 1) < 1:
-                key = f"w{'20' if name == 'u' else '02'}"
-                error = InputError(c0_refusal(basis, name, f"bending weight {key}")
-                                   + "; or use tension weights only (w10, w01)")
-                error.key = f"material.{key}"  # type: ignore[attr-defined]
-                raise error
+        check_bending(surface, material)
         self.surface = surface
         self.material = material
         self.mass_matrix = mass_matrix
@@ -129,13 +117,8 @@ class Model:
                 "(surface.cells; a CAD or control net surface: insert knots with surface.refine)")
             error.key = "boundary"  # type: ignore[attr-defined]
             raise error
-        top = lambda b: min(2, b.degree)  # noqa: E731
-        self.gram_u = [gram_matrix(surface.basis_u, a) for a in range(top(surface.basis_u) + 1)]
-        self.gram_v = [gram_matrix(surface.basis_v, a) for a in range(top(surface.basis_v) + 1)]
-        if physics == "intrinsic":
-            K, M = intrinsic.matrices(surface, material, mass_matrix == "lumped")
-        else:
-            K, M = full_matrices(self.gram_u, self.gram_v, material, mass_matrix == "lumped")
+        self.gram_u, self.gram_v, K, M = patch_matrices(surface, material, physics,
+                                                        mass_matrix == "lumped")
         T = self.constraints.T
         self.K_full, self.M_full = K, M
         reduced = None if physics == "intrinsic" else reduced_matrices(
