@@ -8,6 +8,7 @@
 
 from . import loads
 from .basis import BSplineBasis
+from .body import Body, BodyModel, find_interfaces
 from .knots import KnotVectorBasis, RationalBasis
 from .errors import InputError, ScenarioError, SingularSystemError
 from .loads import Constant, Function, Harmonic, Piecewise, Point, Pressure, Step, Uniform
@@ -34,7 +35,7 @@ def __getattr__(name: str) -> object:
         return sweep
     raise AttributeError(f"module 'splinedeform' has no attribute {name!r}")
 
-__all__ = ["AreaForce", "ShellMaterial", "ShellModel", "BSplineBasis", "KnotVectorBasis", "RationalBasis", "Constant", "Energy", "Function", "Harmonic", "InputError",
+__all__ = ["AreaForce", "Body", "BodyModel", "find_interfaces", "ShellMaterial", "ShellModel", "BSplineBasis", "KnotVectorBasis", "RationalBasis", "Constant", "Energy", "Function", "Harmonic", "InputError",
            "Material", "Model", "Piecewise", "Point", "Pressure", "ScenarioError",
            "SingularSystemError", "Solution", "StaticSolution", "Step", "Surface", "Uniform", "sweep",
            "loads", "shapes", "__version__"]

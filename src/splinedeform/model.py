@@ -47,6 +47,23 @@ STATIC_TRUST = 1e-6
 STEP_METHODS = ("newmark", "radau3", "radau5", "radau7", "genalpha")   # take a step dt
 
 
+def check_options(material: Material, mass_matrix: str, rest: str, physics: str) -> None:
+    """Refuse a material that is not one, and unknown mass, rest or physics options."""
+    if not isinstance(material, Material):
+        raise InputError(f"material must be a splinedeform.Material, got "
+                         f"{type(material).__name__}")
+    if mass_matrix not in ("consistent", "lumped"):
+        raise InputError(f"mass_matrix must be 'consistent' or 'lumped', got {mass_matrix!r}")
+    if rest not in ("initial", "none"):
+        raise InputError(f"rest must be 'initial' or 'none', got {rest!r}")
+    if physics == "shell":
+        raise InputError("physics 'shell' couples x, y and z and has its own material: use "
+                         "splinedeform.ShellModel(surface, ShellMaterial(E, nu, thickness, "
+                         "density), boundary)")
+    if physics not in PHYSICS:
+        raise InputError(f"physics must be one of {PHYSICS}, got {physics!r}")
+
+
 class Model:
     """A B-spline surface with a material and boundary conditions.
 
@@ -86,19 +103,7 @@ class Model:
         start = time.perf_counter()
         if not isinstance(surface, Surface):
             raise InputError(f"surface must be a splinedeform.Surface, got {type(surface).__name__}")
-        if not isinstance(material, Material):
-            raise InputError(f"material must be a splinedeform.Material, got "
-                             f"{type(material).__name__}")
-        if mass_matrix not in ("consistent", "lumped"):
-            raise InputError(f"mass_matrix must be 'consistent' or 'lumped', got {mass_matrix!r}")
-        if rest not in ("initial", "none"):
-            raise InputError(f"rest must be 'initial' or 'none', got {rest!r}")
-        if physics == "shell":
-            raise InputError("physics 'shell' couples x, y and z and has its own material: use "
-                             "splinedeform.ShellModel(surface, ShellMaterial(E, nu, thickness, "
-                             "density), boundary)")
-        if physics not in PHYSICS:
-            raise InputError(f"physics must be one of {PHYSICS}, got {physics!r}")
+        check_options(material, mass_matrix, rest, physics)
         check_bending(surface, material)
         self.surface = surface
         self.material = material
@@ -124,6 +129,11 @@ class Model:
         reduced = None if physics == "intrinsic" else reduced_matrices(
             self.gram_u, self.gram_v, material, mass_matrix == "lumped", M, self.constraints)
         self._K, self._M = reduced or ((T.T @ K @ T).tocsc(), (T.T @ M @ T).tocsc())
+        self._finish(start)
+
+    def _finish(self, start: float) -> None:
+        """Damping ``C_r = (γ/μ) M_r + β K_r``, the checks of scale and the caches."""
+        material = self.material
         if self._M.nnz:
             check_scales(material, _largest(self._K), _largest(self._M))
         self._C = ((material.damping / material.mass) * self._M
@@ -167,8 +177,12 @@ class Model:
 
     def _reduce_force(self, F_full: Array) -> Array:
         if self.rest == "none":
-            F_full = F_full - self.K_full @ self.surface.control_points.reshape(-1, 3)
+            F_full = F_full - self.K_full @ self._rest_net()
         return np.asarray(self.constraints.T.T @ F_full)
+
+    def _rest_net(self) -> Array:
+        """The rest control points ``p0`` as rows ``(n_points, 3)`` of ``T``'s layout."""
+        return self.surface.control_points.reshape(-1, 3)
 
     # -- static ----------------------------------------------------------------------
     @owned
@@ -293,18 +307,22 @@ class Model:
     def _to_free(self, net: ArrayLike | None, what: str) -> Array:
         if net is None:
             return np.zeros((self.n_free, 3))
-        arr = np.asarray(net, dtype=float)
-        if arr.shape != self.surface.shape + (3,):
-            raise InputError(f"{what} must have shape (n_u, n_v, 3) = "
-                             f"{self.surface.shape + (3,)}, got {arr.shape}")
-        if not np.all(np.isfinite(arr)):
+        flat = self._flatten_net(net, what)
+        if not np.all(np.isfinite(flat)):
             raise InputError(f"{what} must be finite")
         T = self.constraints.T
-        flat = arr.reshape(-1, 3)
         free = spla.spsolve((T.T @ T).tocsc(), T.T @ flat).reshape(-1, 3)
         if np.linalg.norm(T @ free - flat) > 1e-9 * max(np.linalg.norm(flat), 1e-300):
             raise InputError(f"{what} moves control points that the boundary conditions fix")
         return free
+
+    def _flatten_net(self, net: ArrayLike, what: str) -> Array:
+        """A net ``(n_u, n_v, 3)`` as rows ``(n_points, 3)``; the shape checked."""
+        arr = np.asarray(net, dtype=float)
+        if arr.shape != self.surface.shape + (3,):
+            raise InputError(f"{what} must have shape (n_u, n_v, 3) = "
+                             f"{self.surface.shape + (3,)}, got {arr.shape}")
+        return arr.reshape(-1, 3)
 
     @owned
     def dynamic(self, load: Load | None, t_end: float, method: str = "analytic",

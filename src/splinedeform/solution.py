@@ -18,6 +18,7 @@ import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
 from .errors import InputError
+from .readout import BodyReadout, Readout  # noqa: F401 (Readout: public here)
 from .solvers.bases import DenseBasis, ModalBasis
 from .surface import Surface
 from .threads import owned
@@ -47,37 +48,15 @@ class Frames:
     ----------
     times : ndarray (F,)
     control_points : ndarray (F, n_u, n_v, 3)
+        (a body's: a list of them, one per patch)
     points : ndarray (F, r_u, r_v, 3) or None
-        Surface samples on the parameter grid, when a resolution was asked for.
+        Surface samples on the parameter grid, when a resolution was asked for (a body's:
+        a list, one per patch).
     """
 
     times: Array
-    control_points: Array
-    points: Array | None
-
-
-@dataclass(frozen=True)
-class Readout:
-    """What a solution needs to read its free coordinates out as a surface.
-
-    Attributes
-    ----------
-    surface : Surface
-        The rest surface (control points ``p_rest``, bases for evaluation).
-    T : sparse ``(n_u n_v, n_free)``
-        The constraint map ``d = T d_free``.
-    M, K : sparse ``(n_free, n_free)``
-        Reduced mass and stiffness, for the energies.
-    """
-
-    surface: Surface
-    T: sp.spmatrix
-    M: sp.spmatrix
-    K: sp.spmatrix
-
-    def matrices(self) -> tuple[sp.spmatrix, sp.spmatrix]:
-        """``(M, K)``."""
-        return self.M, self.K
+    control_points: Any
+    points: Any
 
 
 def _check_times(t: ArrayLike, t_end: float | None = None) -> tuple[Array, bool]:
@@ -93,24 +72,37 @@ def _check_times(t: ArrayLike, t_end: float | None = None) -> tuple[Array, bool]
     return np.atleast_1d(arr), arr.ndim == 0
 
 
+def _deformed(readout: Any, nets: Any, name: str) -> Any:
+    """The deformed surface of ``nets`` (a body's: a list of its deformed patches)."""
+    if isinstance(readout, BodyReadout):
+        return readout.deformed(nets, name)
+    return readout.surface.with_control_points(nets, name=name)
+
+
+def _patch(readout: Any, nets: Any, patch: int | None) -> tuple[Surface, Array]:
+    """The rest surface and nets of ``patch`` (a single surface: ``None`` or 0)."""
+    if isinstance(readout, BodyReadout):
+        return readout.patch(nets, patch)
+    if patch not in (None, 0):
+        raise InputError(f"a single surface has no patch {patch!r}")
+    return readout.surface, nets
+
+
 class _Displaced:
     """Shared read-out of a state in free coordinates."""
 
-    readout: Readout
+    readout: Readout | BodyReadout
 
     @property
-    def rest(self) -> Surface:
-        """The rest surface the displacements are added to."""
-        return self.readout.surface
+    def rest(self) -> Any:
+        """The rest surface the displacements are added to (a body's: its patches)."""
+        surfaces = getattr(self.readout, "surfaces", None)
+        return self.readout.surface if surfaces is None else surfaces
 
-    def _full(self, d_free: Array) -> Array:
-        """``p_rest + T d_free`` for ``d_free`` of shape ``(..., n_free, 3)`` → ``(..., n_u, n_v, 3)``."""
-        m = self.readout
-        T = m.T
-        lead = d_free.shape[:-2]
-        flat = np.moveaxis(d_free, -2, 0).reshape(T.shape[1], -1)
-        full = np.moveaxis((T @ flat).reshape((T.shape[0],) + lead + (3,)), 0, -2)
-        return m.surface.control_points + full.reshape(lead + m.surface.shape + (3,))
+    def _full(self, d_free: Array, rest: bool = True) -> Any:
+        """``[p_rest +] T d_free`` for ``d_free`` of shape ``(..., n_free, 3)`` →
+        ``(..., n_u, n_v, 3)`` (a body's: a list of them, one per patch)."""
+        return self.readout.nets(d_free, rest)
 
 
 class StaticSolution(_Displaced):
@@ -128,15 +120,16 @@ class StaticSolution(_Displaced):
         """Deformed control net ``(n_u, n_v, 3)``."""
         return self._full(self.d_free)
 
-    def surface(self) -> Surface:
-        """The deformed surface."""
-        return self.rest.with_control_points(self.control_points(), name="static")
+    def surface(self) -> Any:
+        """The deformed surface (a body's: a list of its deformed patches)."""
+        return _deformed(self.readout, self.control_points(), "static")
 
     @owned
-    def displacement(self, u: ArrayLike, v: ArrayLike) -> Array:
-        """Displacement ``d(u, v)`` of surface points, shape ``S + (3,)``."""
-        net = self.control_points() - self.rest.control_points
-        return self.rest.derivative(u, v, control_points=net)
+    def displacement(self, u: ArrayLike, v: ArrayLike, patch: int | None = None) -> Array:
+        """Displacement ``d(u, v)`` of surface points, shape ``S + (3,)`` (of ``patch`` for
+        a body)."""
+        rest, net = _patch(self.readout, self._full(self.d_free, rest=False), patch)
+        return rest.derivative(u, v, control_points=net)
 
     @owned
     def energy(self) -> Energy:
@@ -178,27 +171,29 @@ class Solution(_Displaced):
         """Control net at ``t``: ``(n_u, n_v, 3)`` for a number, ``(F, n_u, n_v, 3)`` for an array."""
         times, scalar = _check_times(t)
         nets = self._full(self.state(times)[0])
-        return nets[0] if scalar else nets
+        return _first(nets) if scalar else nets
 
     @owned
     def velocities(self, t: ArrayLike) -> Array:
         """Control point velocities, same shapes as :meth:`control_points`."""
         times, scalar = _check_times(t)
-        vel = self._full(self.state(times)[1]) - self.rest.control_points
-        return vel[0] if scalar else vel
+        vel = self._full(self.state(times)[1], rest=False)
+        return _first(vel) if scalar else vel
 
-    def surface(self, t: float) -> Surface:
-        """The deformed surface at time ``t``."""
-        return self.rest.with_control_points(self.control_points(float(t)),
-                                                      name=f"t={float(t):g}")
+    def surface(self, t: float) -> Any:
+        """The deformed surface at time ``t`` (a body's: a list of its deformed patches)."""
+        return _deformed(self.readout, self.control_points(float(t)), f"t={float(t):g}")
 
     @owned
-    def displacement(self, t: ArrayLike, u: ArrayLike, v: ArrayLike) -> Array:
-        """Displacement of surface points: ``S + (3,)`` for scalar ``t``, ``(F,) + S + (3,)`` else."""
+    def displacement(self, t: ArrayLike, u: ArrayLike, v: ArrayLike,
+                     patch: int | None = None) -> Array:
+        """Displacement of surface points: ``S + (3,)`` for scalar ``t``, ``(F,) + S + (3,)``
+        else (of ``patch`` for a body)."""
         times, scalar = _check_times(t)
-        nets = self.control_points(times) - self.rest.control_points
+        rest, nets = _patch(self.readout, self.control_points(times), patch)
+        nets = nets - rest.control_points
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
-        E = self.rest.evaluation_matrix(u, v)
+        E = rest.evaluation_matrix(u, v)
         flat = np.moveaxis(nets.reshape(times.size, -1, 3), 0, 1).reshape(E.shape[1], -1)
         out = np.moveaxis((E @ flat).reshape(E.shape[0], times.size, 3), 1, 0)
         out = out.reshape((times.size,) + u.shape + (3,))
@@ -218,16 +213,24 @@ class Solution(_Displaced):
         nets = self.control_points(times_arr)
         if resolution is None:
             return Frames(times_arr, nets, None)
-        surf = self.rest
-        cache = self._grid_matrices
         key = resolution if np.isscalar(resolution) else tuple(resolution)
-        if key not in cache:
-            u, v = surf.sample_parameters(resolution)
-            cache[key] = (surf.evaluation_matrix(u[:, None], v[None, :]), u.size, v.size)
-        E, ru, rv = cache[key]
-        flat = np.moveaxis(nets.reshape(times_arr.size, -1, 3), 0, 1).reshape(E.shape[1], -1)
-        points = np.moveaxis(np.asarray(E @ flat).reshape(ru, rv, times_arr.size, 3), 2, 0)
+        if isinstance(nets, list):          # a body: each patch on its own grid
+            points = [self._sampled(surf, net, key, i)
+                      for i, (surf, net) in enumerate(zip(self.rest, nets))]
+        else:
+            points = self._sampled(self.rest, nets, key, 0)
         return Frames(times_arr, nets, points)
+
+    def _sampled(self, surf: Surface, nets: Array, key: Any, index: int) -> Array:
+        """Samples ``(F, r_u, r_v, 3)`` of the nets ``(F, n_u, n_v, 3)`` of one surface."""
+        cache = self._grid_matrices
+        if (key, index) not in cache:
+            u, v = surf.sample_parameters(key)
+            cache[key, index] = (surf.evaluation_matrix(u[:, None], v[None, :]), u.size, v.size)
+        E, ru, rv = cache[key, index]
+        count = nets.shape[0]
+        flat = np.moveaxis(nets.reshape(count, -1, 3), 0, 1).reshape(E.shape[1], -1)
+        return np.moveaxis(np.asarray(E @ flat).reshape(ru, rv, count, 3), 2, 0)
 
     @owned
     def energy(self, t: ArrayLike) -> Energy:
@@ -241,6 +244,11 @@ class Solution(_Displaced):
         if scalar:
             return Energy(kinetic[0], strain[0], work[0])
         return Energy(kinetic, strain, work)
+
+
+def _first(nets: Any) -> Any:
+    """The first frame of nets ``(F, ...)`` (of each patch's for a body)."""
+    return [n[0] for n in nets] if isinstance(nets, list) else nets[0]
 
 
 def _quadratic(A: sp.spmatrix, x: Array) -> Array:
@@ -336,7 +344,7 @@ class ModalSolution(Solution):
         """Control net at ``t``: ``(n_u, n_v, 3)`` for a number, ``(F, n_u, n_v, 3)`` for an array."""
         times, scalar = _check_times(t)
         nets = self._full(self._displacements(times, False)[0])
-        return nets[0] if scalar else nets
+        return _first(nets) if scalar else nets
 
     def modal(self, t: ArrayLike) -> tuple[Array, Array]:
         """Modal coordinates ``Q(t), Q'(t)``, each ``(F, N, 3)``."""

@@ -28,7 +28,7 @@ class ReducedForcing:
         self.reduction = reduction
         self.terms = load.terms()
         self._fixed = [None if term.time_dependent_field
-                       else self.reduction.reduce(term.field_vector(self.reduction.surface))
+                       else self.reduction.reduce(self.reduction.field(term))
                        for term in self.terms]
         rest = self.reduction.rest_force
         self._rest = None if rest is None else np.array(rest, dtype=float)
@@ -38,7 +38,7 @@ class ReducedForcing:
         fixed = self._fixed[i]
         if fixed is not None:
             return fixed
-        return self.reduction.reduce(self.terms[i].field_vector(self.reduction.surface, t))
+        return self.reduction.reduce(self.reduction.field(self.terms[i], t))
 
     def __call__(self, t: float) -> Array:
         out = np.zeros((self.reduction.n_free, 3)) if self._rest is None else self._rest.copy()

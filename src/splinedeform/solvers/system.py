@@ -91,6 +91,10 @@ class Reduction:
         """Number of free coordinates."""
         return int(self.T.shape[1])
 
+    def field(self, term: Any, t: float = 0.0) -> Array:
+        """Spatial vector ``F`` of one load term on the net, ``(n_points, 3)``."""
+        return term.field_vector(self.surface, t)
+
     def reduce(self, F_full: Array) -> Array:
         """``Tᵀ F`` for a full force array ``(n_points, c)``."""
         return np.asarray(self.T.T @ F_full)

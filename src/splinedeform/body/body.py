@@ -1,0 +1,209 @@
+"""A body: patches and the interfaces between their edges.
+
+``Body(patches)`` finds its interfaces geometrically (:mod:`.topology`) unless they are
+given (e.g. from a CAD file's topology); poles and boundary edges are always found from the
+geometry. :meth:`Body.conforming` makes interfaces whose two sides have the same degree but
+different knots conform by exact knot insertion (Boehm's algorithm, :mod:`splinedeform.refine`):
+on each side the knots of the other side that it lacks (normalised to ``[0, 1]``, mirrored
+when reversed, with the larger multiplicity) are inserted, and since inserting knots into a
+direction changes every edge along it, this is repeated until nothing is left to insert.
+The geometry does not move (``P' = T (a P) / a'`` in homogeneous coordinates).
+"""
+
+from __future__ import annotations
+
+from typing import Iterator, Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..basis import BSplineBasis
+from ..errors import InputError
+from ..knots import KnotVectorBasis, RationalBasis
+from ..refine import boehm_insert
+from ..surface import Surface
+from .interface import Interface
+from .topology import (KNOT_TOLERANCE, Topology, body_size, edge_basis, edges_of,
+                       find_topology)
+
+Array = NDArray[np.float64]
+MAX_PASSES = 16
+"""Most rounds of knot insertion :meth:`Body.conforming` makes."""
+
+
+class Body:
+    """Patches deformed as one connected surface.
+
+    Parameters
+    ----------
+    patches : list of Surface
+    interfaces : list of Interface, optional
+        Where edges meet; found geometrically (:func:`~.topology.find_topology`) if not given.
+    tol : float, optional
+        Matching distance (default ``1e-6 ×`` the bounding-box diagonal).
+
+    Examples
+    --------
+    >>> import splinedeform as sd
+    >>> left = sd.shapes.plane(size=(0.5, 1.0), cells=(2, 2))
+    >>> right = left.with_control_points(left.control_points + [0.5, 0, 0])
+    >>> body = sd.Body([left, right])
+    >>> body.summary()["shared"], body.summary()["boundary"]
+    (1, 6)
+    """
+
+    def __init__(self, patches: Sequence[Surface], interfaces: Sequence[Interface] | None = None,
+                 tol: float | None = None):
+        self.patches: tuple[Surface, ...] = tuple(patches)
+        found = find_topology(self.patches, tol)
+        if interfaces is None:
+            self.topology = found
+        else:
+            self.topology = _given(self.patches, list(interfaces), found)
+        self.interfaces: tuple[Interface, ...] = self.topology.interfaces
+
+    @classmethod
+    def from_surfaces(cls, surfaces: Sequence[Surface], tol: float | None = None) -> Body:
+        """A body of ``surfaces`` with its interfaces found geometrically."""
+        return cls(surfaces, None, tol)
+
+    def __len__(self) -> int:
+        return len(self.patches)
+
+    def __iter__(self) -> Iterator[Surface]:
+        return iter(self.patches)
+
+    def __getitem__(self, index: int) -> Surface:
+        return self.patches[index]
+
+    def __repr__(self) -> str:
+        counts = ", ".join(f"{k}={v}" for k, v in self.summary().items())
+        return f"Body({len(self.patches)} patches, {counts})"
+
+    def summary(self) -> dict[str, int]:
+        """Counts of shared edges, seams, boundary edges, non-manifold edges, poles and
+        non-conforming interfaces (:meth:`~.topology.Topology.summary`)."""
+        return self.topology.summary()
+
+    def evaluate(self, patch: int, u: ArrayLike, v: ArrayLike) -> Array:
+        """Points ``x(u, v)`` of patch ``patch`` (:meth:`Surface.evaluate`)."""
+        return self.patches[self._index(patch)].evaluate(u, v)
+
+    def _index(self, patch: int) -> int:
+        if not isinstance(patch, (int, np.integer)) or not 0 <= patch < len(self.patches):
+            raise InputError(f"patch must be an index in [0, {len(self.patches) - 1}], "
+                             f"got {patch!r}")
+        return int(patch)
+
+    def bounding_box(self) -> tuple[Array, Array]:
+        """``(lower, upper)`` corners of the patches sampled on ``17 × 17`` grids."""
+        return body_size(self.patches)
+
+    def conforming(self) -> Body:
+        """The same body with every interface of equal degrees made conforming by exact knot
+        insertion (module docstring); interfaces of different degrees stay as they are."""
+        patches = list(self.patches)
+        for _ in range(MAX_PASSES):
+            topology = find_topology(patches, self.topology.tol)
+            wanted: dict[tuple[int, str], list[list[float]]] = {}
+            for interface, aligned in zip(topology.interfaces, topology.aligned):
+                if interface.conforming or not aligned:
+                    continue
+                sides = ((interface.a, interface.edge_a, interface.b, interface.edge_b),
+                         (interface.b, interface.edge_b, interface.a, interface.edge_a))
+                for p, e, q, f in sides:
+                    missing = _missing(edge_basis(patches[p], e), edge_basis(patches[q], f),
+                                       interface.reversed)
+                    direction = "v" if e[0] == "u" else "u"
+                    if missing:
+                        wanted.setdefault((p, direction), []).append(missing)
+            if not wanted:
+                return Body(patches, None, self.topology.tol)
+            for (p, direction), values in wanted.items():
+                patches[p] = insert_knots_at(patches[p], direction, _distinct(values))
+        raise InputError(f"knot insertion did not make the interfaces conform in {MAX_PASSES} "
+                         "rounds; refine the patches to common knots")
+
+
+def _given(patches: tuple[Surface, ...], interfaces: list[Interface], found: Topology
+           ) -> Topology:
+    """A topology with the given interfaces; poles and boundary edges from the geometry."""
+    for i in interfaces:
+        if not isinstance(i, Interface):
+            raise InputError(f"interfaces must be splinedeform.body.Interface records, got "
+                             f"{type(i).__name__}")
+        for p, e in ((i.a, i.edge_a), (i.b, i.edge_b)):
+            if not 0 <= p < len(patches) or e not in edges_of(patches[p]):
+                raise InputError(f"interface {i} names edge {e} of patch {p}, which the body "
+                                 f"of {len(patches)} patches does not have")
+    used = {(i.a, i.edge_a) for i in interfaces} | {(i.b, i.edge_b) for i in interfaces}
+    boundary = tuple(edge for edge in found.boundary + tuple(
+        edge for i in found.interfaces for edge in ((i.a, i.edge_a), (i.b, i.edge_b)))
+        if edge not in used)
+    aligned = tuple(i.conforming for i in interfaces)
+    return Topology(tuple(interfaces), aligned, tuple(dict.fromkeys(boundary)), found.poles,
+                    found.non_manifold, found.tol)
+
+
+def _multiplicities(basis: object, mirrored: bool) -> dict[float, int]:
+    t = np.asarray(getattr(basis, "knots"), dtype=float) / basis.length  # type: ignore[attr-defined]
+    if mirrored:
+        t = 1.0 - t[::-1]
+    inner = t[(t > KNOT_TOLERANCE) & (t < 1.0 - KNOT_TOLERANCE)]
+    values, counts = np.unique(np.round(inner / KNOT_TOLERANCE) * KNOT_TOLERANCE,
+                               return_counts=True)
+    return dict(zip(values.tolist(), counts.tolist()))
+
+
+def _missing(mine: object, other: object, reversed_: bool) -> list[float]:
+    """Knots of ``other`` (in ``mine``'s parameter) that ``mine`` lacks, with multiplicity."""
+    have, want = _multiplicities(mine, False), _multiplicities(other, reversed_)
+    length = mine.length  # type: ignore[attr-defined]
+    out: list[float] = []
+    for x, count in want.items():
+        near = [k for k in have if abs(k - x) <= 10 * KNOT_TOLERANCE]
+        extra = count - (have[near[0]] if near else 0)
+        out += [(near[0] if near else x) * length] * max(extra, 0)
+    return out
+
+
+def _distinct(requests: list[list[float]]) -> list[float]:
+    """The knots asked for by several interfaces along one direction: each value with the
+    largest multiplicity any of them asks for."""
+    largest: dict[float, tuple[float, int]] = {}
+    for values in requests:
+        rounded = np.round(np.asarray(values) / KNOT_TOLERANCE) * KNOT_TOLERANCE
+        keys, first, counts = np.unique(rounded, return_index=True, return_counts=True)
+        for key, i, count in zip(keys.tolist(), first, counts):
+            if count > largest.get(key, (0.0, 0))[1]:
+                largest[key] = (float(values[i]), int(count))
+    return [x for x, count in largest.values() for _ in range(count)]
+
+
+def insert_knots_at(surface: Surface, direction: str, values: Sequence[float]) -> Surface:
+    """``surface`` with the knots ``values`` inserted in ``direction`` (exactly, Boehm).
+
+    The direction must have a knot vector clamped at both ends (open or general knots,
+    polynomial or rational); a rational one is refined in homogeneous coordinates.
+    """
+    axis = 0 if direction == "u" else 1
+    basis = surface.basis_u if axis == 0 else surface.basis_v
+    weights = basis.weights if isinstance(basis, RationalBasis) else None
+    poly = basis.basis if isinstance(basis, RationalBasis) else basis
+    if isinstance(poly, BSplineBasis) and poly.kind != "open":
+        raise InputError(f"knots can be inserted into open or general knot vectors only; "
+                         f"direction {direction} of {surface.name!r} is {poly.kind!r}")
+    a = np.ones(poly.size) if weights is None else np.asarray(weights)
+    P = np.moveaxis(np.asarray(surface.control_points), axis, 0)       # (n, m, 3)
+    coefficients = np.concatenate([P * a[:, None, None], np.broadcast_to(
+        a[:, None, None], P.shape[:2] + (1,))], axis=2)
+    knots = np.asarray(poly.knots, dtype=float)
+    for x in sorted(values):
+        knots, coefficients = boehm_insert(knots, poly.degree, float(x), coefficients)
+    new_weights = coefficients[:, 0, 3]
+    new_points = coefficients[..., :3] / coefficients[..., 3:]
+    new: object = KnotVectorBasis(poly.degree, knots)
+    if weights is not None:
+        new = RationalBasis(new, new_weights)  # type: ignore[arg-type]
+    bases = (new, surface.basis_v) if axis == 0 else (surface.basis_u, new)
+    return Surface(np.moveaxis(new_points, 0, axis), bases[0], bases[1], name=surface.name)

@@ -1,0 +1,158 @@
+"""The constraint map of a body: merged control points and per-patch edge conditions.
+
+The unknowns of a body are all its patches' control points, patch after patch (row-major in
+each), ``N = Σ n_u n_v``. The map ``d = T d_free`` is built in two steps:
+
+1. **Edge conditions per patch.** Each patch gets ``free`` on its interface and pole edges
+   and the body's preset (``free``, ``pinned``, ``clamped``) on its boundary edges:
+   ``T_p`` of :func:`splinedeform.boundary.build_constraints`, and ``T_b = diag(T_p)``.
+2. **Merging.** Points that must move as one are joined into classes: along a conforming
+   interface the ``k``-th control point of edge ``a`` with the ``k``-th (``reversed``: the
+   ``k``-th from the end) of edge ``b``; on a pole all control points of the degenerate edge.
+   The classes are the connected components of that graph (union-find, by
+   :func:`scipy.sparse.csgraph.connected_components`), so a corner shared by three or more
+   patches, a seam and a pole come out as one class each. With ``S`` mapping the columns
+   of ``T_b`` to classes, ``T = T_b S``: the columns of one class are summed, and a class
+   with a member that its patch's edge condition fixes (a zero row of ``T_b``) is fixed as a
+   whole. Displacement continuity across the interface is then exact.
+
+A merged point must be a coefficient of its own (a unit row of ``T_b``) or fixed (a zero
+row): knot layouts whose edge conditions couple several coefficients (Höllig's uniform
+knots) cannot be merged and are refused.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Mapping, Sequence
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import NDArray
+from scipy.sparse.csgraph import connected_components
+
+from ..boundary import EDGES, build_constraints, edge_points
+from ..errors import InputError
+from ..surface import Surface
+from .topology import Edge, Topology
+
+BODY_PRESETS = ("free", "pinned", "clamped")
+
+
+@dataclass(frozen=True)
+class BodyConstraints:
+    """The map ``d = T d_free`` of a body (module docstring).
+
+    Attributes
+    ----------
+    T : scipy.sparse.csr_matrix, shape ``(N, n_free)``
+    free_index : ndarray of int
+        Row (body-wide point index) of the first point of each free coordinate's class.
+    edges : dict
+        The preset of each boundary edge, keyed ``(patch, edge)``.
+    offsets : ndarray of int
+        First row of each patch (``len(patches) + 1`` values).
+    """
+
+    T: sp.csr_matrix
+    free_index: NDArray[np.int64]
+    edges: dict[Edge, str]
+    offsets: NDArray[np.int64]
+    T_u: None = field(default=None, init=False)
+    T_v: None = field(default=None, init=False)
+    has_fixed_points: bool = field(default=False, init=False)
+
+    @property
+    def n_free(self) -> int:
+        return int(self.T.shape[1])
+
+    @property
+    def unconstrained(self) -> bool:
+        """No boundary edge is pinned or clamped: rigid motions are free."""
+        return all(preset == "free" for preset in self.edges.values())
+
+
+def boundary_presets(boundary: str | Mapping[Edge, str], topology: Topology
+                     ) -> dict[Edge, str]:
+    """``"clamped"`` for every boundary edge, or ``{(patch, edge): preset}`` (missing: free)."""
+    edges = list(topology.boundary)
+    if isinstance(boundary, str):
+        if boundary not in BODY_PRESETS:
+            raise InputError(f"boundary preset must be one of {BODY_PRESETS}, got {boundary!r}")
+        return {edge: boundary for edge in edges}
+    if not isinstance(boundary, Mapping):
+        raise InputError(f"a body's boundary is a preset name or a mapping (patch, edge) -> "
+                         f"preset, got {type(boundary).__name__}")
+    out = {edge: "free" for edge in edges}
+    joined = {(i.a, i.edge_a): (i.b, i.edge_b) for i in topology.interfaces}
+    joined.update({(i.b, i.edge_b): (i.a, i.edge_a) for i in topology.interfaces})
+    for key, preset in boundary.items():
+        if preset not in BODY_PRESETS:
+            raise InputError(f"boundary[{key!r}] must be one of {BODY_PRESETS}, got {preset!r}")
+        if key in joined:
+            other = joined[key]
+            raise InputError(f"boundary[{key!r}]: edge {key[1]} of patch {key[0]} is an "
+                             f"interface with edge {other[1]} of patch {other[0]}, not a "
+                             "boundary edge")
+        if key in topology.poles:
+            raise InputError(f"boundary[{key!r}]: edge {key[1]} of patch {key[0]} is a pole "
+                             "(collapsed to a point), not a boundary edge")
+        if key not in out:
+            raise InputError(f"boundary[{key!r}] names no boundary edge; the boundary edges "
+                             f"are {edges}")
+        out[key] = preset
+    return out
+
+
+def edge_rows(surface: Surface, edge: str) -> NDArray[np.int64]:
+    """Flat (row-major) indices of the control points on ``edge``, in order along it."""
+    index = np.arange(surface.shape[0] * surface.shape[1]).reshape(surface.shape + (1,))
+    return edge_points(index, edge)[:, 0]
+
+
+def build_body_constraints(patches: Sequence[Surface], topology: Topology,
+                           presets: dict[Edge, str]) -> BodyConstraints:
+    """``T = T_b S`` (module docstring) for conforming interfaces and the given presets."""
+    sizes = np.array([s.shape[0] * s.shape[1] for s in patches])
+    offsets = np.concatenate([[0], np.cumsum(sizes)])
+    maps, columns = [], []
+    for p, surface in enumerate(patches):
+        own = {e: presets.get((p, e), "free") for e in EDGES}
+        c = build_constraints(surface.basis_u, surface.basis_v, own)
+        maps.append(c.T)
+        columns.append(offsets[p] + c.free_index)
+    Tb = sp.block_diag(maps, format="csr")
+    column_point = np.concatenate(columns)
+    pairs = [np.zeros((0, 2), dtype=np.int64)]
+    for i in topology.interfaces:
+        ra = offsets[i.a] + edge_rows(patches[i.a], i.edge_a)
+        rb = offsets[i.b] + edge_rows(patches[i.b], i.edge_b)
+        pairs.append(np.stack([ra, rb[::-1] if i.reversed else rb], axis=1))
+    for p, e in topology.poles:
+        rows = offsets[p] + edge_rows(patches[p], e)
+        pairs.append(np.stack([np.full(rows.size, rows[0]), rows], axis=1))
+    pair = np.concatenate(pairs)
+    n = int(offsets[-1])
+    graph = sp.coo_matrix((np.ones(len(pair)), (pair[:, 0], pair[:, 1])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    merged = np.bincount(label, minlength=n)[label] > 1
+    is_column = np.zeros(n, dtype=bool)
+    is_column[column_point] = True
+    fixed = (Tb.getnnz(axis=1) == 0) & ~is_column
+    coupled = merged & ~is_column & ~fixed
+    if np.any(coupled):
+        row = int(np.flatnonzero(coupled)[0])
+        p = int(np.searchsorted(offsets, row, side="right") - 1)
+        raise InputError(f"control point {divmod(row - offsets[p], patches[p].shape[1])} of "
+                         f"patch {p} lies on an interface or pole but its edge condition "
+                         "couples it to other control points (uniform knots): use open knots "
+                         "at edges that meet")
+    class_fixed = np.bincount(label, weights=fixed, minlength=label.max() + 1) > 0
+    column_class = label[column_point]
+    keep = ~class_fixed[column_class]
+    classes, new = np.unique(column_class[keep], return_inverse=True)
+    S = sp.csr_matrix((np.ones(new.size), (np.flatnonzero(keep), new)),
+                      shape=(column_point.size, classes.size))
+    first = np.full(label.max() + 1, n, dtype=np.int64)
+    np.minimum.at(first, label, np.arange(n))
+    return BodyConstraints((Tb @ S).tocsr(), first[classes], dict(presets), offsets)

@@ -1,0 +1,216 @@
+"""A body of patches deformed as one model: one energy, one constraint map, one solve.
+
+The unknowns are all patches' control points (patch after patch); per patch the matrices
+are those of a single surface (:func:`splinedeform.assembly.patch_matrices`), so that
+
+.. math:: K = \\operatorname{diag}(K_1, …, K_P), \\qquad M = \\operatorname{diag}(M_1, …, M_P),
+
+and the constraint map ``d = T d_free`` of :mod:`.constraints` merges the control points
+of conforming interfaces and poles and applies the edge conditions of boundary edges:
+``K_r = Tᵀ K T``, ``M_r = Tᵀ M T``, ``F_r = Tᵀ F``. Everything a solver or a solution needs
+(static, modes, the closed-form and numerical dynamics) is the single-surface model's
+(:class:`splinedeform.Model`), on these matrices.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import ArrayLike, NDArray
+from scipy.sparse.csgraph import connected_components
+
+from ..assembly import check_bending, patch_matrices
+from ..errors import InputError
+from ..loads import Load, Point, as_load
+from ..material import Material
+from ..model import Model, check_options
+from ..readout import BodyReadout
+from ..solvers.system import Reduction
+from ..surface import Surface
+from .body import Body
+from .constraints import boundary_presets, build_body_constraints
+from .loads import OnPatch
+
+Array = NDArray[np.float64]
+
+
+class BodyReduction(Reduction):
+    """:class:`~splinedeform.solvers.system.Reduction` of a body: a load's vector is the
+    patches' vectors, patch after patch; :class:`.OnPatch` loads act on their patch only."""
+
+    def field(self, term: Any, t: float = 0.0) -> Array:
+        parts = []
+        for p, surface in enumerate(self.surface):
+            if isinstance(term, OnPatch):
+                parts.append(term.load.field_vector(surface, t) if term.patch == p
+                             else np.zeros((surface.shape[0] * surface.shape[1], 3)))
+            elif isinstance(term, Point):
+                raise InputError("a point load on a body needs its patch: "
+                                 "splinedeform.body.OnPatch(Point(u, v, force), patch=i)")
+            else:
+                parts.append(term.field_vector(surface, t))
+        return np.concatenate(parts)
+
+
+class BodyModel(Model):
+    """Patches of a :class:`.Body` with one material, deformed as one connected surface.
+
+    Parameters
+    ----------
+    body : Body or list of Surface
+        A list is made a body with its interfaces found geometrically.
+    material : Material
+    boundary : str or mapping, default "free"
+        ``"free" | "pinned" | "clamped"`` for every boundary edge (an edge no other edge
+        meets), or ``{(patch, edge): preset}`` (missing boundary edges are free). Interface
+        and pole edges have no preset: their control points are merged.
+    mass_matrix : {"consistent", "lumped"}
+    rest : {"initial", "none"}
+    physics : {"intrinsic", "parametric"}, default "intrinsic"
+        ``intrinsic`` measures the energy on the initial surface, the same on every patch
+        whatever its parametrisation. ``parametric`` (the paper's energy per unit parameter
+        area) depends on each patch's parametrisation: two patches of one surface
+        parametrised differently (a reversed or rescaled direction of a curved patch, a
+        different parameter length) get different energies, so the body is a different
+        material patch by patch; use it only where the patches are parametrised alike.
+
+    Raises
+    ------
+    InputError
+        For a non-manifold edge (three or more patches on one edge), a non-conforming
+        interface, or bending weights across an interface (the surface is only C0 there).
+
+    Examples
+    --------
+    >>> import splinedeform as sd
+    >>> left = sd.shapes.plane(size=(0.5, 1.0), cells=(2, 2))
+    >>> right = left.with_control_points(left.control_points + [0.5, 0, 0])
+    >>> model = sd.BodyModel(sd.Body([left, right]), sd.Material(w10=1, w01=1),
+    ...                      boundary="clamped")
+    >>> model.n_free
+    9
+    """
+
+    def __init__(self, body: Body | Sequence[Surface], material: Material,
+                 boundary: str | Mapping[tuple[int, str], str] = "free",
+                 mass_matrix: str = "consistent", rest: str = "initial",
+                 physics: str = "intrinsic"):
+        start = time.perf_counter()
+        if not isinstance(body, Body):
+            body = Body(body)
+        check_options(material, mass_matrix, rest, physics)
+        topology = body.topology
+        _refuse(topology, material)
+        self.body = body
+        self.patches: tuple[Surface, ...] = body.patches
+        self.surface = None            # no single surface: the read-out has the patches
+        self.gram_u = self.gram_v = None
+        self.material, self.mass_matrix, self.rest, self.physics = (material, mass_matrix,
+                                                                    rest, physics)
+        for surface in self.patches:
+            check_bending(surface, material)
+        self.constraints = build_body_constraints(
+            self.patches, topology, boundary_presets(boundary, topology))
+        if self.constraints.n_free == 0:
+            error = InputError(f"no free coordinate: the boundary fixes every control point of "
+                               f"the {len(self.patches)} patches; free an edge or refine them")
+            error.key = "boundary"  # type: ignore[attr-defined]
+            raise error
+        blocks = [patch_matrices(s, material, physics, mass_matrix == "lumped")[2:]
+                  for s in self.patches]
+        self.K_full = sp.block_diag([k for k, _ in blocks], format="csr")
+        self.M_full = sp.block_diag([m for _, m in blocks], format="csr")
+        T = self.constraints.T
+        self._K = (T.T @ self.K_full @ T).tocsc()
+        self._M = (T.T @ self.M_full @ T).tocsc()
+        self._finish(start)
+
+    # -- layout ------------------------------------------------------------------------
+    @property
+    def reduction(self) -> BodyReduction:
+        rest = self._reduce_force(np.zeros((self.constraints.T.shape[0], 3))) \
+            if self.rest == "none" else None
+        return BodyReduction(self.constraints.T, self.patches, rest)
+
+    @property
+    def readout(self) -> BodyReadout:  # type: ignore[override]
+        return BodyReadout(self.patches, self.constraints.T, self._M, self._K)
+
+    def load_vector(self, load: Load, t: float = 0.0) -> Array:
+        """Reduced ``Tᵀ (F(t) [- K p0 when rest='none'])`` of all patches, ``(n_free, 3)``."""
+        reduction = self.reduction
+        F = sum((term.profile(t) * reduction.field(term, t) for term in as_load(load).terms()),
+                np.zeros((self.constraints.T.shape[0], 3)))
+        return self._reduce_force(F)
+
+    def _rest_net(self) -> Array:
+        return np.concatenate([s.control_points.reshape(-1, 3) for s in self.patches])
+
+    def _flatten_net(self, net: ArrayLike, what: str) -> Array:
+        """A list of per-patch nets ``(n_u, n_v, 3)`` as rows ``(N, 3)``."""
+        if not isinstance(net, (list, tuple)) or len(net) != len(self.patches):
+            raise InputError(f"{what} of a body is a list of {len(self.patches)} nets, one "
+                             "per patch")
+        rows = []
+        for p, (part, surface) in enumerate(zip(net, self.patches)):
+            arr = np.asarray(part, dtype=float)
+            if arr.shape != surface.shape + (3,):
+                raise InputError(f"{what}[{p}] must have shape {surface.shape + (3,)}, got "
+                                 f"{arr.shape}")
+            rows.append(arr.reshape(-1, 3))
+        return np.concatenate(rows)
+
+    def modes(self, k: int = 6) -> tuple[Array, list[Array]]:  # type: ignore[override]
+        """Lowest ``k`` frequencies and mode shapes per patch, each ``(k, n_u, n_v)``."""
+        lam, phi = self.eigen(k)
+        full = np.asarray(self.constraints.T @ phi).T
+        parts = np.split(full, self.constraints.offsets[1:-1], axis=1)
+        return np.sqrt(lam), [part.reshape((phi.shape[1],) + s.shape)
+                              for part, s in zip(parts, self.patches)]
+
+    @property
+    def rigid_modes(self) -> int | None:
+        """Dimension of ``null K_r``: with tension in both directions the energy vanishes on
+        constant displacements only, one per connected part of the body that no pinned or
+        clamped edge holds; ``None`` (unknown) without tension."""
+        m = self.material
+        if not (m.w10 > 0 and m.w01 > 0):
+            return None
+        n = len(self.patches)
+        links = [(i.a, i.b) for i in self.body.topology.interfaces] or [(0, 0)]
+        graph = sp.coo_matrix((np.ones(len(links)), np.array(links).T), shape=(n, n))
+        parts, label = connected_components(graph, directed=False)
+        held = np.zeros(parts, dtype=bool)
+        for (p, _), preset in self.constraints.edges.items():
+            held[label[p]] |= preset != "free"
+        return int(np.sum(~held))
+
+
+def _refuse(topology: Any, material: Material) -> None:
+    """Refuse what the merged constraint map cannot couple (see :class:`BodyModel`)."""
+    if topology.non_manifold:
+        group = topology.non_manifold[0]
+        names = ", ".join(f"patch {p} edge {e}" for p, e in group)
+        raise InputError(f"non-manifold edge: {len(group)} patch edges meet on one curve "
+                         f"({names}); a body's edge joins at most two patch edges")
+    bad = [i for i in topology.interfaces if not i.conforming]
+    if bad:
+        i = bad[0]
+        raise InputError(f"non-conforming interface between patch {i.a} edge {i.edge_a} and "
+                         f"patch {i.b} edge {i.edge_b} (different knots, degrees or control "
+                         "points along the edge): refine to conforming (Body.conforming() "
+                         "inserts the missing knots where the degrees match) or wait for "
+                         "penalty coupling")
+    bending = [k for k in ("w20", "w11", "w02") if getattr(material, k)]
+    if bending and topology.interfaces:
+        i = topology.interfaces[0]
+        raise InputError(
+            f"bending weight {bending[0]} needs a C1 surface, but the patches meet at "
+            f"{len(topology.interfaces)} interface(s) (e.g. patch {i.a} edge {i.edge_a} with "
+            f"patch {i.b} edge {i.edge_b}) where merged control points make it only C0: the "
+            "surface may kink there, where bending energy is undefined, and would bend like "
+            "a hinge. The rotation across an interface is not coupled yet; use tension "
+            "weights only (w10, w01), or one patch")
