@@ -48,7 +48,7 @@ class Readout:
         return self.surface
 
     def nets(self, d_free: Array, rest: bool = True) -> Array:
-        """``[p_rest +] T d_free`` for ``d_free`` ``(..., n_free, 3)`` → ``(..., n_u, n_v, 3)``."""
+        """``[p_rest +] T d_free``: ``(..., n_free, 3)`` → ``(..., n_u, n_v, 3)``."""
         full = _expand(self.T, d_free)
         net = full.reshape(d_free.shape[:-2] + self.surface.shape + (3,))
         return self.surface.control_points + net if rest else net

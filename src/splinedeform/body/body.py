@@ -24,7 +24,7 @@ from ..refine import boehm_insert
 from ..surface import Surface
 from .interface import Interface
 from .topology import (KNOT_TOLERANCE, Topology, body_size, edge_basis, edges_of,
-                       find_topology)
+                       find_topology, normalised_knots)
 
 Array = NDArray[np.float64]
 MAX_PASSES = 16
@@ -146,9 +146,7 @@ def _given(patches: tuple[Surface, ...], interfaces: list[Interface], found: Top
 
 
 def _multiplicities(basis: object, mirrored: bool) -> dict[float, int]:
-    t = np.asarray(getattr(basis, "knots"), dtype=float) / basis.length  # type: ignore[attr-defined]
-    if mirrored:
-        t = 1.0 - t[::-1]
+    t = normalised_knots(basis, mirrored)
     inner = t[(t > KNOT_TOLERANCE) & (t < 1.0 - KNOT_TOLERANCE)]
     values, counts = np.unique(np.round(inner / KNOT_TOLERANCE) * KNOT_TOLERANCE,
                                return_counts=True)

@@ -24,7 +24,7 @@ control points within ``tol`` of each other and NURBS weights along the edge pro
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 import scipy.sparse as sp
@@ -147,8 +147,9 @@ def _project(surface: Surface, edge: str, x: Array) -> Array:
     return np.linalg.norm(surface.evaluate(*edge_parameters(surface, edge, s)) - x, axis=1)
 
 
-def _normalised(basis: object, mirrored: bool) -> Array:
-    t = np.asarray(getattr(basis, "knots"), dtype=float) / basis.length  # type: ignore[attr-defined]
+def normalised_knots(basis: Any, mirrored: bool) -> Array:
+    """The knot vector of ``basis`` over its length, ``t / L`` (mirrored: ``1 − t/L`` reversed)."""
+    t = np.asarray(basis.knots, dtype=float) / basis.length
     return 1.0 - t[::-1] if mirrored else t
 
 
@@ -161,7 +162,7 @@ def conforming(sa: Surface, ea: str, sb: Surface, eb: str, reversed_: bool, tol:
     ba, bb = edge_basis(sa, ea), edge_basis(sb, eb)
     if ba.degree != bb.degree or ba.size != bb.size:      # type: ignore[attr-defined]
         return False
-    ta, tb = _normalised(ba, False), _normalised(bb, reversed_)
+    ta, tb = normalised_knots(ba, False), normalised_knots(bb, reversed_)
     if ta.shape != tb.shape or np.max(np.abs(ta - tb)) > KNOT_TOLERANCE:
         return False
     for surface, edge in ((sa, ea), (sb, eb)):
