@@ -91,7 +91,7 @@ class BodyModel(Model):
     >>> model = sd.BodyModel(sd.Body([left, right]), sd.Material(w10=1, w01=1),
     ...                      boundary="clamped")
     >>> model.n_free
-    9
+    5
     """
 
     def __init__(self, body: Body | Sequence[Surface], material: Material,
