@@ -19,8 +19,19 @@ from .surface import Surface
 Array = NDArray[np.float64]
 
 
+class _Energies:
+    """The reduced matrices of the energies, ``M`` and ``K``."""
+
+    M: sp.spmatrix
+    K: sp.spmatrix
+
+    def matrices(self) -> tuple[sp.spmatrix, sp.spmatrix]:
+        """``(M, K)``."""
+        return self.M, self.K
+
+
 @dataclass(frozen=True)
-class Readout:
+class Readout(_Energies):
     """What a solution needs to read its free coordinates out as a surface.
 
     Attributes
@@ -38,15 +49,6 @@ class Readout:
     M: sp.spmatrix
     K: sp.spmatrix
 
-    def matrices(self) -> tuple[sp.spmatrix, sp.spmatrix]:
-        """``(M, K)``."""
-        return self.M, self.K
-
-    @property
-    def rest(self) -> Surface:
-        """The rest surface."""
-        return self.surface
-
     def nets(self, d_free: Array, rest: bool = True) -> Array:
         """``[p_rest +] T d_free``: ``(..., n_free, 3)`` → ``(..., n_u, n_v, 3)``."""
         full = _expand(self.T, d_free)
@@ -55,7 +57,7 @@ class Readout:
 
 
 @dataclass(frozen=True)
-class BodyReadout:
+class BodyReadout(_Energies):
     """:class:`Readout` of a body: the patches' rest surfaces and one map ``d = T d_free``
     whose rows are the patches' control points, patch after patch (row-major in each)."""
 
@@ -63,15 +65,6 @@ class BodyReadout:
     T: sp.spmatrix
     M: sp.spmatrix
     K: sp.spmatrix
-
-    def matrices(self) -> tuple[sp.spmatrix, sp.spmatrix]:
-        """``(M, K)``."""
-        return self.M, self.K
-
-    @property
-    def rest(self) -> tuple[Surface, ...]:
-        """The rest patches."""
-        return self.surfaces
 
     def nets(self, d_free: Array, rest: bool = True) -> list[Array]:
         """Per patch ``[p_rest +] T d_free``: a list of ``(..., n_u, n_v, 3)``."""
