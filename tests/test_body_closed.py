@@ -96,3 +96,14 @@ def test_sphere_of_two_hemispheres_stays_closed() -> None:
                        indexing="ij")
     radial = np.sum(motion.displacement(30.0, U, V, patch=0) * upper.evaluate(U, V), -1) / R
     np.testing.assert_allclose(radial, R**2 / 2, rtol=2e-3)
+
+
+def test_pole_merged_like_the_single_surface_pole_preset() -> None:
+    # the same net and constraints built two ways (the pole's points one unknown): the same
+    # matrices in another order, 1e-10 (as the split squares)
+    dome = sd.shapes.half_sphere(R, cells=(8, 4))
+    single = sd.Model(dome, MEMBRANE, boundary={"v0": "clamped", "v1": "pole"},
+                      physics="intrinsic")
+    body = sd.BodyModel([dome], MEMBRANE, boundary="clamped")
+    assert body.n_free == single.n_free
+    np.testing.assert_allclose(body.frequencies(6), single.frequencies(6), rtol=1e-10)

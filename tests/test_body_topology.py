@@ -101,3 +101,41 @@ def test_bad_patches_are_refused() -> None:
         find_topology(box(), tol=-1.0)
     with pytest.raises(sd.InputError, match="edge u1 of patch 3"):
         sd.Body(box()[:2], interfaces=[Interface(0, "u0", 3, "u1")])
+
+
+def quarter_tube(spans_v: int, angle0: float) -> sd.Surface:
+    """A quarter of the unit cylinder from ``angle0``: an exact NURBS arc in u (degree 2,
+    weights 1, √2/2, 1) times a line of ``spans_v`` quadratic spans in v."""
+    from splinedeform.knots import KnotVectorBasis, RationalBasis
+    arc = RationalBasis(KnotVectorBasis(2, [0, 0, 0, 1, 1, 1]), [1, np.sqrt(0.5), 1])
+    bv = KnotVectorBasis(2, np.concatenate([[0, 0], np.linspace(0, 1, spans_v + 1), [1, 1]]))
+    c, s = np.cos(angle0), np.sin(angle0)
+    corners = np.array([[c, s], [c - s, s + c], [-s, c]])        # the arc's control polygon
+    z = bv.greville()
+    net = np.concatenate([np.repeat(corners[:, None], z.size, 1),
+                          np.broadcast_to(z, (3, z.size))[..., None]], axis=-1)
+    return sd.Surface(net, arc, bv)
+
+
+def test_rational_patches_made_conforming_by_exact_knot_insertion() -> None:
+    a, b = quarter_tube(1, 0.0), quarter_tube(3, np.pi / 2)
+    body = sd.Body.from_surfaces([a, b])
+    assert body.summary()["shared"] == 1 and body.summary()["non_conforming"] == 1
+    refined = body.conforming()
+    assert refined.summary()["non_conforming"] == 0
+    assert refined[0].shape == b.shape
+    U, V = np.meshgrid(np.linspace(0, 1, 9), np.linspace(0, 1, 9), indexing="ij")
+    # Boehm's insertion in homogeneous coordinates: the geometry does not move (round-off)
+    np.testing.assert_allclose(refined.evaluate(0, U, V), a.evaluate(U, V), atol=1e-14)
+    radius = np.linalg.norm(refined.evaluate(0, U, V)[..., :2], axis=-1)
+    np.testing.assert_allclose(radius, 1.0, atol=1e-14)     # still the exact circle
+    lower, upper = refined.bounding_box()
+    np.testing.assert_allclose(lower, [-1, 0, 0], atol=1e-14)
+    np.testing.assert_allclose(upper, [1, 1, 1], atol=1e-14)
+    # a quadratic and a cubic edge: no knot makes them conform
+    cubic = flat_patch((0, 1), (0, 1), (1, 1))
+    quadratic = sd.Surface(np.stack(np.meshgrid([1.0, 1.5, 2.0], [0.0, 0.5, 1.0],
+                                                indexing="ij") + (np.zeros((3, 3)),), -1),
+                           *(sd.KnotVectorBasis(2, [0, 0, 0, 1, 1, 1]),) * 2)
+    mixed = sd.Body([cubic, quadratic])
+    assert mixed.conforming().summary()["non_conforming"] == 1
