@@ -70,6 +70,10 @@ def test_quarters_meet_at_a_corner_of_four_and_one_interface_is_reversed() -> No
     # merged, the 4 × 6 × 6 control points are the 11 × 11 coefficients of the single patch
     assert model.n_free == split_square((2, 2), 3).shape[0] ** 2
     assert model.rigid_modes == 1      # free: one constant per coordinate
+    # a constant field is the rigid motion: every patch's net moves as one
+    nets = model.to_full(np.ones(model.n_free))
+    assert [net.shape for net in nets] == [(6, 6)] * 4
+    np.testing.assert_array_equal(np.concatenate(nets), 1.0)     # 0/1 entries of T: exact
 
 
 def test_parametric_lumped_and_dynamic_paths_agree_with_single_patch() -> None:

@@ -163,6 +163,10 @@ class Model:
         """The constraint map and load offset the solvers reduce loads with."""
         rest = self._reduce_force(np.zeros((self.constraints.T.shape[0], 3))) \
             if self.rest == "none" else None
+        return self._reduction(rest)
+
+    def _reduction(self, rest: Array | None) -> Reduction:
+        """:class:`Reduction` of ``T`` with the surface loads are evaluated on."""
         return Reduction(self.constraints.T, self.surface, rest)
 
     @property

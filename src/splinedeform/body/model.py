@@ -129,11 +129,16 @@ class BodyModel(Model):
         self._finish(start)
 
     # -- layout ------------------------------------------------------------------------
-    @property
-    def reduction(self) -> BodyReduction:
-        rest = self._reduce_force(np.zeros((self.constraints.T.shape[0], 3))) \
-            if self.rest == "none" else None
+    def _reduction(self, rest: Array | None) -> BodyReduction:
         return BodyReduction(self.constraints.T, self.patches, rest)
+
+    def to_full(self, d_free: Array) -> list[Array]:  # type: ignore[override]
+        """Per patch the full displacement net ``T d_free``: ``(n_u, n_v, 3)`` (or
+        ``(n_u, n_v)`` for a scalar field) each."""
+        full = np.asarray(self.constraints.T @ d_free)
+        parts = np.split(full, self.constraints.offsets[1:-1], axis=0)
+        return [part.reshape(s.shape + np.shape(d_free)[1:])
+                for part, s in zip(parts, self.patches)]
 
     @property
     def readout(self) -> BodyReadout:  # type: ignore[override]
@@ -141,7 +146,7 @@ class BodyModel(Model):
 
     def load_vector(self, load: Load, t: float = 0.0) -> Array:
         """Reduced ``Tᵀ (F(t) [- K p0 when rest='none'])`` of all patches, ``(n_free, 3)``."""
-        reduction = self.reduction
+        reduction = self._reduction(None)
         F = sum((term.profile(t) * reduction.field(term, t) for term in as_load(load).terms()),
                 np.zeros((self.constraints.T.shape[0], 3)))
         return self._reduce_force(F)
