@@ -10,6 +10,7 @@ from splinedeform.body import Interface
 from splinedeform.errors import InputError
 from splinedeform.knots import KnotVectorBasis, one_sided
 from splinedeform.physics import coupling
+from splinedeform.physics.coupling_traces import merged
 from splinedeform.surface import Surface
 
 from coupling_systems import MEMBRANE, PLATE, c0_basis, flat_patch, offsets
@@ -136,4 +137,8 @@ def test_c0_lines_and_one_sided_slopes():
 
 def test_the_projection_needs_a_trace_space_longer_than_its_merged_ends():
     with pytest.raises(InputError, match="cannot merge"):
-        coupling._merged(BSplineBasis(1, 1, 1.0, "open").matrix([0.2, 0.7]), 1)
+        merged(BSplineBasis(1, 1, 1.0, "open").matrix([0.2, 0.7]), 1, 1)
+    # merged ends keep the partition of unity: one at every point, to round-off
+    space = merged(BSplineBasis(3, 5, 1.0, "open").matrix([0.1, 0.5, 0.9]), 2, 1)
+    assert space.shape == (3, 5)
+    np.testing.assert_allclose(np.asarray(space.sum(axis=1)).ravel(), 1.0, rtol=1e-14)
