@@ -100,7 +100,8 @@ def value(surface: Surface, d: np.ndarray, u: float, v: float) -> float:
     return float((surface.evaluation_matrix(u, v) @ d)[0])
 
 
-def single(cells: int, material: Material, edge: str, f: Callable = uniform) -> float:
-    """Centre deflection of the unit square as one patch, ``cells × cells`` cubic spans."""
-    s = flat_patch(0.0, 1.0, cells, cells)
+def single(cells: int, material: Material, edge: str, f: Callable = uniform, degree: int = 3
+           ) -> float:
+    """Centre deflection of the unit square as one patch, ``cells × cells`` spans."""
+    s = flat_patch(0.0, 1.0, cells, cells, degree)
     return value(s, solve([s], [0.0], [edge], material, 0.0, f)[0], 0.5, 0.5)
