@@ -44,7 +44,7 @@ from ..body.interface import Interface
 from ..errors import InputError
 from ..material import Material
 from ..surface import Surface
-from .coupling_traces import EXTRA_POINTS, Side, common_line, gauss
+from .coupling_traces import Line, Side, common_line
 from .shell import ShellMaterial
 
 Array = NDArray[np.float64]
@@ -145,7 +145,8 @@ def displacement_penalty(patches: Sequence[Surface], interface: Interface, alpha
     side_a, side_b = _sides(patches, interface)
     line = common_line(side_a, side_b, interface.reversed, f"interface {interface}")
     off_a, off_b, size = _global(patches, interface, offsets)
-    jump = _place(line.values[0], off_a, size) - _place(line.values[1], off_b, size)
+    jump = (_place(line.sides[0].values, off_a, size)
+            - _place(line.sides[1].values, off_b, size))
     return _penalty(jump, line.weights, alpha, line.space(crosspoints) if projected else None)
 
 
@@ -159,7 +160,8 @@ def rotation_penalty(patches: Sequence[Surface], interface: Interface, beta: flo
     side_a, side_b = _sides(patches, interface)
     line = common_line(side_a, side_b, interface.reversed, f"interface {interface}")
     off_a, off_b, size = _global(patches, interface, offsets)
-    jump = _place(line.slopes[0], off_a, size) + _place(line.slopes[1], off_b, size)
+    jump = (_place(line.sides[0].slopes, off_a, size)
+            + _place(line.sides[1].slopes, off_b, size))
     return _penalty(jump, line.weights, beta, line.space(crosspoints) if projected else None)
 
 
@@ -212,21 +214,26 @@ def c0_sides(surface: Surface, direction: str, knot: float) -> tuple[Side, Side]
 
 
 def c0_rotation_penalty(surface: Surface, direction: str, knot: float, beta: float,
-                        offset: int = 0, size: int | None = None) -> sp.csr_matrix:
+                        offset: int = 0, size: int | None = None, crosspoints: int = 0
+                        ) -> sp.csr_matrix:
     """Matrix of ``½ β ∫ (∂_{n_-} d_- + ∂_{n_+} d_+)² ds`` along the C0 line ``direction = knot``.
 
     ``d_-`` and ``d_+`` are the one-sided limits from the spans below and above the knot
-    (:func:`splinedeform.knots.one_sided`), with their outward conormals; the quadrature runs
-    over the spans along the line. The surface's control points are ``offset …`` of ``size``
-    global ones (default: the surface alone).
+    (:func:`splinedeform.knots.one_sided`), with their outward conormals: the interface
+    between the two sides, on the same splines along the line (so the projection changes
+    nothing but the ``crosspoints``). The surface's control points are ``offset …`` of
+    ``size`` global ones (default: the surface alone).
     """
-    below, above = c0_sides(surface, direction, knot)
-    s, w = gauss(below.breaks, below.running.degree + 1 + EXTRA_POINTS)
-    _, D_below, _, speed = below.traces(s)
-    _, D_above, _, _ = above.traces(s)
+    line = _c0_line(surface, direction, knot)
     count = surface.shape[0] * surface.shape[1]
     size = offset + count if size is None else int(size)
-    return _penalty(_place(D_below + D_above, offset, size), w * speed, beta)
+    jump = _place(line.sides[0].slopes, offset, size) + _place(line.sides[1].slopes, offset, size)
+    return _penalty(jump, line.weights, beta, line.space(crosspoints))
+
+
+def _c0_line(surface: Surface, direction: str, knot: float) -> Line:
+    below, above = c0_sides(surface, direction, knot)
+    return common_line(below, above, False, f"C0 line {direction} = {knot:.12g}")
 
 
 def interface_size(patches: Sequence[Surface], interface: Interface) -> float:

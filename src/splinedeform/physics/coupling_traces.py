@@ -27,6 +27,21 @@ GAP_TOLERANCE = 1e-6
 
 
 @dataclass(frozen=True)
+class Trace:
+    """One side on ``Q`` points of a line: ``values`` ``V`` (``d`` there) and ``slopes``
+    ``Dn`` (outward conormal derivatives ``∂_n d``) as ``(Q, n_u n_v)`` operators on the net;
+    the rest ``points``, the line's ``speed`` ``|x_s|``, its unit ``tangent`` ``x_s / |x_s|``
+    and the unit outward ``conormal``, each ``(Q, 3)`` (the speed ``(Q,)``)."""
+
+    values: sp.csr_matrix
+    slopes: sp.csr_matrix
+    points: Array
+    speed: Array
+    tangent: Array
+    conormal: Array
+
+
+@dataclass(frozen=True)
 class Side:
     """One side of a coupling line: ``surface`` near the line ``fixed = value``.
 
@@ -61,11 +76,9 @@ class Side:
         breaks = getattr(basis, "breaks", None)
         return np.arange(basis.cells + 1) * basis.h if breaks is None else np.asarray(breaks)
 
-    def traces(self, s: Array) -> tuple[sp.csr_matrix, sp.csr_matrix, Array, Array]:
-        """Operators on the net at running parameters ``s`` (shape ``(Q,)``).
+    def traces(self, s: Array) -> Trace:
+        """The side's :class:`Trace` at running parameters ``s`` (shape ``(Q,)``).
 
-        Returns ``V`` (values ``d``), ``Dn`` (outward conormal derivatives ``∂_n d``), both
-        ``(Q, n_u n_v)``, the rest points ``x`` ``(Q, 3)`` and the line's speed ``|x_s|``.
         With ``f`` the held and ``r`` the running parameter, the conormal is
         ``n ∝ x_f − (x_f·x_r / x_r·x_r) x_r``, so ``∂_n d = ±(d_f − c d_r) / |x_f − c x_r|``.
         """
@@ -92,15 +105,18 @@ class Side:
         P = surface.control_points.reshape(-1, 3)
         x, x_f, x_r = V @ P, Df @ P, Dr @ P
         c = np.einsum("qi,qi->q", x_f, x_r) / np.einsum("qi,qi->q", x_r, x_r)
-        length = np.linalg.norm(x_f - c[:, None] * x_r, axis=1)
+        across_line = x_f - c[:, None] * x_r
+        length = np.linalg.norm(across_line, axis=1)
         Dn = sp.diags(self.outward / length) @ (Df - sp.diags(c) @ Dr)
-        return V, Dn.tocsr(), x, np.linalg.norm(x_r, axis=1)
+        speed = np.linalg.norm(x_r, axis=1)
+        return Trace(V, Dn.tocsr(), x, speed, x_r / speed[:, None],
+                     self.outward * across_line / length[:, None])
 
     def element_size(self) -> float:
         """Mean length of the line's knot spans on the rest surface, ``h = |Γ| / spans``."""
         breaks = self.breaks
         s, w = gauss(breaks, self.running.degree + 1 + EXTRA_POINTS)
-        return float(w @ self.traces(s)[3]) / (breaks.size - 1)
+        return float(w @ self.traces(s).speed) / (breaks.size - 1)
 
 
 def gauss(breaks: Array, points: int) -> tuple[Array, Array]:
@@ -120,14 +136,13 @@ def union(first: Array, second: Array, tol: float = 1e-12) -> Array:
 class Line:
     """Both sides' traces at common quadrature points of ``Γ`` and the weights ``ds``.
 
-    ``values`` and ``slopes`` hold, per side, the operators ``V`` and ``Dn`` of
-    :meth:`Side.traces` (columns of that side's own net); ``projector`` is the finer side's
+    ``sides`` are the two :class:`Trace` (columns of each side's own net); ``projector`` is
+    the finer side's
     running basis at the points, ``(Q, n_r)``, the space a jump is measured in, and
     ``mirrored`` whether its functions run against ``a``'s parameter.
     """
 
-    values: tuple[sp.csr_matrix, sp.csr_matrix]
-    slopes: tuple[sp.csr_matrix, sp.csr_matrix]
+    sides: tuple[Trace, Trace]
     weights: Array
     projector: sp.csr_matrix
     mirrored: bool
@@ -154,12 +169,11 @@ def common_line(side_a: Side, side_b: Side, reversed_: bool, where: str) -> Line
     sigma, w = gauss(breaks, degree + 1 + EXTRA_POINTS)
     s_a = lo_a + (hi_a - lo_a) * sigma
     s_b = lo_b + (hi_b - lo_b) * ((1.0 - sigma) if reversed_ else sigma)
-    V_a, Dn_a, x_a, speed = side_a.traces(s_a)
-    V_b, Dn_b, x_b, _ = side_b.traces(s_b)
+    trace_a, trace_b = side_a.traces(s_a), side_b.traces(s_b)
     points = np.concatenate([side_a.surface.control_points.reshape(-1, 3),
                              side_b.surface.control_points.reshape(-1, 3)])
     size = float(np.ptp(points, axis=0).max())
-    gap = np.linalg.norm(x_a - x_b, axis=1)
+    gap = np.linalg.norm(trace_a.points - trace_b.points, axis=1)
     if gap.max() > GAP_TOLERANCE * size:
         worst = int(gap.argmax())
         raise InputError(
@@ -169,7 +183,7 @@ def common_line(side_a: Side, side_b: Side, reversed_: bool, where: str) -> Line
     # the finer edge's splines (more functions; a's on a tie), ends in a's order
     fine_b = side_b.running.size > side_a.running.size
     projector = side_b.running.matrix(s_b) if fine_b else side_a.running.matrix(s_a)
-    return Line((V_a, V_b), (Dn_a, Dn_b), w * speed * (hi_a - lo_a), projector.tocsr(),
+    return Line((trace_a, trace_b), w * trace_a.speed * (hi_a - lo_a), projector.tocsr(),
                 fine_b and reversed_)
 
 
