@@ -165,6 +165,64 @@ def rotation_penalty(patches: Sequence[Surface], interface: Interface, beta: flo
     return _penalty(jump, line.weights, beta, line.space(crosspoints) if projected else None)
 
 
+def _interleaved(operator: sp.csr_matrix, direction: Array, offset: int, size: int
+                 ) -> sp.csr_matrix:
+    """``operator`` (on scalar control values) dotted with a vector ``direction[q]`` per row:
+    columns ``3 (offset + k) + c`` of ``3 size`` interleaved unknowns (the shell's layout)."""
+    coo = operator.tocoo()
+    rows = np.repeat(coo.row, 3)
+    cols = 3 * (np.repeat(coo.col, 3) + offset) + np.tile(np.arange(3), coo.nnz)
+    values = (coo.data[:, None] * direction[coo.row]).ravel()
+    return sp.csr_matrix((values, (rows, cols)), shape=(operator.shape[0], 3 * size))
+
+
+def shell_displacement_penalty(patches: Sequence[Surface], interface: Interface, alpha: float,
+                               offsets: Sequence[int], crosspoints: int | tuple[int, int] = 0
+                               ) -> sp.csr_matrix:
+    """:func:`displacement_penalty` on the shell's interleaved unknowns (dof ``3k + c``):
+    ``½ α ∫ |Π (d_a − d_b)|² ds`` for the displacement vector, ``(3N, 3N)``."""
+    scalar = displacement_penalty(patches, interface, alpha, offsets, crosspoints=crosspoints)
+    return sp.kron(scalar, sp.identity(3), format="csr")
+
+
+def shell_rotation_penalty(patches: Sequence[Surface], interface: Interface, beta: float,
+                           offsets: Sequence[int], crosspoints: int | tuple[int, int] = 0
+                           ) -> sp.csr_matrix:
+    """Matrix of ``½ β ∫_Γ (Π (θ_a − θ_b))² ds`` on the shell's interleaved unknowns.
+
+    ``θ = ∂_n d · (τ × n)`` is the linearised rotation of a side's conormal fibre ``n``
+    about the common tangent ``τ`` (``a``'s). A rigid motion ``d = ω × x`` turns every fibre
+    by ``ω·τ``, whatever the angle between the sides, so the angle between them is what is
+    kept: ``G1`` where the rest shape is smooth, the crease where it is not (Kiendl et al.,
+    CMAME 199, 2010; Herrema et al. 2019). On a flat body ``τ × n = ∓ e_z`` and this is
+    :func:`rotation_penalty` of the deflection.
+    """
+    side_a, side_b = _sides(patches, interface)
+    line = common_line(side_a, side_b, interface.reversed, f"interface {interface}")
+    off_a, off_b, size = _global(patches, interface, offsets)
+    return _penalty(_rotation_jump(line, off_a, off_b, size), line.weights, beta,
+                    line.space(crosspoints))
+
+
+def _rotation_jump(line: Line, off_a: int, off_b: int, size: int) -> sp.csr_matrix:
+    """``θ_a − θ_b`` at the line's points, ``(Q, 3 size)``."""
+    a, b = line.sides
+    tangent = a.tangent
+    return (_interleaved(a.slopes, np.cross(tangent, a.conormal), off_a, size)
+            - _interleaved(b.slopes, np.cross(tangent, b.conormal), off_b, size))
+
+
+def shell_c0_rotation_penalty(surface: Surface, direction: str, knot: float, beta: float,
+                              offset: int = 0, size: int | None = None, crosspoints: int = 0
+                              ) -> sp.csr_matrix:
+    """:func:`shell_rotation_penalty` across a C0 line (:func:`c0_rotation_penalty`'s layout,
+    interleaved): the crease of the rest shape there is kept."""
+    line = _c0_line(surface, direction, knot)
+    size = offset + surface.shape[0] * surface.shape[1] if size is None else int(size)
+    return _penalty(_rotation_jump(line, offset, offset, size), line.weights, beta,
+                    line.space(crosspoints))
+
+
 HELD = {"free": 0, "pinned": 1, "clamped": 2}
 """Coefficients of an edge's trace an end condition fixes, the crosspoints merged there."""
 
@@ -175,7 +233,8 @@ def interface_penalty(patches: Sequence[Surface], interface: Interface,
     """The coupling of a non-conforming interface, every factor from the material and the mesh.
 
     :func:`displacement_penalty` with ``α`` of :func:`penalty_factors` at the element size
-    :func:`interface_size`, plus, where the energy bends, :func:`rotation_penalty` with ``β``.
+    :func:`interface_size`, plus, where the energy bends, :func:`rotation_penalty` with ``β``;
+    for a shell their vector forms on its interleaved unknowns (``(3N, 3N)``).
     ``ends`` are the boundary conditions holding the interface's start and end (in ``a``'s
     parameter), ``"free" | "pinned" | "clamped"``: the crosspoints (:data:`HELD`).
     """
@@ -184,6 +243,9 @@ def interface_penalty(patches: Sequence[Surface], interface: Interface,
             raise InputError(f"an interface end is one of {tuple(HELD)}, got {end!r}")
     crosspoints = (HELD[ends[0]], HELD[ends[1]])
     alpha, beta = penalty_factors(material, interface_size(patches, interface))
+    if isinstance(material, ShellMaterial):
+        return (shell_displacement_penalty(patches, interface, alpha, offsets, crosspoints)
+                + shell_rotation_penalty(patches, interface, beta, offsets, crosspoints))
     K = displacement_penalty(patches, interface, alpha, offsets, crosspoints=crosspoints)
     if beta == 0:
         return K
