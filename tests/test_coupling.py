@@ -39,7 +39,7 @@ def interpolant(surface: Surface, field) -> np.ndarray:
 
 
 def two_patches(degree_b: int = 2) -> list[Surface]:
-    """Left 4 × 8 cubic spans, right 3 × 5 spans of ``degree_b``: nothing in common along x = 1/2."""
+    """Left 4 × 8 cubic spans, right 3 × 5 of ``degree_b``: no common knot inside x = 1/2."""
     return [flat_patch(0.0, 0.5, 4, 8), flat_patch(0.5, 0.5, 3, 5, degree=degree_b)]
 
 

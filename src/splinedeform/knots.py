@@ -339,7 +339,8 @@ def one_sided(basis: object, x: float, side: int, max_derivative: int = 1
     Examples
     --------
     >>> b = KnotVectorBasis(2, [0, 0, 0, 0.5, 0.5, 1, 1, 1])
-    >>> [float(v) for v in one_sided(b, 0.5, -1)[1][1]], [float(v) for v in one_sided(b, 0.5, +1)[1][1]]
+    >>> below, above = one_sided(b, 0.5, -1)[1][1], one_sided(b, 0.5, +1)[1][1]
+    >>> [float(v) for v in below], [float(v) for v in above]
     ([0.0, -4.0, 4.0], [-4.0, 4.0, 0.0])
     """
     if side not in (-1, 1):

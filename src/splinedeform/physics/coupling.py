@@ -15,10 +15,12 @@ perpendicular to ``Γ``, pointing out of the patch)::
 
 ``Π`` is the ``L²(Γ)`` projection onto the splines of the finer edge (a penalised mortar
 condition, :func:`displacement_penalty`): the plain penalty (``Π = I``) locks on edges whose
-knots differ. A smooth continuation across ``Γ`` has ``n_b = −n_a`` and the same gradient on both sides,
-so it costs nothing; a hinge (a kink of ``d``) does. Each coordinate of the displacement is
-coupled alike (the plate's energy is scalar per coordinate), so the matrices act on the
-concatenated control points of the patches, ``(N, N)`` with ``N = Σ n_u n_v``.
+knots differ. A smooth continuation across ``Γ`` has ``n_b = −n_a`` and the same gradient on
+both sides, so it costs nothing; a hinge (a kink of ``d``) does. Each coordinate of the
+displacement is coupled alike (the plate's energy is scalar per coordinate), so the matrices
+act on the concatenated control points of the patches, ``(N, N)`` with ``N = Σ n_u n_v``; the
+shell's forms (``shell_*``) act on its interleaved unknowns, and its rotation is that of each
+side's conormal fibre about the common tangent, which keeps a crease's angle.
 
 Lengths ``ds`` and conormals come from the rest geometry. ``b``'s edge parameter is mapped
 affinely onto ``a``'s (mirrored when the interface is reversed); the quadrature runs over
