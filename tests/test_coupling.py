@@ -11,6 +11,7 @@ from splinedeform.errors import InputError
 from splinedeform.knots import KnotVectorBasis, one_sided
 from splinedeform.physics import coupling
 from splinedeform.physics.coupling_traces import merged
+from splinedeform.shapes import from_function
 from splinedeform.surface import Surface
 
 from coupling_systems import MEMBRANE, PLATE, c0_basis, flat_patch, offsets
@@ -77,6 +78,34 @@ def test_a_smooth_field_costs_nothing_and_a_kink_its_slope_jump():
                              for p, k in zip(flat, (-1.0, 1.0))])
     assert abs(kinked @ D @ kinked) <= 1e-11 * unit
     assert 0.5 * kinked @ R @ kinked == pytest.approx(4.0, rel=1e-10)
+
+
+def test_a_curved_interface_is_measured_on_the_rest_surface():
+    # two cubic fits of a quarter cylinder of radius 1, 8 and 5 spans around, meeting at
+    # z = 1/2 along an arc whose two drawings differ by their fit errors (3e-5)
+    def cylinder(u, v):
+        return np.stack([np.cos(u), np.sin(u), v], -1)
+
+    below = from_function(cylinder, cells=(8, 4), domain=((0, np.pi / 2), (0, 0.5)))
+    above = from_function(cylinder, cells=(5, 3), domain=((0, np.pi / 2), (0.5, 1.0)))
+    patches, interface = [below, above], Interface(0, "v1", 1, "v0", conforming=False)
+    o = offsets(patches)
+    D = coupling.displacement_penalty(patches, interface, 1.0, o)
+    R = coupling.rotation_penalty(patches, interface, 1.0, o)
+    # the length of the lower patch's top edge, as a polyline of 20001 points (relative
+    # error (Δs κ)² / 24 ~ 3e-10): the quadrature of the non-polynomial |x_s| to 1e-8
+    s = np.linspace(0.0, np.pi / 2, 20001)
+    edge = below.evaluate(s, np.full_like(s, 0.5))
+    length = np.linalg.norm(np.diff(edge, axis=0), axis=1).sum()
+    unit = np.concatenate([np.ones(o[1]), np.zeros(D.shape[0] - o[1])])
+    assert 0.5 * unit @ D @ unit == pytest.approx(0.5 * length, rel=1e-8)
+    # the height z is smooth across (slopes +1 and -1 out of the two sides): nothing to pay
+    # but the fit errors' share; |z - 1/2| has a slope jump of 2: ½ · 4 · |Γ| (3e-5, the fits)
+    z = np.concatenate([p.control_points[..., 2].ravel() for p in patches])
+    assert abs(z @ R @ z) <= 1e-9
+    kink = np.concatenate([0.5 - below.control_points[..., 2].ravel(),
+                           above.control_points[..., 2].ravel() - 0.5])
+    assert 0.5 * kink @ R @ kink == pytest.approx(2.0 * length, rel=3e-5)
 
 
 def test_a_reversed_interface_gives_the_same_energies():

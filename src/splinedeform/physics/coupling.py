@@ -67,6 +67,12 @@ def _sides(patches: Sequence[Surface], interface: Interface) -> tuple[Side, Side
             Side.of_edge(patches[interface.b], interface.edge_b))
 
 
+def _name(interface: Interface) -> str:
+    return (f"the interface of patch {interface.a} edge {interface.edge_a} and patch "
+            f"{interface.b} edge {interface.edge_b}"
+            + (" (reversed)" if interface.reversed else ""))
+
+
 def _penalty(jump: sp.csr_matrix, weights: Array, factor: float,
              projector: sp.csr_matrix | None = None) -> sp.csr_matrix:
     """The matrix of ``½ factor ∫ (Π J d)² ds``.
@@ -145,7 +151,7 @@ def displacement_penalty(patches: Sequence[Surface], interface: Interface, alpha
         on each coordinate alike.
     """
     side_a, side_b = _sides(patches, interface)
-    line = common_line(side_a, side_b, interface.reversed, f"interface {interface}")
+    line = common_line(side_a, side_b, interface.reversed, _name(interface))
     off_a, off_b, size = _global(patches, interface, offsets)
     jump = (_place(line.sides[0].values, off_a, size)
             - _place(line.sides[1].values, off_b, size))
@@ -160,7 +166,7 @@ def rotation_penalty(patches: Sequence[Surface], interface: Interface, beta: flo
     Same arguments, layout and projection as :func:`displacement_penalty`, with ``beta``.
     """
     side_a, side_b = _sides(patches, interface)
-    line = common_line(side_a, side_b, interface.reversed, f"interface {interface}")
+    line = common_line(side_a, side_b, interface.reversed, _name(interface))
     off_a, off_b, size = _global(patches, interface, offsets)
     jump = (_place(line.sides[0].slopes, off_a, size)
             + _place(line.sides[1].slopes, off_b, size))
@@ -200,7 +206,7 @@ def shell_rotation_penalty(patches: Sequence[Surface], interface: Interface, bet
     :func:`rotation_penalty` of the deflection.
     """
     side_a, side_b = _sides(patches, interface)
-    line = common_line(side_a, side_b, interface.reversed, f"interface {interface}")
+    line = common_line(side_a, side_b, interface.reversed, _name(interface))
     off_a, off_b, size = _global(patches, interface, offsets)
     return _penalty(_rotation_jump(line, off_a, off_b, size), line.weights, beta,
                     line.space(crosspoints))

@@ -22,8 +22,10 @@ Array = NDArray[np.float64]
 
 EXTRA_POINTS = 2
 """Gauss points per span beyond the ``max(p_a, p_b) + 1`` that integrate the products exactly."""
-GAP_TOLERANCE = 1e-6
-"""Largest distance, relative to the patches' size, between the two edges at a quadrature point."""
+GAP_TOLERANCE = 1e-3
+"""Largest distance, relative to the patches' size, between the two rest edges at a quadrature
+point. Edges drawn separately differ by their fit errors (1e-5 for two cubic fits of one
+circular arc); edges that do not belong together, or a reversal left out, by far more."""
 
 
 @dataclass(frozen=True)
