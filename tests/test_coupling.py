@@ -8,7 +8,7 @@ import pytest
 from splinedeform.basis import BSplineBasis
 from splinedeform.body import Interface
 from splinedeform.errors import InputError
-from splinedeform.knots import KnotVectorBasis, one_sided
+from splinedeform.knots import KnotVectorBasis, RationalBasis, one_sided
 from splinedeform.physics import coupling
 from splinedeform.physics.coupling_traces import merged
 from splinedeform.shapes import from_function
@@ -107,6 +107,32 @@ def test_a_curved_interface_is_measured_on_the_rest_surface():
     kink = np.concatenate([0.5 - below.control_points[..., 2].ravel(),
                            above.control_points[..., 2].ravel() - 0.5])
     assert 0.5 * kink @ R @ kink == pytest.approx(2.0 * length, rel=1e-8)
+
+
+def test_an_exact_circular_interface_of_nurbs_patches():
+    # a quarter cylinder as NURBS (weights 1, √½, 1 around), cut at z = 1/2 into 3 and 2
+    # spans of height: the interface is an exact quarter circle, π/2 long
+    around = RationalBasis(KnotVectorBasis(2, [0, 0, 0, 1, 1, 1]), [1, 0.5 ** 0.5, 1])
+    arc = np.array([[1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+
+    def wall(z0: float, cells: int) -> Surface:
+        up = BSplineBasis(2, cells, 0.5, "open")
+        g = up.greville()
+        P = np.stack(np.broadcast_arrays(arc[:, None, 0], arc[:, None, 1], z0 + g[None, :]), -1)
+        return Surface(P, around, up)
+
+    patches = [wall(0.0, 3), wall(0.5, 2)]
+    o = offsets(patches)
+    D = coupling.displacement_penalty(patches, Interface(0, "v1", 1, "v0"), 1.0, o)
+    unit = np.concatenate([np.ones(o[1]), np.zeros(D.shape[0] - o[1])])
+    # the rational basis' own 14 Gauss points per span: round-off, 1e-13
+    assert 0.5 * unit @ D @ unit == pytest.approx(np.pi / 4, rel=1e-13)
+    # inside a span the one-sided values of a rational basis are its values (round-off)
+    index, values = around.nonzero_derivatives(0.3, 1)
+    for side in (-1, 1):
+        i, v = one_sided(around, 0.3, side, 1)
+        np.testing.assert_array_equal(i, index)
+        np.testing.assert_allclose(v, values, rtol=1e-14, atol=1e-14)
 
 
 def test_a_reversed_interface_gives_the_same_energies():

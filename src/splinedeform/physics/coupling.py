@@ -24,9 +24,10 @@ side's conormal fibre about the common tangent, which keeps a crease's angle.
 
 Lengths ``ds`` and conormals come from the rest geometry. ``b``'s edge parameter is mapped
 affinely onto ``a``'s (mirrored when the interface is reversed); the quadrature runs over
-the union of both edges' knot spans, with :data:`EXTRA_POINTS` more Gauss points than the
-products of the two edges' polynomials need (the measure ``|x_s|`` is constant on a straight
-edge parametrised uniformly, and smooth otherwise).
+the union of both edges' knot spans, with
+:data:`~splinedeform.physics.coupling_traces.EXTRA_POINTS` more Gauss points than the products
+of the two edges' polynomials need (the measure ``|x_s|`` is constant on a straight edge
+parametrised uniformly, and smooth otherwise), or a rational basis' own number.
 
 The factors come from the material and the mesh (:func:`penalty_factors`), as in
 PENGoLINS: ``α = C (A / h)``, ``β = C (D / h)`` with the membrane stiffness ``A``, the bending
@@ -164,6 +165,9 @@ def rotation_penalty(patches: Sequence[Surface], interface: Interface, beta: flo
     """Matrix of ``½ β ∫_Γ (Π (∂_{n_a} d_a + ∂_{n_b} d_b))² ds`` (outward conormals).
 
     Same arguments, layout and projection as :func:`displacement_penalty`, with ``beta``.
+    Each coordinate's slope is tied, which is the smooth continuation where the rest
+    shape is ``G1`` (``n_b = −n_a``); across a crease the scalar energies have no rotation
+    to keep, and :func:`shell_rotation_penalty` keeps the shell's angle.
     """
     side_a, side_b = _sides(patches, interface)
     line = common_line(side_a, side_b, interface.reversed, _name(interface))

@@ -114,10 +114,16 @@ class Side:
         return Trace(V, Dn.tocsr(), x, speed, x_r / speed[:, None],
                      self.outward * across_line / length[:, None])
 
+    def points(self) -> int:
+        """Gauss points per span along the line: ``n + 1 +`` :data:`EXTRA_POINTS`, or a
+        rational basis' own (its functions are not polynomials)."""
+        running = self.running
+        return max(running.degree + 1 + EXTRA_POINTS, getattr(running, "points_per_cell", 0))
+
     def element_size(self) -> float:
         """Mean length of the line's knot spans on the rest surface, ``h = |Γ| / spans``."""
         breaks = self.breaks
-        s, w = gauss(breaks, self.running.degree + 1 + EXTRA_POINTS)
+        s, w = gauss(breaks, self.points())
         return float(w @ self.traces(s).speed) / (breaks.size - 1)
 
 
@@ -167,8 +173,7 @@ def common_line(side_a: Side, side_b: Side, reversed_: bool, where: str) -> Line
     unit_a = (side_a.breaks - lo_a) / (hi_a - lo_a)
     unit_b = (side_b.breaks - lo_b) / (hi_b - lo_b)
     breaks = union(unit_a, 1.0 - unit_b if reversed_ else unit_b)
-    degree = max(side_a.running.degree, side_b.running.degree)
-    sigma, w = gauss(breaks, degree + 1 + EXTRA_POINTS)
+    sigma, w = gauss(breaks, max(side_a.points(), side_b.points()))
     s_a = lo_a + (hi_a - lo_a) * sigma
     s_b = lo_b + (hi_b - lo_b) * ((1.0 - sigma) if reversed_ else sigma)
     trace_a, trace_b = side_a.traces(s_a), side_b.traces(s_b)
