@@ -130,7 +130,7 @@ def test_a_c0_line_with_the_rotation_penalty_bends_like_the_smooth_plate():
     # differ by a tenth of the smooth 8 × 8 plate's own error at most (measured: 1e-6 of
     # the deflection against 1.4e-4)
     assert abs(w - smooth) <= 0.1 * error
-    # the slope jump across the line, against the largest slope (measured: 4e-6 at C = 1e5)
+    # the slope jump across the line, against the largest slope (measured: 5.6e-6 at C = 1e5)
     v = np.linspace(0.0, 1.0, 41)
     net = d.reshape(surface.shape + (1,))
     below = surface.derivative(0.5 - 1e-12, v, 1, 0, net)      # the last point of the left span
@@ -138,7 +138,7 @@ def test_a_c0_line_with_the_rotation_penalty_bends_like_the_smooth_plate():
     x = np.linspace(0.0, 1.0, 81)
     slopes = surface.derivative(x[:, None], x[None, :], 1, 0, net)
     jump = np.abs(above - below).max() / np.abs(slopes).max()
-    assert jump < 1e-4
+    assert jump < 1e-5
     # without it the line is a hinge
     surface, d = c0_centre(0.0)
     assert value(surface, d, 0.5, 0.5) / reference > 1.1
