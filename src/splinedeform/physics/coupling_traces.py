@@ -145,9 +145,8 @@ class Line:
     """Both sides' traces at common quadrature points of ``Γ`` and the weights ``ds``.
 
     ``sides`` are the two :class:`Trace` (columns of each side's own net); ``projector`` is
-    the finer side's
-    running basis at the points, ``(Q, n_r)``, the space a jump is measured in, and
-    ``mirrored`` whether its functions run against ``a``'s parameter.
+    the finer side's running basis at the points, ``(Q, n_r)``, the space a jump is measured
+    in, and ``mirrored`` whether its functions run against ``a``'s parameter.
     """
 
     sides: tuple[Trace, Trace]
