@@ -198,3 +198,13 @@ def test_the_projection_needs_a_trace_space_longer_than_its_merged_ends():
     space = merged(BSplineBasis(3, 5, 1.0, "open").matrix([0.1, 0.5, 0.9]), 2, 1)
     assert space.shape == (3, 5)
     np.testing.assert_allclose(np.asarray(space.sum(axis=1)).ravel(), 1.0, rtol=1e-14)
+
+
+def test_bad_ends_and_factors_are_refused_by_name():
+    patches = two_patches()
+    with pytest.raises(InputError, match="interface end is one of .*'glued'"):
+        coupling.interface_penalty(patches, SPLIT, PLATE, offsets(patches), ("glued", "free"))
+    with pytest.raises(InputError, match="penalty factor is finite and >= 0"):
+        coupling.rotation_penalty(patches, SPLIT, -1.0, offsets(patches))
+    with pytest.raises(InputError, match="offsets has 1 entries for 2 patches"):
+        coupling.displacement_penalty(patches, SPLIT, 1.0, [0])
