@@ -293,16 +293,68 @@ class RationalBasis:
                             ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
         """Indices and ``D^j R_k(x)``, ``j = 0..max_derivative`` (shapes as the polynomial basis)."""
         index, b = self.basis.nonzero_derivatives(x, max_derivative)
+        return index, self.rational(index, b)
+
+    def rational(self, index: NDArray[np.int64], b: NDArray[np.float64]) -> NDArray[np.float64]:
+        """``D^j R_k`` from the polynomial ``D^j N_k`` (``b[j]``) of the functions ``index``."""
         wb = b * self.weights[index]                 # w_k D^j N_k
         W = wb.sum(axis=-1, keepdims=True)           # D^j W
         R = np.empty_like(wb)
-        for j in range(max_derivative + 1):
+        for j in range(b.shape[0]):
             acc = wb[j].copy()
             for i in range(1, j + 1):
                 acc -= comb(j, i) * W[i] * R[j - i]
             R[j] = acc / W[0]
-        return index, R
+        return R
 
     nonzero = KnotVectorBasis.nonzero
     matrix = KnotVectorBasis.matrix
     __call__ = KnotVectorBasis.__call__
+
+
+def one_sided(basis: object, x: float, side: int, max_derivative: int = 1
+              ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    """The ``n + 1`` functions of the span on one side of ``x`` and their one-sided derivatives.
+
+    ``side = -1`` takes the span ending at ``x`` (the limits from below), ``side = +1`` the
+    span starting there (from above); inside a span both are the ordinary values. At a
+    ``C^0`` knot the first derivatives of the two sides differ, which is what a coupling
+    across it compares. The span's Bézier form (:mod:`splinedeform.spans`) is evaluated at
+    its local end parameter ``s = 1`` or ``s = 0`` exactly.
+
+    Parameters
+    ----------
+    basis : BSplineBasis, KnotVectorBasis or RationalBasis
+    x : float
+        A parameter in the domain.
+    side : {-1, +1}
+    max_derivative : int
+
+    Returns
+    -------
+    index : ndarray of int, shape ``(n + 1,)``
+    values : ndarray, shape ``(max_derivative + 1, n + 1)``
+        ``D^j`` of those functions at ``x`` from the chosen side.
+
+    Examples
+    --------
+    >>> b = KnotVectorBasis(2, [0, 0, 0, 0.5, 0.5, 1, 1, 1])
+    >>> below, above = one_sided(b, 0.5, -1)[1][1], one_sided(b, 0.5, +1)[1][1]
+    >>> [float(v) for v in below], [float(v) for v in above]
+    ([0.0, -4.0, 4.0], [-4.0, 4.0, 0.0])
+    """
+    if side not in (-1, 1):
+        raise InputError(f"side is -1 (from below) or +1 (from above), got {side!r}")
+    polynomial = basis.basis if isinstance(basis, RationalBasis) else basis
+    breaks = getattr(polynomial, "breaks", None)
+    if breaks is None:                               # equal cells of a BSplineBasis
+        breaks = np.arange(polynomial.cells + 1) * polynomial.h
+    x = float(polynomial._check_points(x))
+    span = int(np.searchsorted(breaks, x, side="left" if side < 0 else "right")) - 1
+    span = min(max(span, 0), breaks.size - 2)
+    s = (x - breaks[span]) / (breaks[span + 1] - breaks[span])
+    values = polynomial.form.values(np.array([span]), np.array([s]), max_derivative)[:, 0]
+    index = polynomial.span_functions()[span]
+    if isinstance(basis, RationalBasis):
+        values = basis.rational(index, values)
+    return index, values
