@@ -20,6 +20,7 @@ from typing import Any, Sequence, Union
 
 from .cad import CAD_SUFFIXES, NurbsPatch, surface_from_patch
 from .cad_child import check_cad_file, read_in_child
+from .cad_faces import is_trimmed
 from .cad_topology import Topology, body_topology
 from .errors import InputError, InputWarning
 
@@ -138,7 +139,7 @@ def read_body(path: str | os.PathLike, faces: FaceChoice = "all"
         except InputError as exc:
             skipped[number] = str(exc)
             continue
-        if entry.get("trimmed"):
+        if is_trimmed(entry):
             trimmed.append(number)
             warnings.warn(f"{source} is trimmed; its whole underlying surface is used",
                           InputWarning, stacklevel=2)

@@ -71,14 +71,27 @@ def _describe(number: int, entry: dict[str, Any]) -> dict[str, Any]:
     points, w = np.asarray(entry["points"], float), np.asarray(entry["weights"], float)
     whole = area(bases, points, w)
     inside = entry.get("trimmed_area")
-    trimmed = bool(entry["trimmed"]) or (inside is not None and
-                                         abs(inside) < whole * (1 - TRIM_AREA_TOL))
+    trimmed = is_trimmed(entry, whole)
     return {**out, "degrees": list(degrees), "net": list(w.shape), "weights": _weights(w),
             "trimmed": trimmed, "closed": [bool(c) for c in entry["closed"]],
             "periodic": [bool(c) for c in entry["periodic"]],
             "c0_knots": {d: [float(x) for x in b.c0_knots] for d, b in zip("uv", bases)},
             "degenerate": degenerate_edges(points), "area": whole,
             "trimmed_area": None if inside is None else abs(float(inside))}
+
+
+def is_trimmed(entry: dict[str, Any], whole: float | None = None) -> bool:
+    """Whether a listed face is trimmed: so read, or (STEP / IGES) its area inside its loops
+    is below its surface's ``whole`` area (computed if not given) by :data:`TRIM_AREA_TOL`."""
+    inside = entry.get("trimmed_area")
+    if entry["trimmed"] or inside is None:
+        return bool(entry["trimmed"])
+    if whole is None:
+        bases = [KnotVectorBasis(int(n), np.asarray(t, dtype=float))
+                 for n, t in zip(entry["degrees"], (entry["knots_u"], entry["knots_v"]))]
+        whole = area(bases, np.asarray(entry["points"], float),
+                     np.asarray(entry["weights"], float))
+    return bool(abs(inside) < whole * (1 - TRIM_AREA_TOL))
 
 
 def _weights(w: NDArray[np.float64]) -> str:
