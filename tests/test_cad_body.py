@@ -183,3 +183,65 @@ def test_a_step_body_in_metres_keeps_its_unit(tmp_path):
     # the file's numbers (millimetres divided by 1000 twice over: round-off)
     extent = np.ptp(np.concatenate([s.control_points.reshape(-1, 3) for s in surfaces]), axis=0)
     assert extent == pytest.approx([1e-3, 2e-3, 3e-3], rel=1e-12)
+
+
+# -- the scenario key surface.faces -----------------------------------------------------------
+def cad_scenario(folder, source, surface: str):
+    """A scenario reading ``source`` (copied beside it) with the ``[surface]`` lines given."""
+    import shutil
+
+    shutil.copy(source, folder / source.name)
+    path = folder / "case.toml"
+    path.write_text(f'[surface]\nshape = "cad"\npath = "{source.name}"\n{surface}\n'
+                    '[material]\nw10 = 1.0\nw01 = 1.0\n[boundary]\nu0 = "pinned"\n'
+                    '[[load]]\nkind = "pressure"\nq = -1.0\n[solve]\nkind = "static"\n')
+    return path
+
+
+def scenario_error(path) -> str:
+    from splinedeform.errors import ScenarioError
+    from splinedeform.scenario import build, load_scenario
+
+    with pytest.raises(ScenarioError) as info:
+        build(load_scenario(path))
+    return str(info.value)
+
+
+def test_one_face_chosen_by_number_is_read_as_face_is(solids_3dm, tmp_path):
+    from splinedeform.scenario import build, load_scenario
+
+    by_faces = build(load_scenario(cad_scenario(tmp_path, solids_3dm, 'faces = [3]')))
+    by_face = build(load_scenario(cad_scenario(tmp_path, solids_3dm, 'face = 3')))
+    # the same face read by the same reader twice: the same numbers
+    np.testing.assert_array_equal(by_faces.surface.control_points,
+                                  by_face.surface.control_points)
+    assert by_faces.units == by_face.units == "in"
+
+
+def test_faces_are_checked_where_they_are_given(solids_3dm, tmp_path):
+    message = scenario_error(cad_scenario(tmp_path, solids_3dm, 'faces = ["lid"]'))
+    assert "surface.faces" in message and "no object or layer is named 'lid'" in message
+    assert "'ball', 'box', 'can', 'walls'" in message
+    message = scenario_error(cad_scenario(tmp_path, solids_3dm, 'faces = [12]'))
+    assert "surface.faces" in message and "face 12 out of range" in message
+    message = scenario_error(cad_scenario(tmp_path, solids_3dm, 'face = 1\nfaces = [2]'))
+    assert "surface.faces: give face (one face) or faces (a body), not both" in message
+    message = scenario_error(cad_scenario(tmp_path, solids_3dm, 'faces = "some"'))
+    assert "surface.faces" in message and 'expected "all" or an array of integers' in message
+    message = scenario_error(cad_scenario(tmp_path, solids_3dm, 'faces = [1, "box"]'))
+    assert "surface.faces" in message
+
+
+def test_a_body_of_several_faces_is_read(solids_3dm, tmp_path):
+    import importlib.util
+
+    path = cad_scenario(tmp_path, solids_3dm, 'faces = ["box"]')
+    if importlib.util.find_spec("splinedeform.body.model") is None:
+        message = scenario_error(path)
+        assert ("surface.faces: multi-face bodies are read (6 faces, 12 shared edges, 0 "
+                "seam(s)); running them needs BodyModel") in message
+    else:                                   # pragma: no cover - once bodies run
+        from splinedeform.body.body import Body
+        from splinedeform.scenario import build, load_scenario
+
+        assert isinstance(build(load_scenario(path)).surface, Body)

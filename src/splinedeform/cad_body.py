@@ -66,6 +66,8 @@ def choose_faces(listing: dict[str, Any], faces: FaceChoice, source: str) -> lis
     """The file face numbers chosen by ``faces`` (see :func:`read_body`), in file order
     for ``"all"`` and names, in the order given for numbers."""
     entries = listing["faces"]
+    if not entries:
+        raise InputError(f"{source}: the file holds no surface")
     if isinstance(faces, str):
         if faces != "all":
             raise InputError(f"{source}: faces must be \"all\", a list of face numbers or a "
@@ -118,9 +120,13 @@ def read_body(path: str | os.PathLike, faces: FaceChoice = "all"
     """
     path = Path(path)
     listing = read_listing(path)
-    if not listing["faces"]:
-        raise InputError(f"{path}: the file holds no surface")
-    chosen = choose_faces(listing, faces, str(path))
+    return body_of(path, listing, choose_faces(listing, faces, str(path)))
+
+
+def body_of(path: Path, listing: dict[str, Any], chosen: list[int]
+            ) -> tuple[list[Any], Topology, dict[str, Any]]:
+    """What :func:`read_body` returns, for the faces ``chosen`` of a file's listing
+    (:func:`read_listing`, :func:`choose_faces`)."""
     patches = patches_of(listing)
     surfaces, kept, skipped, trimmed = [], [], {}, []
     seams = _seam_faces(listing, patches, chosen)
