@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 from .body.interface import Interface
 from .cad import SEAM_TOL, WEIGHT_TOL, NurbsPatch
 from .cad_3dm_read import TRIM_SAMPLES, TRIM_TOL
+from .knots import KnotVectorBasis
 
 #: knots along two edges within this distance (on ``[0, 1]``) are the same knot
 KNOT_TOL = 1e-9
@@ -70,15 +71,23 @@ def _size(patch: NurbsPatch) -> float:
 
 def side_curves(patch: NurbsPatch) -> dict[str, NDArray[np.float64]]:
     """The four sides of the patch's parameter rectangle sampled at
-    :data:`~splinedeform.cad_3dm_read.TRIM_SAMPLES` points each, in increasing parameter."""
-    (nu, nv), ku, kv = patch.degrees, np.asarray(patch.knots_u), np.asarray(patch.knots_v)
-    (u0, u1), (v0, v1) = (ku[nu], ku[ku.size - nu - 1]), (kv[nv], kv[kv.size - nv - 1])
+    :data:`~splinedeform.cad_3dm_read.TRIM_SAMPLES` points each, in increasing parameter:
+    ``S = (B_u H B_vᵀ)_xyz / (B_u H B_vᵀ)_w`` on the homogeneous net ``H = (w P, w)``, with
+    the collocation matrices of the samples built once per direction (their first and
+    last rows are the rectangle's sides)."""
     s = np.linspace(0.0, 1.0, TRIM_SAMPLES)
-    us, vs = u0 + (u1 - u0) * s, v0 + (v1 - v0) * s
-    return {"u0": patch.evaluate(np.array([u0]), vs)[0],
-            "u1": patch.evaluate(np.array([u1]), vs)[0],
-            "v0": patch.evaluate(us, np.array([v0]))[:, 0],
-            "v1": patch.evaluate(us, np.array([v1]))[:, 0]}
+    B = []
+    for n, knots in zip(patch.degrees, (patch.knots_u, patch.knots_v)):
+        basis = KnotVectorBasis(n, np.asarray(knots, dtype=float))
+        lo, hi = basis.domain
+        B.append(basis(lo + (hi - lo) * s))
+    Bu, Bv = B
+    w = np.asarray(patch.weights, dtype=float)
+    H = np.concatenate([np.asarray(patch.points, float) * w[..., None], w[..., None]], -1)
+    u_sides = np.einsum("ai,ijc,bj->abc", Bu[[0, -1]], H, Bv)        # (2, S, 4)
+    v_sides = np.einsum("ai,ijc,bj->bac", Bu, H, Bv[[0, -1]])        # (2, S, 4)
+    (u0, u1), (v0, v1) = (sides[..., :3] / sides[..., 3:] for sides in (u_sides, v_sides))
+    return {"u0": u0, "u1": u1, "v0": v0, "v1": v1}
 
 
 def place_on_side(curve: NDArray[np.float64], points: NDArray[np.float64]
