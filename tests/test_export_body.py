@@ -82,6 +82,35 @@ def test_step_holds_every_face_in_the_file_unit(box, tmp_path):
         # OpenCASCADE reads every file in millimetres: inches × 25.4 (written and read back,
         # two roundings of a product: 1e-12 of the size)
         np.testing.assert_allclose(got / 25.4, P, rtol=0, atol=1e-12 * 3)
+    # one shell: each of the box's 12 edges is shared by two faces (OpenCASCADE's count)
+    assert _faces_per_edge(reader.OneShape()) == [2] * 12
+    # and read as a body again: the 12 interfaces of the box, conforming
+    _, topology, info = read_body(path)
+    assert info["units"] == "in" and topology.counts["shared"] == 12
+    assert len(topology.interfaces) == 12 and all(i.conforming for i in topology.interfaces)
+
+
+def _faces_per_edge(shape):
+    from OCP.OCP.collections import \
+        IndexedDataMap_TopoDS_Shape_List_TopoDS_Shape_TopTools_ShapeMapHasher as EdgeMap
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
+    from OCP.TopExp import TopExp
+
+    ancestors = EdgeMap()
+    TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, ancestors)
+    return [ancestors.FindFromIndex(k).Size() for k in range(1, ancestors.Extent() + 1)]
+
+
+def test_step_faces_stay_apart_unless_sewn(box, tmp_path):
+    pytest.importorskip("OCP", reason="the 'cad-step' extra (cadquery-ocp) is not installed")
+    from OCP.STEPControl import STEPControl_Reader
+
+    surfaces, _, nets, units = box
+    path = write_body_step(tmp_path / "faces.step", surfaces, nets, units=units, shell=False)
+    reader = STEPControl_Reader()
+    assert reader.ReadFile(str(path)) == 1
+    reader.TransferRoots()
+    assert _faces_per_edge(reader.OneShape()) == [1] * 24      # 6 faces of 4 free edges
 
 
 def test_the_mesh_is_welded_along_the_shared_edges(box, tmp_path):
