@@ -150,7 +150,11 @@ def write_solids_step(path, unit="MM"):
         builder.Add(compound, BRepBuilderAPI_NurbsConvert(shape, True).Shape())
     writer = STEPControl_Writer()
     Interface_Static.SetCVal_s("write.step.unit", unit)
-    assert writer.Transfer(compound, STEPControl_AsIs) == 1 and writer.Write(str(path)) == 1
+    try:
+        assert writer.Transfer(compound, STEPControl_AsIs) == 1
+        assert writer.Write(str(path)) == 1
+    finally:                     # a process-wide setting: later writers get millimetres
+        Interface_Static.SetCVal_s("write.step.unit", "MM")
     return path
 
 

@@ -23,9 +23,10 @@ RESOLUTION = 5
 
 @pytest.fixture(scope="module")
 def box(tmp_path_factory):
-    """A 1 × 2 × 3 box of 6 bilinear faces in inches (rhino3dm), and a deformed net per face: the smooth field ``d(x) = 0.01 (sin x_1,
-    cos x_2, x_0 x_1)`` applied to the control points of every face, which moves the points
-    of a shared edge alike (they are the same points), so the seams stay closed."""
+    """A 1 × 2 × 3 box of 6 bilinear faces in inches (rhino3dm), and a deformed net per
+    face: the smooth field ``d(x) = 0.01 (sin x_1, cos x_2, x_0 x_1)`` applied to the
+    control points of every face, which moves the points of a shared edge alike (they are
+    the same points), so the seams stay closed."""
     path = tmp_path_factory.mktemp("box") / "box.3dm"
     model = r3.File3dm()
     model.Settings.ModelUnitSystem = r3.UnitSystem.Inches

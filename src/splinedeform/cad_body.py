@@ -2,7 +2,7 @@
 
 :func:`read_body` reads every face of a ``.3dm``, STEP or IGES file once, in the reader
 child (:func:`splinedeform.cad_3dm_read.list_3dm_body`,
-:func:`splinedeform.cad_step_read.list_step_body`), keeps the faces chosen (``"all"``,
+:func:`splinedeform.cad_step_edges.list_step_body`), keeps the faces chosen (``"all"``,
 face numbers as ``splinedeform faces`` lists them, or object names and layers), makes
 each a deformable :class:`~splinedeform.surface.Surface`
 (:func:`splinedeform.cad.surface_from_patch`) and finds the interfaces between them from
@@ -42,7 +42,8 @@ def read_listing(path: Path) -> dict[str, Any]:
         return read_in_child(list_3dm_body, path, library="openNURBS (rhino3dm)")
     import importlib.util
 
-    from .cad_step_read import MISSING, list_step_body
+    from .cad_step_edges import list_step_body
+    from .cad_step_read import MISSING
 
     if importlib.util.find_spec("OCP") is None:  # pragma: no cover - the installation
         raise InputError(MISSING)

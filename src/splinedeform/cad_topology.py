@@ -1,7 +1,7 @@
 """The topology of a CAD body from its file: which face edges are shared, free or seams.
 
 The readers (:func:`splinedeform.cad_3dm_read.list_3dm_body`, openNURBS Brep edges and
-the trims of every face's loops; :func:`splinedeform.cad_step_read.list_step_body`,
+the trims of every face's loops; :func:`splinedeform.cad_step_edges.list_step_body`,
 OpenCASCADE's ``TopExp.MapShapesAndAncestors(shape, EDGE, FACE)``) give each edge of the
 file with the faces that use it (a seam: its face twice) and points sampled inside it.
 Here each use is placed on a side of its face's parameter rectangle (``u0``, ``u1``,
