@@ -266,3 +266,11 @@ def test_a_face_that_cannot_be_deformed_is_skipped_and_said_why(tmp_path):
     assert topology.counts == dict.fromkeys(topology.counts, 0)   # plain surfaces: no edges
     with pytest.raises(InputError, match="none of the faces chosen can be deformed: face 0: "):
         read_body(path, [0])
+
+
+def test_a_file_without_surfaces_is_the_path_s_fault(tmp_path):
+    empty = tmp_path / "src" / "empty.3dm"
+    empty.parent.mkdir()
+    r3.File3dm().Write(str(empty), 7)
+    message = scenario_error(cad_scenario(tmp_path, empty, 'faces = "all"'))
+    assert "surface.path" in message and "empty.3dm: the file holds no surface" in message

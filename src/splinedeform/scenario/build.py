@@ -134,6 +134,8 @@ def _body_from_cad(scenario: Scenario) -> tuple[Any, int, str | None]:
     path, faces = spec.path, spec.parameters["faces"]
     with _located(scenario, "surface.path"):
         listing = read_listing(path)
+        if not listing["faces"]:
+            raise InputError(f"{path}: the file holds no surface")
     with _located(scenario, "surface.faces"):
         chosen = choose_faces(listing, list(faces) if isinstance(faces, tuple) else faces,
                               str(path))
