@@ -182,7 +182,9 @@ FILE_TEXTS = [file_scenario("net.json", "frame = 0"),
               file_scenario("grid.npy", 'cells = 3\ndegree = 2\nknots = ["open", "open"]\n'
                                         'method = "l2"'),
               file_scenario("patch.3dm", 'face = 1\nunits = "in"\nrefine = {u = 2, v = 1}\n'
-                                         'elevate = [0, 1]').replace('"file"', '"cad"')]
+                                         'elevate = [0, 1]').replace('"file"', '"cad"'),
+              # several faces of a CAD file: run by tests/test_cad_body.py on files built there
+              file_scenario("solids.3dm", 'faces = ["box"]').replace('"file"', '"cad"')]
 
 
 def all_test_texts() -> list[str]:

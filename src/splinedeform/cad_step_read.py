@@ -286,9 +286,18 @@ def list_step_arrays(path: Path) -> dict[str, Any]:
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS_Iterator
 
+    return faces_listing(path, *read_faces(path))
+
+
+def faces_listing(path: Path, reader: Any, faces: list[Any], units: str | None
+                  ) -> dict[str, Any]:
+    """What :func:`list_step_arrays` returns, of a file already read."""
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS_Iterator
+
     iges = path.suffix.lower() in IGES_SUFFIXES
     bad_weights = iges_bad_weights(path) if iges else {}
-    reader, faces, units = read_faces(path)
     shape = reader.OneShape()
     children = []
     iterator = TopoDS_Iterator(shape)
@@ -351,3 +360,4 @@ def _wires(face: Any) -> int:
         count += 1
         explorer.Next()
     return count
+

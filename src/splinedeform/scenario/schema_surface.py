@@ -119,6 +119,10 @@ class FromFile(_Fitted):
             "which frame of a control net file (negative counts from the end)"))
 
 
+FaceNumber = Annotated[int, Strict(), Field(ge=0)]
+FaceName = Annotated[str, Strict(), Field(min_length=1)]
+
+
 class FromCad(_Refined):
     shape: Literal["cad"]
     path: Text = Field(
@@ -130,6 +134,14 @@ class FromCad(_Refined):
     face: Annotated[int, Strict(), Field(ge=0)] = Field(0, description=(
             "which surface of the file, counting plain surfaces and Brep faces in file "
             "order from 0; a trimmed face is taken untrimmed, with a warning"))
+    faces: Optional[Union[Literal["all"], Annotated[list[FaceNumber], Field(min_length=1)],
+                          Annotated[list[FaceName], Field(min_length=1)]]] = Field(
+        None, description=(
+            "several faces read as one body: `\"all\"` (every face of every surface object), "
+            "face numbers (as `splinedeform faces FILE` lists them) or names of objects or "
+            "layers (`.3dm`), with the file's topology (shared edges, seams); one face "
+            "chosen is the same as `face`; not with `face`"),
+        json_schema_extra={"doc_default": "`face` alone"})
     units: Optional[Literal[CAD_UNITS]] = Field(  # type: ignore[valid-type]
         None, description=(
             "length unit of the file's coordinates, overriding the unit the file declares "
