@@ -1,0 +1,262 @@
+"""Trim loops of CAD faces: read as Bézier pieces in the deformed surface's parameters.
+
+:func:`read_trims` gives the :class:`~splinedeform.trim.loops.TrimDomain` of face
+``face`` of a ``.3dm``, STEP or IGES file in the parameters of the surface that
+:func:`splinedeform.cad.surface_from_patch` makes of the same face: the file's ``(u, v)``
+moved by the origin ``(u_0, v_0)`` of the surface's knot vectors, so that the domain
+starts at 0. Loops are chains of trim curves, each fitted with Bézier pieces
+(:mod:`splinedeform.trim.bezier`): exactly where a trim is polynomial in the surface's
+parameters, within :data:`FIT_TOL` of the face's parameter box (its diagonal) where it is
+rational or must be found by projection. Consecutive trims must meet within
+:data:`GAP_TOL`. A loop of straight pieces is a :class:`~splinedeform.trim.loops.PolygonLoop`,
+any other a :class:`~splinedeform.trim.piecewise_loop.PiecewiseLoop`; the
+:class:`TrimDomain` orients them (outer counter-clockwise, holes clockwise).
+
+``.3dm``: rhino3dm (8.x) gives a Brep face's loops (outer / inner), their trims in order
+and each trim's edge and direction, but not the trims' 2-D curves. The 2-D curve is
+therefore the trim's 3-D edge (a NURBS curve) pulled back onto the face's NURBS surface:
+each point ``X(t)`` of the edge is projected, ``(u, v) = argmin |S(u, v) - X(t)|`` by
+Gauss–Newton steps ``[S_u S_v] Δ = X - S`` from the nearest point of a
+:data:`SEED_GRID`² grid. On a surface affine in ``(u, v)`` (a plane) this is the exact
+preimage. A trim without an edge (a singular trim at a pole) is the straight segment
+joining its neighbours. A trim curve on a seam of a closed surface is refused: which of
+the seam's two sides it lies on is not known without its 2-D curve.
+
+STEP / IGES: the pcurves themselves (:mod:`splinedeform.cad_trims_step`).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .cad_child import check_cad_file, read_in_child
+from .errors import InputError
+from .trim.bezier import fit_pieces, join_loop
+from .trim.loops import Loop, PolygonLoop, TrimDomain
+from .trim.piecewise_loop import PiecewiseLoop
+
+#: distance (relative to the diagonal of the face's parameter box) within which the Bézier
+#: pieces of a rational or projected trim curve follow it
+FIT_TOL = 1e-10
+#: distance (same measure) within which one trim's end must meet the next one's start
+GAP_TOL = 1e-6
+#: seeds per side for projecting edge points on a .3dm face's surface
+SEED_GRID = 33
+
+
+def read_trims(path: str | os.PathLike, face: int = 0) -> TrimDomain | None:
+    """The trim loops of face ``face`` of a CAD file as a :class:`TrimDomain` in the
+    parameters of :func:`~splinedeform.cad.surface_from_patch` (module docstring); None for
+    a plain surface of a ``.3dm`` file (no Brep: nothing trims it). An untrimmed Brep
+    face's outer loop is its parameter rectangle."""
+    from .cad import CAD_SUFFIXES
+
+    path = Path(path)
+    kind = CAD_SUFFIXES.get(path.suffix.lower())
+    if kind is None:
+        raise InputError(f"{path}: not a CAD file (expected one of "
+                         f"{', '.join(CAD_SUFFIXES)}), got suffix {path.suffix or 'none'!r}")
+    check_cad_file(path)
+    if isinstance(face, bool) or not isinstance(face, int) or face < 0:
+        raise InputError(f"{path}: face {face!r} out of range; faces are numbered from 0")
+    if kind == "openNURBS":
+        from .cad_3dm_read import _rhino3dm
+
+        _rhino3dm()
+        data = read_in_child(trim_arrays_3dm, path, face, library="openNURBS (rhino3dm)")
+    else:
+        from .cad_step_read import ocp
+        from .cad_trims_step import step_trim_arrays
+
+        ocp()
+        data = read_in_child(step_trim_arrays, path, face, library="OpenCASCADE")
+    return domain_from_arrays(data, f"{path} face {face}")
+
+
+def pieces_arrays(loops: list[list[NDArray[np.float64]]], box: NDArray[np.float64],
+                  gap: float, source: str) -> dict[str, Any]:
+    """``{"box": (u0, u1, v0, v1), "loops": [(K, n + 1, 2), ...]}``: each loop's trims
+    joined (:func:`~splinedeform.trim.bezier.join_loop`), the outer loop first."""
+    joined = [join_loop(trims, gap, f"{source} loop {k}") for k, trims in enumerate(loops)]
+    return {"box": np.asarray(box, dtype=float), "loops": joined}
+
+
+def domain_from_arrays(data: dict[str, Any], source: str) -> TrimDomain | None:
+    """The :class:`TrimDomain` of :func:`pieces_arrays`' result, moved to start at 0."""
+    if data.get("loops") is None:
+        return None
+    origin = np.asarray(data["box"], dtype=float)[[0, 2]]
+    loops: list[Loop] = []
+    for number, pieces in enumerate(data["loops"]):
+        pieces = np.asarray(pieces, dtype=float) - origin
+        try:
+            if _straight(pieces):
+                loops.append(PolygonLoop(pieces[:, 0]))
+            else:
+                loops.append(PiecewiseLoop.from_pieces(pieces))
+        except InputError as exc:
+            raise InputError(f"{source} loop {number}: {exc}") from None
+    try:
+        return TrimDomain(loops[0], tuple(loops[1:]))
+    except InputError as exc:
+        raise InputError(f"{source}: {exc}") from None
+
+
+def _straight(pieces: NDArray[np.float64]) -> bool:
+    """Whether every piece is a straight segment: its Bézier points on its chord within
+    ``1e-13`` of the loop's size (round-off of the fit)."""
+    a, b = pieces[:, :1], pieces[:, -1:]
+    chord = b - a
+    cross = chord[..., 0] * (pieces - a)[..., 1] - chord[..., 1] * (pieces - a)[..., 0]
+    size = max(float(np.ptp(pieces.reshape(-1, 2), axis=0).max()), 1e-300)
+    return bool(np.all(np.abs(cross) <= 1e-13 * size * np.hypot(*chord.T)[..., None]))
+
+
+def loop_pieces(loop: Loop) -> NDArray[np.float64]:
+    """Bézier pieces ``(K, n + 1, 2)`` of a polygon or piecewise loop (as oriented)."""
+    if isinstance(loop, PiecewiseLoop):
+        return loop.pieces
+    if isinstance(loop, PolygonLoop):
+        a, b = loop.segments()
+        return np.stack([a, b], axis=1)
+    raise InputError(f"a {type(loop).__name__} has no Bézier pieces")
+
+
+# --- .3dm: run in the reader child ------------------------------------------------------
+
+def trim_arrays_3dm(path: Path, face: int) -> dict[str, Any]:
+    """The loops of face ``face`` of a ``.3dm`` file as Bézier pieces (module docstring);
+    ``{"loops": None}`` for a plain surface."""
+    from .cad_3dm_read import _objects, _rhino3dm
+
+    r3 = _rhino3dm()
+    model = r3.File3dm.Read(str(path))
+    if model is None:
+        raise InputError(f"{path}: not a .3dm (openNURBS) file")
+    found = []
+    for _, _, geometry in _objects(model, r3):
+        if isinstance(geometry, r3.Brep):
+            found += [(geometry, f) for f in geometry.Faces]
+        else:
+            found.append((None, geometry))
+    if not 0 <= face < len(found):
+        raise InputError(f"{path}: face {face!r} out of range; the file holds "
+                         f"{len(found)} surface(s), numbered 0..{len(found) - 1}")
+    brep, member = found[face]
+    if brep is None:
+        return {"loops": None}
+    return brep_face_trims(brep, member, f"{path} face {face}")
+
+
+def brep_face_trims(brep: Any, brep_face: Any, source: str) -> dict[str, Any]:
+    """A rhino3dm Brep face's loops, outer first, as Bézier pieces (module docstring)."""
+    from .cad_3dm_read import _patch_from_rhino
+
+    patch = _patch_from_rhino(brep_face.UnderlyingSurface().ToNurbsSurface(), source)
+    surface = _PatchProjection(patch)
+    box = surface.box
+    size = float(np.hypot(box[1] - box[0], box[3] - box[2]))
+    loops = sorted(brep_face.Loops, key=lambda lp: str(lp.LoopType).split(".")[-1] != "Outer")
+    out = []
+    for number, loop in enumerate(loops):
+        name = f"{source} loop {number}"
+        trims: list[NDArray[np.float64] | None] = []
+        for k, trim in enumerate(loop.Trims):
+            if trim.EdgeIndex < 0:
+                trims.append(None)
+                continue
+            curve = brep.Edges[trim.EdgeIndex].ToNurbsCurve()
+            knots = np.array([curve.Knots[i] for i in range(len(curve.Knots))])
+            d = curve.Domain
+            breaks = np.unique(np.clip(np.r_[d.T0, knots, d.T1], d.T0, d.T1))
+            if trim.IsReversed:
+                breaks = breaks[::-1]
+            pull = lambda t, c=curve: surface.project(  # noqa: E731
+                np.array([[p.X, p.Y, p.Z] for p in map(c.PointAt, map(float, t))]))
+            trims.append(fit_pieces(pull, breaks, 1, FIT_TOL * size, f"{name} trim {k}"))
+        out.append(_fill_singular(trims, name))
+    surface.check_seams(out, source)
+    return pieces_arrays(out, box, GAP_TOL * size, source)
+
+
+def _fill_singular(trims: list[NDArray[np.float64] | None], source: str
+                   ) -> list[NDArray[np.float64]]:
+    """Trims without an edge as straight segments from the previous trim's end to the
+    next one's start."""
+    if all(t is None for t in trims):
+        raise InputError(f"{source}: the loop has no edges")
+    out = list(trims)
+    for k, trim in enumerate(trims):
+        if trim is None:
+            before = next(t for t in (trims[k - j] for j in range(1, len(trims) + 1))
+                          if t is not None)
+            after = next(t for t in (trims[(k + j) % len(trims)] for j in range(1, len(trims)))
+                         if t is not None)
+            out[k] = np.stack([before[-1, -1], after[0, 0]])[None]
+    return [t for t in out if t is not None]
+
+
+class _PatchProjection:
+    """Points in space projected on a NURBS patch's surface (module docstring)."""
+
+    def __init__(self, patch: dict[str, Any]) -> None:
+        from .knots import KnotVectorBasis
+
+        self.bases = [KnotVectorBasis(n, np.asarray(t, dtype=float))
+                      for n, t in zip(patch["degrees"], (patch["knots_u"], patch["knots_v"]))]
+        w = np.asarray(patch["weights"], dtype=float)
+        self.hom = np.concatenate([patch["points"] * w[..., None], w[..., None]], axis=-1)
+        self.box = np.array([*self.bases[0].domain, *self.bases[1].domain])
+        seeds = [np.linspace(*b.domain, SEED_GRID) for b in self.bases]
+        self.seed_uv = np.stack(np.meshgrid(*seeds, indexing="ij"), -1).reshape(-1, 2)
+        self.seed_xyz = self.evaluate(self.seed_uv)[0]
+
+    def evaluate(self, uv: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
+        """``S, S_u, S_v`` at points ``uv`` ``(m, 2)`` (quotient rule on ``(w S, w)``)."""
+        (bu, bv) = self.bases
+        Bu, Du = bu(uv[:, 0]), bu(uv[:, 0], 1)
+        Bv, Dv = bv(uv[:, 1]), bv(uv[:, 1], 1)
+        H = np.einsum("mi,ijc,mj->mc", Bu, self.hom, Bv)
+        Hu = np.einsum("mi,ijc,mj->mc", Du, self.hom, Bv)
+        Hv = np.einsum("mi,ijc,mj->mc", Bu, self.hom, Dv)
+        W = H[:, 3:]
+        S = H[:, :3] / W
+        return S, (Hu[:, :3] - S * Hu[:, 3:]) / W, (Hv[:, :3] - S * Hv[:, 3:]) / W
+
+    def project(self, xyz: NDArray[np.float64]) -> NDArray[np.float64]:
+        """``argmin_{(u, v)} |S(u, v) - X|`` for points ``xyz`` ``(m, 3)``."""
+        gap = np.linalg.norm(xyz[:, None] - self.seed_xyz[None], axis=-1)
+        uv = self.seed_uv[np.argmin(gap, axis=1)].copy()
+        lo, hi = self.box[[0, 2]], self.box[[1, 3]]
+        for _ in range(12):
+            S, Su, Sv = self.evaluate(uv)
+            J = np.stack([Su, Sv], axis=-1)                 # (m, 3, 2)
+            JtJ = np.einsum("mki,mkj->mij", J, J)
+            JtJ += 1e-14 * np.trace(JtJ, axis1=1, axis2=2)[:, None, None] * np.eye(2)
+            rhs = np.einsum("mki,mk->mi", J, xyz - S)
+            uv = np.clip(uv + np.linalg.solve(JtJ, rhs[..., None])[..., 0], lo, hi)
+        return uv
+
+    def check_seams(self, loops: list[list[NDArray[np.float64]]], source: str) -> None:
+        """Refuse a trim that runs along a side of the box where the surface is closed."""
+        for k, (a, b) in enumerate(((0, 1), (2, 3))):
+            lo, hi = self.box[a], self.box[b]
+            side = [np.take(self.seed_uv.reshape(SEED_GRID, SEED_GRID, 2), i, axis=k)
+                    for i in (0, -1)]
+            ends = [self.evaluate(s)[0] for s in side]
+            if np.abs(ends[0] - ends[1]).max() > 1e-9 * max(1.0, np.abs(ends[0]).max()):
+                continue                                # not closed in this direction
+            for loop in loops:
+                for trim in loop:
+                    x = trim[..., k]
+                    if np.ptp(x) <= 1e-9 * (hi - lo) and (
+                            abs(x.mean() - lo) <= 1e-9 * (hi - lo)
+                            or abs(x.mean() - hi) <= 1e-9 * (hi - lo)):
+                        raise InputError(f"{source}: a trim runs along the seam "
+                                         f"{'uv'[k]} = {lo:g} / {hi:g} of a closed surface; "
+                                         "rhino3dm does not give its 2-D curve")
