@@ -340,6 +340,10 @@ def list_step_arrays(path: Path) -> dict[str, Any]:
             arrays["points"] /= millimetres(units)
             arrays["trimmed_area"] = _area(face) / millimetres(units) ** 2
             entry.update(arrays)
+            from .cad_trims import listed
+            from .cad_trims_step import face_trim_arrays
+
+            entry.update(listed(lambda: face_trim_arrays(face, source)))
             entry["trimmed"] = _wires(face) > 1 or any("trimmed" in str(w.message)
                                                          for w in caught)
         except InputError as exc:

@@ -81,9 +81,18 @@ def read_trims(path: str | os.PathLike, face: int = 0) -> TrimDomain | None:
 def pieces_arrays(loops: list[list[NDArray[np.float64]]], box: NDArray[np.float64],
                   gap: float, source: str) -> dict[str, Any]:
     """``{"box": (u0, u1, v0, v1), "loops": [(K, n + 1, 2), ...]}``: each loop's trims
-    joined (:func:`~splinedeform.trim.bezier.join_loop`), the outer loop first."""
-    joined = [join_loop(trims, gap, f"{source} loop {k}") for k, trims in enumerate(loops)]
-    return {"box": np.asarray(box, dtype=float), "loops": joined}
+    joined (:func:`~splinedeform.trim.bezier.join_loop`), the outer loop first. Bézier
+    points outside the box by less than :data:`FIT_TOL` of its diagonal (round-off of the
+    fit, where a loop touches a side) are moved onto it, so the loops stay in the box."""
+    box = np.asarray(box, dtype=float)
+    lo, hi = box[[0, 2]], box[[1, 3]]
+    slack = FIT_TOL * float(np.hypot(*(hi - lo)))
+    joined = []
+    for k, trims in enumerate(loops):
+        pieces = join_loop(trims, gap, f"{source} loop {k}")
+        near = (pieces > lo - slack) & (pieces < hi + slack)
+        joined.append(np.where(near, np.clip(pieces, lo, hi), pieces))
+    return {"box": box, "loops": joined}
 
 
 def domain_from_arrays(data: dict[str, Any], source: str) -> TrimDomain | None:
@@ -105,6 +114,44 @@ def domain_from_arrays(data: dict[str, Any], source: str) -> TrimDomain | None:
         return TrimDomain(loops[0], tuple(loops[1:]))
     except InputError as exc:
         raise InputError(f"{source}: {exc}") from None
+
+
+#: cells per side of the grid of the trimmed-fraction quadrature
+FRACTION_CELLS = 8
+
+
+def trimmed_fraction(domain: TrimDomain, lengths: tuple[float, float]) -> float:
+    """``|Ω| / (L_u L_v)``: the part of the parameter box ``[0, L_u] × [0, L_v]`` inside the
+    loops, by :func:`~splinedeform.trim.quadrature.trim_quadrature` (Gauss–Green on cut
+    cells, ``n + 1`` points along pieces of degree ``n``: exact for ``∫ 1``). The grid's
+    cells are ``L (1 + 1 / 2m) / m`` wide (``m`` = :data:`FRACTION_CELLS`), so that the
+    box's far sides, where outer loops often run, fall inside cells, not on their lines."""
+    from .trim.cells import Grid
+    from .trim.quadrature import trim_quadrature
+
+    m = FRACTION_CELLS
+    pad = 1.0 + 0.5 / m
+    degree = max([getattr(loop, "degree", 1) for loop in domain.loops])
+    rule = trim_quadrature(domain, Grid((m, m), (lengths[0] * pad, lengths[1] * pad)),
+                           max(2, degree + 1))
+    return float(rule.weights.sum() / (lengths[0] * lengths[1]))
+
+
+def trim_summary(entry: dict[str, Any], source: str) -> dict[str, Any]:
+    """``loops`` (``[outer, inner]`` counts) and ``trimmed_fraction`` of a listed face
+    (:func:`listed`), None where it has no loops; ``trim_error`` where they cannot be read."""
+    if "trim_error" in entry:
+        return {"loops": None, "trimmed_fraction": None, "trim_error": entry["trim_error"]}
+    data = entry.get("trim") or {"loops": None}
+    try:
+        domain = domain_from_arrays(data, source)
+        if domain is None:
+            return {"loops": None, "trimmed_fraction": None}
+        box = np.asarray(data["box"], dtype=float)
+        fraction = trimmed_fraction(domain, (box[1] - box[0], box[3] - box[2]))
+    except InputError as exc:
+        return {"loops": None, "trimmed_fraction": None, "trim_error": str(exc)}
+    return {"loops": [1, len(domain.holes)], "trimmed_fraction": fraction}
 
 
 def _straight(pieces: NDArray[np.float64]) -> bool:
@@ -131,7 +178,8 @@ def loop_pieces(loop: Loop) -> NDArray[np.float64]:
 
 def trim_arrays_3dm(path: Path, face: int) -> dict[str, Any]:
     """The loops of face ``face`` of a ``.3dm`` file as Bézier pieces (module docstring);
-    ``{"loops": None}`` for a plain surface."""
+    for a plain surface those written beside it (:func:`add_trim_curves`), if any, else
+    ``{"loops": None}``."""
     from .cad_3dm_read import _objects, _rhino3dm
 
     r3 = _rhino3dm()
@@ -139,18 +187,42 @@ def trim_arrays_3dm(path: Path, face: int) -> dict[str, Any]:
     if model is None:
         raise InputError(f"{path}: not a .3dm (openNURBS) file")
     found = []
-    for _, _, geometry in _objects(model, r3):
+    for index, _, geometry in _objects(model, r3):
         if isinstance(geometry, r3.Brep):
             found += [(geometry, f) for f in geometry.Faces]
         else:
-            found.append((None, geometry))
+            found.append((index, geometry))
     if not 0 <= face < len(found):
         raise InputError(f"{path}: face {face!r} out of range; the file holds "
                          f"{len(found)} surface(s), numbered 0..{len(found) - 1}")
-    brep, member = found[face]
-    if brep is None:
-        return {"loops": None}
-    return brep_face_trims(brep, member, f"{path} face {face}")
+    owner, member = found[face]
+    return member_trims(model, r3, owner, member, f"{path} face {face}")
+
+
+def member_trims(model: Any, r3: Any, owner: Any, member: Any, source: str) -> dict[str, Any]:
+    """The loops of one face: ``owner`` its Brep, or the object index of a plain surface
+    (whose loops are those written beside it, if any: else ``{"loops": None}``)."""
+    if isinstance(owner, int):
+        from .cad_3dm_read import _patch_from_rhino
+
+        loops = written_trims(model, r3, owner)
+        if loops is None:
+            return {"loops": None}
+        patch = _patch_from_rhino(member.ToNurbsSurface(), source)
+        n = patch["degrees"]
+        box = [patch["knots_u"][n[0]], patch["knots_u"][-n[0] - 1],
+               patch["knots_v"][n[1]], patch["knots_v"][-n[1] - 1]]
+        return {"box": np.array(box, dtype=float), "loops": loops}
+    return brep_face_trims(owner, member, source)
+
+
+def listed(read: Any) -> dict[str, Any]:
+    """``{"trim": read()}``, or ``{"trim_error": message}`` if it raises ``InputError``:
+    what a face listing shows of a face's loops."""
+    try:
+        return {"trim": read()}
+    except InputError as exc:
+        return {"trim_error": str(exc)}
 
 
 def brep_face_trims(brep: Any, brep_face: Any, source: str) -> dict[str, Any]:
@@ -260,3 +332,99 @@ class _PatchProjection:
                         raise InputError(f"{source}: a trim runs along the seam "
                                          f"{'uv'[k]} = {lo:g} / {hi:g} of a closed surface; "
                                          "rhino3dm does not give its 2-D curve")
+
+
+# --- .3dm export: trim loops as curve objects -------------------------------------------
+
+#: user-string keys of a written trim curve: the object index of the surface it trims,
+#: and its loop ("outer" or "hole k")
+TRIM_OF, TRIM_LOOP = "splinedeform.trim_of", "splinedeform.loop"
+
+
+def domain_pieces(domain: TrimDomain) -> list[NDArray[np.float64]]:
+    """Bézier pieces ``(K, n + 1, 2)`` of every loop of ``domain``, outer first, as the
+    domain orients them (a spline loop's spans interpolated at ``n + 1`` points: exact);
+    None for a circle, which :func:`add_trim_curves` writes as a rational circle."""
+    from .trim.bezier import interpolate, lobatto
+    from .trim.spline_loop import SplineLoop
+
+    out = []
+    for loop in domain.loops:
+        if isinstance(loop, PiecewiseLoop | PolygonLoop):
+            out.append(loop_pieces(loop))
+        elif isinstance(loop, SplineLoop):           # span s is a polynomial of degree n
+            n = loop.degree
+            t = np.arange(loop.spans)[:, None] + lobatto(n)
+            out.append(interpolate(loop.evaluate(t)[0], n))
+        else:
+            out.append(None)
+    return out
+
+
+def add_trim_curves(model: Any, r3: Any, domain: TrimDomain, surface_index: int,
+                    name: str) -> None:
+    """Add the loops of ``domain`` to a rhino3dm ``File3dm`` as planar curve objects.
+
+    rhino3dm (8.x) cannot build a trimmed Brep face from 2-D trim curves (its ``Brep``
+    offers no loops or trims to add; ``CreateTrimmedPlane`` takes one 3-D curve on a
+    plane), so the loops are written beside the surface: each a NURBS curve in the plane
+    ``z = 0`` whose ``(x, y)`` are the surface's ``(u, v)`` (the parameters it is written
+    with), named ``"<name>: trim outer"`` or ``"<name>: trim hole k"``, with the user
+    strings :data:`TRIM_OF` (the surface's object index) and :data:`TRIM_LOOP`. A loop of
+    ``K`` Bézier pieces of degree ``n`` is the clamped curve with the pieces' points
+    (``n K + 1``, the first repeated at the end) and every joint a knot of multiplicity
+    ``n`` at ``t = s``; a circle is openNURBS' rational circle.
+    """
+    for k, (loop, pieces) in enumerate(zip(domain.loops, domain_pieces(domain))):
+        role = "outer" if k == 0 else f"hole {k}"
+        if pieces is None:                            # a CircleLoop
+            c = r3.Circle(r3.Point3d(*loop.centre, 0.0), loop.radius)
+            curve = r3.NurbsCurve.CreateFromCircle(c)
+            if loop.sense < 0:
+                curve.Reverse()
+        else:
+            K, n = pieces.shape[0], pieces.shape[1] - 1
+            points = np.concatenate([pieces[:, :-1].reshape(-1, 2), pieces[:1, 0]])
+            curve = r3.NurbsCurve(3, False, n + 1, len(points))
+            for i, (u, v) in enumerate(points):
+                curve.Points[i] = r3.Point4d(float(u), float(v), 0.0, 1.0)
+            for i, t in enumerate(np.repeat(np.arange(K + 1.0), n)):
+                curve.Knots[i] = float(t)
+        attributes = r3.ObjectAttributes()
+        attributes.Name = f"{name}: trim {role}"
+        attributes.SetUserString(TRIM_OF, str(surface_index))
+        attributes.SetUserString(TRIM_LOOP, role)
+        model.Objects.AddCurve(curve, attributes)
+
+
+def written_trims(model: Any, r3: Any, surface_index: int) -> list[NDArray[np.float64]] | None:
+    """The loops :func:`add_trim_curves` wrote for object ``surface_index``, as Bézier
+    pieces (outer first), or None if there are none. A circle is fitted like any rational
+    curve (:data:`FIT_TOL` of its size)."""
+    found: dict[str, Any] = {}
+    for obj in model.Objects:
+        attributes = obj.Attributes
+        if attributes.GetUserString(TRIM_OF) == str(surface_index):
+            found[attributes.GetUserString(TRIM_LOOP)] = obj.Geometry
+    if "outer" not in found:
+        return None
+    roles = ["outer"] + sorted((r for r in found if r != "outer"), key=lambda r: int(r[5:]))
+    loops = []
+    for role in roles:
+        curve = found[role].ToNurbsCurve()
+        n = curve.Degree
+        P = np.array([[p.X, p.Y, p.W] for p in (curve.Points[i] for i in range(len(curve.Points)))])
+        knots = np.array([curve.Knots[i] for i in range(len(curve.Knots))])
+        joints = np.unique(knots)
+        if (not curve.IsRational and len(P) == n * (len(joints) - 1) + 1
+                and np.array_equal(knots, np.repeat(joints, n))):     # our Bézier layout
+            pieces = np.stack([P[s * n:s * n + n + 1, :2] for s in range(len(joints) - 1)])
+        else:
+            d = curve.Domain
+            points = lambda t, c=curve: np.array(  # noqa: E731
+                [[p.X, p.Y] for p in map(c.PointAt, map(float, t))])
+            size = float(np.ptp(points(np.linspace(d.T0, d.T1, 65)), axis=0).max())
+            pieces = fit_pieces(points, np.unique(np.clip(np.r_[d.T0, knots, d.T1], d.T0, d.T1)),
+                                1, FIT_TOL * size, f"trim curve {role} of object {surface_index}")
+        loops.append(pieces)
+    return loops
