@@ -193,3 +193,29 @@ def test_bad_requests_are_refused(trimmed_planes, tmp_path):
         read_trims(trimmed_planes, 7)
     with pytest.raises(InputError, match="not a CAD file"):
         read_trims(tmp_path / "loops.txt", 0)
+
+
+def test_3dm_closed_surfaces_seams_and_poles(tmp_path):
+    r3 = pytest.importorskip("rhino3dm", reason="the 'cad' extra (rhino3dm) is not installed")
+    model = r3.File3dm()
+    circle = r3.Circle(r3.Point3d(0, 0, 0), 1.0).ToNurbsCurve()
+    model.Objects.AddExtrusion(r3.Extrusion.Create(circle, 2.0, True), r3.ObjectAttributes())
+    model.Objects.AddBrep(r3.Sphere(r3.Point3d(0, 0, 0), 1.0).ToBrep(), r3.ObjectAttributes())
+    path = tmp_path / "closed.3dm"
+    assert model.Write(str(path), 7)
+    listing = _quiet(read_faces, path)["faces"]
+    wall, cap, _, ball = listing
+    # the tube's wall and the sphere: loops along the seam (both sides) and, for the
+    # sphere, singular trims at the poles: the whole parameter rectangle (straight
+    # pieces: the corners to round-off)
+    for face in (0, 3):
+        domain = read_trims(path, face)
+        surface = _quiet(lambda: surface_from_patch(read_cad(path, face)))
+        Lu, Lv = surface.basis_u.domain[1], surface.basis_v.domain[1]
+        assert isinstance(domain.outer, PolygonLoop)
+        assert domain.area() == pytest.approx(Lu * Lv, rel=1e-12)
+        assert listing[face]["trimmed_fraction"] == pytest.approx(1.0, rel=1e-12)
+    # a cap: the unit disc in its 2.5 × 2.5 plane (the fit's 1e-10 of the box, as above)
+    assert cap["loops"] == [1, 0] and cap["area"] == pytest.approx(6.25, rel=1e-12)
+    assert cap["trimmed_fraction"] == pytest.approx(math.pi / 6.25, abs=1e-9)
+    assert wall["loops"] == ball["loops"] == [1, 0]

@@ -19,8 +19,10 @@ each point ``X(t)`` of the edge is projected, ``(u, v) = argmin |S(u, v) - X(t)|
 Gauss–Newton steps ``[S_u S_v] Δ = X - S`` from the nearest point of a
 :data:`SEED_GRID`² grid. On a surface affine in ``(u, v)`` (a plane) this is the exact
 preimage. A trim without an edge (a singular trim at a pole) is the straight segment
-joining its neighbours. A trim curve on a seam of a closed surface is refused: which of
-the seam's two sides it lies on is not known without its 2-D curve.
+joining its neighbours. On a closed surface a point of the seam has two parameters: a
+piece takes the side where its other points are, and a trim lying on the seam the side
+that joins it to its neighbours; at a pole, where ``u`` is not defined by the point, a
+point takes the ``u`` of its nearest neighbour along the curve.
 
 STEP / IGES: the pcurves themselves (:mod:`splinedeform.cad_trims_step`).
 """
@@ -123,18 +125,30 @@ FRACTION_CELLS = 8
 def trimmed_fraction(domain: TrimDomain, lengths: tuple[float, float]) -> float:
     """``|Ω| / (L_u L_v)``: the part of the parameter box ``[0, L_u] × [0, L_v]`` inside the
     loops, by :func:`~splinedeform.trim.quadrature.trim_quadrature` (Gauss–Green on cut
-    cells, ``n + 1`` points along pieces of degree ``n``: exact for ``∫ 1``). The grid's
-    cells are ``L (1 + 1 / 2m) / m`` wide (``m`` = :data:`FRACTION_CELLS`), so that the
-    box's far sides, where outer loops often run, fall inside cells, not on their lines."""
+    cells, ``n + 1`` points along pieces of degree ``n``: exact for ``∫ 1``). The loops
+    are moved by ``0.3 L / m`` into a grid of ``m`` = :data:`FRACTION_CELLS` cells of
+    ``L (1 + 0.7 / m) / m``, so that the box's sides, where outer loops often run, lie
+    inside cells, off the grid's lines and away from its ends."""
     from .trim.cells import Grid
     from .trim.quadrature import trim_quadrature
 
     m = FRACTION_CELLS
-    pad = 1.0 + 0.5 / m
+    L = np.asarray(lengths, dtype=float)
+    shift = 0.3 * L / m
+    moved = TrimDomain(*_moved(domain.loops, shift))
     degree = max([getattr(loop, "degree", 1) for loop in domain.loops])
-    rule = trim_quadrature(domain, Grid((m, m), (lengths[0] * pad, lengths[1] * pad)),
-                           max(2, degree + 1))
-    return float(rule.weights.sum() / (lengths[0] * lengths[1]))
+    rule = trim_quadrature(moved, Grid((m, m), tuple(L * (1 + 0.7 / m))), max(2, degree + 1))
+    return float(rule.weights.sum() / L.prod())
+
+
+def _moved(loops: tuple[Loop, ...], shift: NDArray[np.float64]) -> tuple[Loop, tuple[Loop, ...]]:
+    """Polygon and piecewise loops translated by ``shift``: the outer one and the holes."""
+    out: list[Loop] = []
+    for loop in loops:
+        pieces = loop_pieces(loop) + shift
+        out.append(PolygonLoop(pieces[:, 0]) if isinstance(loop, PolygonLoop)
+                   else PiecewiseLoop.from_pieces(pieces))
+    return out[0], tuple(out[1:])
 
 
 def trim_summary(entry: dict[str, Any], source: str) -> dict[str, Any]:
@@ -248,11 +262,11 @@ def brep_face_trims(brep: Any, brep_face: Any, source: str) -> dict[str, Any]:
             breaks = np.unique(np.clip(np.r_[d.T0, knots, d.T1], d.T0, d.T1))
             if trim.IsReversed:
                 breaks = breaks[::-1]
-            pull = lambda t, c=curve: surface.project(  # noqa: E731
-                np.array([[p.X, p.Y, p.Z] for p in map(c.PointAt, map(float, t))]))
+            pull = lambda t, c=curve: surface.settle(surface.project(  # noqa: E731
+                np.array([[p.X, p.Y, p.Z] for p in map(c.PointAt, map(float, t))])), t)
             trims.append(fit_pieces(pull, breaks, 1, FIT_TOL * size, f"{name} trim {k}"))
+        surface.seam_sides(trims)
         out.append(_fill_singular(trims, name))
-    surface.check_seams(out, source)
     return pieces_arrays(out, box, GAP_TOL * size, source)
 
 
@@ -287,6 +301,8 @@ class _PatchProjection:
         seeds = [np.linspace(*b.domain, SEED_GRID) for b in self.bases]
         self.seed_uv = np.stack(np.meshgrid(*seeds, indexing="ij"), -1).reshape(-1, 2)
         self.seed_xyz = self.evaluate(self.seed_uv)[0]
+        self.size = float(np.ptp(self.seed_xyz, axis=0).max())
+        self.closed = self._closed()
 
     def evaluate(self, uv: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
         """``S, S_u, S_v`` at points ``uv`` ``(m, 2)`` (quotient rule on ``(w S, w)``)."""
@@ -314,24 +330,66 @@ class _PatchProjection:
             uv = np.clip(uv + np.linalg.solve(JtJ, rhs[..., None])[..., 0], lo, hi)
         return uv
 
-    def check_seams(self, loops: list[list[NDArray[np.float64]]], source: str) -> None:
-        """Refuse a trim that runs along a side of the box where the surface is closed."""
-        for k, (a, b) in enumerate(((0, 1), (2, 3))):
-            lo, hi = self.box[a], self.box[b]
-            side = [np.take(self.seed_uv.reshape(SEED_GRID, SEED_GRID, 2), i, axis=k)
-                    for i in (0, -1)]
-            ends = [self.evaluate(s)[0] for s in side]
-            if np.abs(ends[0] - ends[1]).max() > 1e-9 * max(1.0, np.abs(ends[0]).max()):
-                continue                                # not closed in this direction
-            for loop in loops:
-                for trim in loop:
-                    x = trim[..., k]
-                    if np.ptp(x) <= 1e-9 * (hi - lo) and (
-                            abs(x.mean() - lo) <= 1e-9 * (hi - lo)
-                            or abs(x.mean() - hi) <= 1e-9 * (hi - lo)):
-                        raise InputError(f"{source}: a trim runs along the seam "
-                                         f"{'uv'[k]} = {lo:g} / {hi:g} of a closed surface; "
-                                         "rhino3dm does not give its 2-D curve")
+    def _closed(self) -> list[bool]:
+        """Whether the surface is closed in u, in v: its two opposite sides coincide
+        (the seeds on them within 1e-9 of the surface's size)."""
+        grid = self.seed_xyz.reshape(SEED_GRID, SEED_GRID, 3)
+        size = max(float(np.ptp(self.seed_xyz, axis=0).max()), 1e-300)
+        return [bool(np.abs(np.take(grid, 0, k) - np.take(grid, -1, k)).max() <= 1e-9 * size)
+                for k in (0, 1)]
+
+    def settle(self, uv: NDArray[np.float64], t: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Points of one piece (at curve parameters ``t``) on a seam or a pole, whose
+        parameter there is not defined by the point: a seam point takes the seam's side
+        where the piece's other points are, a pole point the ``u`` (or ``v``) of the point
+        nearest it along the curve that is not at the pole."""
+        uv = uv.copy()
+        for k in (0, 1):
+            lo, hi = self.box[2 * k], self.box[2 * k + 1]
+            eps = 1e-9 * (hi - lo)
+            if self.closed[k]:
+                on = (np.abs(uv[:, k] - lo) <= eps) | (np.abs(uv[:, k] - hi) <= eps)
+                if np.any(on) and not np.all(on):
+                    ref = np.median(uv[~on, k])
+                    uv[on, k] = lo if abs(ref - lo) < abs(ref - hi) else hi
+        _, Su, Sv = self.evaluate(uv)
+        for k, D in ((0, Su), (1, Sv)):
+            pole = np.linalg.norm(D, axis=1) <= 1e-9 * max(self.size, 1e-300)
+            if np.any(pole) and not np.all(pole):
+                good = np.flatnonzero(~pole)
+                nearest = good[np.argmin(np.abs(t[pole, None] - t[None, good]), axis=1)]
+                uv[pole, k] = uv[nearest, k]
+        return uv
+
+    def seam_sides(self, trims: list[NDArray[np.float64] | None]) -> None:
+        """Put each trim lying on a seam (all its points on one side of a closed
+        direction) on the side that joins it to its neighbours (in place); between two
+        singular trims, on the side where a counter-clockwise loop runs its way (openNURBS
+        runs outer loops counter-clockwise in the surface's parameters)."""
+        for k in (0, 1):
+            if not self.closed[k]:
+                continue
+            lo, hi = self.box[2 * k], self.box[2 * k + 1]
+            eps = 1e-9 * (hi - lo)
+            for i, trim in enumerate(trims):
+                if trim is None or np.ptp(trim[..., k]) > eps:
+                    continue
+                if min(abs(trim[..., k].mean() - lo), abs(trim[..., k].mean() - hi)) > eps:
+                    continue
+                ends = [t for t in (trims[i - 1], trims[(i + 1) % len(trims)]) if t is not None]
+                if not ends:        # between singular trims: an outer loop runs
+                    rising = trim[-1, -1, 1 - k] > trim[0, 0, 1 - k]   # counter-clockwise
+                    trim[..., k] = (hi if rising else lo) if k == 0 else (lo if rising else hi)
+                    continue
+                best, gap = None, np.inf
+                for side in (lo, hi):
+                    moved = trim.copy()
+                    moved[..., k] = side
+                    g = sum(np.hypot(*(moved[0, 0] - ends[0][-1, -1]).T) if j == 0 else
+                            np.hypot(*(moved[-1, -1] - e[0, 0]).T) for j, e in enumerate(ends))
+                    if g < gap:
+                        best, gap = moved, g
+                trims[i] = best
 
 
 # --- .3dm export: trim loops as curve objects -------------------------------------------
