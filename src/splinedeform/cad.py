@@ -195,13 +195,20 @@ CAD_SUFFIXES = {".3dm": "openNURBS", ".igs": "IGES", ".iges": "IGES", ".stp": "S
                 ".step": "STEP"}
 
 
-def read_cad(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
-    """Surface number ``face`` of a CAD file, chosen by its suffix (see :data:`CAD_SUFFIXES`)."""
-    path = Path(path)
+def cad_kind(path: Path) -> str:
+    """The format of a CAD file by its suffix (a value of :data:`CAD_SUFFIXES`); an
+    ``InputError`` for any other suffix."""
     kind = CAD_SUFFIXES.get(path.suffix.lower())
     if kind is None:
         raise InputError(f"{path}: not a CAD file (expected one of "
                          f"{', '.join(CAD_SUFFIXES)}), got suffix {path.suffix or 'none'!r}")
+    return kind
+
+
+def read_cad(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
+    """Surface number ``face`` of a CAD file, chosen by its suffix (see :data:`CAD_SUFFIXES`)."""
+    path = Path(path)
+    kind = cad_kind(path)
     if kind == "openNURBS":
         return read_3dm(path, face)
     from .cad_step import read_step   # STEP and IGES: OpenCASCADE, the 'cad-step' extra

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .cad import CAD_SUFFIXES, SEAM_TOL, WEIGHT_TOL, weight_factors
+from .cad import SEAM_TOL, WEIGHT_TOL, cad_kind, weight_factors
 from .cad_child import check_cad_file, read_in_child
 from .cad_trims import trim_summary
 from .errors import InputError
@@ -49,10 +49,7 @@ def read_faces(path: str | os.PathLike) -> dict[str, Any]:
     face's loops, by OpenCASCADE; None for ``.3dm``), or ``error`` for a face that cannot
     be read. Knot values are the file's parameters."""
     path = Path(path)
-    kind = CAD_SUFFIXES.get(path.suffix.lower())
-    if kind is None:
-        raise InputError(f"{path}: not a CAD file (expected one of "
-                         f"{', '.join(CAD_SUFFIXES)}), got suffix {path.suffix or 'none'!r}")
+    kind = cad_kind(path)
     check_cad_file(path)
     if kind == "openNURBS":
         from .cad_3dm_read import _rhino3dm, list_3dm_arrays

@@ -56,13 +56,10 @@ def read_trims(path: str | os.PathLike, face: int = 0) -> TrimDomain | None:
     parameters of :func:`~splinedeform.cad.surface_from_patch` (module docstring); None for
     a plain surface of a ``.3dm`` file (no Brep: nothing trims it). An untrimmed Brep
     face's outer loop is its parameter rectangle."""
-    from .cad import CAD_SUFFIXES
+    from .cad import cad_kind
 
     path = Path(path)
-    kind = CAD_SUFFIXES.get(path.suffix.lower())
-    if kind is None:
-        raise InputError(f"{path}: not a CAD file (expected one of "
-                         f"{', '.join(CAD_SUFFIXES)}), got suffix {path.suffix or 'none'!r}")
+    kind = cad_kind(path)
     check_cad_file(path)
     if isinstance(face, bool) or not isinstance(face, int) or face < 0:
         raise InputError(f"{path}: face {face!r} out of range; faces are numbered from 0")
