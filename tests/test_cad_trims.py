@@ -229,3 +229,32 @@ def test_3dm_closed_surfaces_seams_and_poles(tmp_path):
     assert cap["loops"] == [1, 0] and cap["area"] == pytest.approx(6.25, rel=1e-12)
     assert cap["trimmed_fraction"] == pytest.approx(math.pi / 6.25, abs=1e-9)
     assert wall["loops"] == ball["loops"] == [1, 0]
+
+
+def test_step_sphere_and_cone_seams_and_poles(tmp_path):
+    pytest.importorskip("OCP", reason="the 'cad-step' extra (cadquery-ocp) is not installed")
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeCone, BRepPrimAPI_MakeSphere
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+    from OCP.TopoDS import TopoDS_Compound
+
+    builder, compound = BRep_Builder(), TopoDS_Compound()
+    builder.MakeCompound(compound)
+    builder.Add(compound, BRepPrimAPI_MakeSphere(1.0).Shape())
+    axis = gp_Ax2(gp_Pnt(3, 0, 0), gp_Dir(0, 0, 1))
+    builder.Add(compound, BRepPrimAPI_MakeCone(axis, 1.0, 0.0, 2.0).Shape())
+    writer = STEPControl_Writer()
+    writer.Transfer(compound, STEPControl_AsIs)
+    path = tmp_path / "round.step"
+    writer.Write(str(path))
+    sphere, cone, cap = _quiet(read_faces, path)["faces"]
+    # a sphere and a cone, whose B-spline forms have other parametrisations than their
+    # own (points projected): seams on both sides, poles at the tips. Their loops are the
+    # whole parameter rectangles (straight pieces, the fraction to round-off)
+    assert sphere["loops"] == cone["loops"] == [1, 0]
+    assert sphere["trimmed_fraction"] == pytest.approx(1.0, rel=1e-12)
+    assert cone["trimmed_fraction"] == pytest.approx(1.0, rel=1e-12)
+    # the cone's base: the unit disc on its 2 × 2 plane, to the fit's bound (see above)
+    assert cap["trimmed_fraction"] == pytest.approx(math.pi / 4, abs=1e-9)
+    assert cap["trimmed_area"] == pytest.approx(math.pi, rel=1e-12)   # OpenCASCADE's

@@ -263,11 +263,11 @@ def brep_face_trims(brep: Any, brep_face: Any, source: str) -> dict[str, Any]:
                 np.array([[p.X, p.Y, p.Z] for p in map(c.PointAt, map(float, t))])), t)
             trims.append(fit_pieces(pull, breaks, 1, FIT_TOL * size, f"{name} trim {k}"))
         surface.seam_sides(trims)
-        out.append(_fill_singular(trims, name))
+        out.append(fill_singular(trims, name))
     return pieces_arrays(out, box, GAP_TOL * size, source)
 
 
-def _fill_singular(trims: list[NDArray[np.float64] | None], source: str
+def fill_singular(trims: list[NDArray[np.float64] | None], source: str
                    ) -> list[NDArray[np.float64]]:
     """Trims without an edge as straight segments from the previous trim's end to the
     next one's start."""

@@ -16,7 +16,9 @@ B-spline (a B-spline surface, a plane; checked at the pcurves' points to
 direction moved by whole periods into the opened spline's one period. Elsewhere (a
 cylinder, a cone, a sphere … whose B-spline form has another parametrisation) the point
 ``S(u, v)`` is projected on the spline (``ShapeAnalysis_Surface.ValueOfUV``), a seam's two
-candidates ``u`` and ``u ± T`` decided by the nearer to ``(u, v)`` itself.
+candidates ``u`` and ``u ± T`` decided by the nearer to ``(u, v)`` itself, and a degenerate
+edge (a pole, whose ``u`` its point does not give) is the segment joining its neighbours;
+other points at a pole take the ``u`` of their piece's nearest point.
 """
 
 from __future__ import annotations
@@ -28,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from .cad_step_read import ocp, open_spline, read_faces
-from .cad_trims import FIT_TOL, GAP_TOL, pieces_arrays
+from .cad_trims import FIT_TOL, GAP_TOL, fill_singular, pieces_arrays
 from .cad_units import millimetres
 from .errors import InputError
 from .trim.bezier import fit_pieces
@@ -101,22 +103,22 @@ def _wire_trims(wire: Any, face: Any, mapping: "_Mapping", size: float, source: 
         if curve is None:
             raise InputError(f"{name}: it has no curve in the face's parameters (pcurve)")
         spline = Geom2dConvert.CurveToBSplineCurve_s(Geom2d_TrimmedCurve(curve, first, last))
+        if BRep_Tool.Degenerated_s(edge) and not mapping.same:
+            trims.append(None)      # a pole: its u is not defined by its point
+            explorer.Next()
+            continue
+        # the conversion may reparametrise (a circle): its own range and knots
+        lo, hi = spline.FirstParameter(), spline.LastParameter()
         knots = [spline.Knot(k) for k in range(1, spline.NbKnots() + 1)]
-        breaks = np.array([t for t in knots if first <= t <= last] or [first, last])
-        breaks = np.unique(np.clip(np.r_[spline.FirstParameter(), breaks,
-                                         spline.LastParameter()],
-                                   spline.FirstParameter(), spline.LastParameter()))
+        breaks = np.unique(np.clip(np.r_[lo, knots, hi], lo, hi))
         if edge.Orientation() == TopAbs_REVERSED:
             breaks = breaks[::-1]
-        degenerate = BRep_Tool.Degenerated_s(edge)
-        evaluate = lambda t, c=spline, d=degenerate: mapping(  # noqa: E731
-            np.array([c.Value(float(x)).Coord() for x in t]), d)
+        evaluate = lambda t, c=spline: mapping(  # noqa: E731
+            np.array([c.Value(float(x)).Coord() for x in t]))
         degree = spline.Degree() if not spline.IsRational() and mapping.same else 1
         trims.append(fit_pieces(evaluate, breaks, degree, FIT_TOL * size, name))
         explorer.Next()
-    if not trims:
-        raise InputError(f"{source}: the loop has no edges")
-    return trims
+    return fill_singular(trims, source)
 
 
 class _Mapping:
@@ -143,7 +145,7 @@ class _Mapping:
         shift = np.where((self.periods > 0) & ~inside, np.floor(offset) * T, 0.0)
         return uv - shift
 
-    def __call__(self, uv: np.ndarray, degenerate: bool) -> np.ndarray:
+    def __call__(self, uv: np.ndarray) -> np.ndarray:
         from OCP.gp import gp_Pnt
 
         if self.same:
@@ -152,9 +154,6 @@ class _Mapping:
                 p, q = self.surface.Value(float(u), float(v)), self.spline.Value(float(a), float(b))
                 self.worst = max(self.worst, p.Distance(q) / (1.0 + p.Distance(gp_Pnt())))
             return mapped
-        if degenerate:
-            raise InputError("a degenerate edge (a pole) of a surface whose B-spline form has "
-                             "another parametrisation: its trim cannot be placed")
         out, near = [], self._into_box(uv)
         for (u, v), (nu, nv) in zip(uv, near):
             p = self.surface.Value(float(u), float(v))
@@ -165,7 +164,25 @@ class _Mapping:
                     options = best[k] + np.array([-1, 0, 1]) * self.periods[k]
                     best[k] = options[np.argmin(np.abs(options - (nu, nv)[k]))]
             out.append(best)
-        return np.array(out)
+        return self._poles(np.array(out), uv)
+
+    def _poles(self, mapped: np.ndarray, uv: np.ndarray) -> np.ndarray:
+        """Points at a pole (``S_u = 0``: every ``u`` gives the point) take the ``u`` of the
+        point of the same piece nearest them in the face's parameters ``uv``; the same in v."""
+        from OCP.gp import gp_Pnt, gp_Vec
+
+        derivatives = []
+        for a, b in mapped:
+            p, du, dv = gp_Pnt(), gp_Vec(), gp_Vec()
+            self.spline.D1(float(a), float(b), p, du, dv)
+            scale = 1e-9 * (1.0 + p.Distance(gp_Pnt()))
+            derivatives.append((du.Magnitude() <= scale, dv.Magnitude() <= scale))
+        for k, pole in enumerate(np.array(derivatives).T):
+            if np.any(pole) and not np.all(pole):
+                good = np.flatnonzero(~pole)
+                gap = np.linalg.norm(uv[pole, None] - uv[None, good], axis=-1)
+                mapped[pole, k] = mapped[good[np.argmin(gap, axis=1)], k]
+        return mapped
 
     def check(self, source: str) -> None:
         """Refuse if the face's surface and its spline differ at the same parameters by more
