@@ -12,7 +12,8 @@ import pytest
 from splinedeform import cli
 from splinedeform.cad import read_cad, surface_from_patch, write_frames_3dm
 from splinedeform.cad_faces import read_faces
-from splinedeform.cad_trims import TRIM_LOOP, TRIM_OF, loop_pieces, read_trims
+from splinedeform.cad_trims import loop_pieces, read_trims
+from splinedeform.cad_trims_3dm import TRIM_LOOP, TRIM_OF
 from splinedeform.errors import InputError
 from splinedeform.trim import Grid, PiecewiseLoop, PolygonLoop, trim_quadrature
 

@@ -225,7 +225,7 @@ def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch],
     of :data:`splinedeform.cad_units.UNITS`; default: the first patch's) is the file's
     ``ModelUnitSystem``; ``None`` when not known (openNURBS ``UnitSystem.None``).
     ``trims`` (one per patch, None for an untrimmed one) are written beside their surface
-    as curves in its ``(u, v)`` (:func:`splinedeform.cad_trims.add_trim_curves`).
+    as curves in its ``(u, v)`` (:func:`splinedeform.cad_trims_3dm.add_trim_curves`).
     """
     r3 = _rhino3dm()
     path = Path(path)
@@ -253,7 +253,7 @@ def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch],
             attributes.Name = names[index]
         model.Objects.AddSurface(srf, attributes)
         if trims is not None and trims[index] is not None:
-            from .cad_trims import add_trim_curves
+            from .cad_trims_3dm import add_trim_curves
 
             add_trim_curves(model, r3, trims[index], len(model.Objects) - 1,
                             names[index] if names is not None else f"surface {index}")
