@@ -31,7 +31,6 @@ import numpy as np
 
 from .cad_step_read import ocp, open_spline, read_faces
 from .cad_trims import FIT_TOL, GAP_TOL, fill_singular, pieces_arrays
-from .cad_units import millimetres
 from .errors import InputError
 from .trim.bezier import fit_pieces
 
@@ -44,14 +43,11 @@ def step_trim_arrays(path: Path, face: int) -> dict[str, Any]:
     """The loops of face ``face`` of a STEP or IGES file as Bézier pieces (see
     :func:`splinedeform.cad_trims.pieces_arrays`)."""
     ocp()
-    reader, faces, units = read_faces(path)
+    _, faces, _ = read_faces(path)
     if not 0 <= face < len(faces):
         raise InputError(f"{path}: face {face!r} out of range; the file holds "
                          f"{len(faces)} face(s), numbered 0..{len(faces) - 1}")
-    out = face_trim_arrays(faces[face], f"{path} face {face}")
-    out["units"] = units
-    out["scale"] = millimetres(units)
-    return out
+    return face_trim_arrays(faces[face], f"{path} face {face}")
 
 
 def face_trim_arrays(face: Any, source: str) -> dict[str, Any]:
