@@ -151,7 +151,7 @@ def test_grid_evaluation_equals_ndbspline_by_gather_and_by_sparse_product(sample
     Both paths and scipy sum the same ``(n+1)²`` products in other orders: 1e-13 relative
     to the largest value of the order, as for the pointwise evaluation.
     """
-    from splinedeform import surface as surface_module
+    from splinedeform import collocation
     basis = BSplineBasis(3, 9, 1.0, "open")
     other = basis if shared else BSplineBasis(2, 7, 1.0, "open")
     s = surface_on(basis, other, seed=4)
@@ -159,7 +159,7 @@ def test_grid_evaluation_equals_ndbspline_by_gather_and_by_sparse_product(sample
     # the numbers each product would gather: N_u (n+1) n_v 3, then N_v (n+1) N_u 3
     sizes = (samples[0] * 4 * other.size * 3, samples[1] * (other.degree + 1) * samples[0] * 3)
     small = samples == (4, 3)
-    assert all((size <= surface_module.GATHER_LIMIT) == small for size in sizes)
+    assert all((size <= collocation.GATHER_LIMIT) == small for size in sizes)
     U, V = np.meshgrid(u, v, indexing="ij")
     points = np.stack([U.ravel(), V.ravel()], axis=-1)
     for du, dv in [(0, 0), (1, 0), (0, 2), (1, 1)]:

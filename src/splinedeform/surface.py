@@ -15,6 +15,7 @@ import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
 from .basis import BSplineBasis
+from .collocation import collocate
 from .deboor import BLOCK
 from .patches import evaluate_patch_point, evaluate_patches, patches_when_worth
 from .spans import scalar_bernstein
@@ -279,28 +280,6 @@ class Surface:
         u, v = self.sample_parameters(resolution)
         vertices = self.evaluate_grid(u, v, control_points=control_points).reshape(-1, 3)
         return vertices, grid_faces(u.size, v.size)
-
-
-GATHER_LIMIT = 16384
-"""Most numbers ``N (n+1) w`` :func:`collocate` gathers instead of building a sparse matrix
-(below it the gather is cheaper than the matrix's construction; measured at 64² cubic)."""
-
-
-def collocate(index: NDArray[np.int64], values: NDArray[np.float64],
-              rows: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``A @ rows`` for the collocation matrix ``A_{i, index[i, r]} = values[i, r]``.
-
-    ``Y_i = Σ_r values[i, r] rows[index[i, r]]``, shape ``(N, w)`` for ``rows`` of shape
-    ``(size, w)``. Small products gather the ``n + 1`` rows of each parameter and contract
-    them (a few numpy calls); larger ones build ``A`` from its CSR arrays and take scipy's
-    sparse product (``csr_array``, without the ``np.matrix`` layer of ``csr_matrix``).
-    """
-    count, width = index.shape
-    if index.size * rows.shape[1] <= GATHER_LIMIT:
-        return np.matmul(values[:, None, :], rows[index])[:, 0]
-    indptr = np.arange(0, count * width + 1, width)
-    A = sp.csr_array((values.ravel(), index.ravel(), indptr), shape=(count, rows.shape[0]))
-    return A @ rows
 
 
 def knots_summary(basis: Basis) -> str:
