@@ -21,13 +21,13 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
-from .assembly import (_largest, check_bending, full_matrices, mass,  # noqa: F401
-                       patch_matrices, reduced_matrices, stiffness)
+from .assembly import (_largest, check_bending, full_matrices, gram_matrices,  # noqa: F401
+                       mass, reduced_matrices, stiffness)
 from .boundary import Constraints, build_constraints
 from .errors import InputError, SingularSystemError
 from .loads import Load, as_load, static_time
 from .material import Material, check_scales
-from .physics import PHYSICS
+from .physics import PHYSICS, intrinsic
 from . import modal_solve
 from .modal_solve import check_count as _check_count
 from .solution import ModalSolution, Readout, SampledSolution, StaticSolution
@@ -122,26 +122,52 @@ class Model:
                 "(surface.cells; a CAD or control net surface: insert knots with surface.refine)")
             error.key = "boundary"  # type: ignore[attr-defined]
             raise error
-        self.gram_u, self.gram_v, K, M = patch_matrices(surface, material, physics,
-                                                        mass_matrix == "lumped")
-        T = self.constraints.T
-        self.K_full, self.M_full = K, M
+        lumped = mass_matrix == "lumped"
+        self.gram_u, self.gram_v = gram_matrices(surface)
+        # K and M on the whole net: assembled here only where the constrained matrices are
+        # made from them, else when first asked for (K_full, M_full)
+        self._full: tuple[sp.csr_matrix, sp.csr_matrix] | None = (
+            intrinsic.matrices(surface, material, lumped) if physics == "intrinsic" else None)
         reduced = None if physics == "intrinsic" else reduced_matrices(
-            self.gram_u, self.gram_v, material, mass_matrix == "lumped", M, self.constraints)
-        self._K, self._M = reduced or ((T.T @ K @ T).tocsc(), (T.T @ M @ T).tocsc())
+            self.gram_u, self.gram_v, material, lumped, self.constraints)
+        if reduced is None:
+            T = self.constraints.T
+            K, M = self._full_matrices()
+            self._K, self._M = (T.T @ K @ T).tocsc(), (T.T @ M @ T).tocsc()
+            self._C: sp.csc_matrix | None = None
+        else:
+            self._K, self._M, self._C = reduced
         self._finish(start)
 
     def _finish(self, start: float) -> None:
-        """Damping ``C_r = (γ/μ) M_r + β K_r``, the checks of scale and the caches."""
+        """Damping ``C_r = (γ/μ) M_r + β K_r`` (unless made with K_r), the checks of scale
+        and the caches."""
         material = self.material
+        if getattr(self, "_C", None) is None:
+            self._C = ((material.damping / material.mass) * self._M
+                       + material.rayleigh * self._K).tocsc()
         if self._M.nnz:
             check_scales(material, _largest(self._K), _largest(self._M))
-        self._C = ((material.damping / material.mass) * self._M
-                   + material.rayleigh * self._K).tocsc()
         self._eigen: tuple[Array, Array] | None = None
         self._bases: dict[tuple, modal_basis.ModalBasis] = {}
         self._rigid: tuple[int | None] | None = None
         self.timings: dict[str, float] = {"assembly": time.perf_counter() - start}
+
+    def _full_matrices(self) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        if self._full is None:
+            self._full = full_matrices(self.gram_u, self.gram_v, self.material,
+                                       self.mass_matrix == "lumped")
+        return self._full
+
+    @property
+    def K_full(self) -> sp.csr_matrix:
+        """Stiffness ``K`` of the whole net, before constraints (assembled when first used)."""
+        return self._full_matrices()[0]
+
+    @property
+    def M_full(self) -> sp.csr_matrix:
+        """Mass ``M`` of the whole net, before constraints (assembled when first used)."""
+        return self._full_matrices()[1]
 
     # -- layout --------------------------------------------------------------------
     @property

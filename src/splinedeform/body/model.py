@@ -121,11 +121,13 @@ class BodyModel(Model):
             raise error
         blocks = [patch_matrices(s, material, physics, mass_matrix == "lumped")[2:]
                   for s in self.patches]
-        self.K_full = sp.block_diag([k for k, _ in blocks], format="csr")
-        self.M_full = sp.block_diag([m for _, m in blocks], format="csr")
+        K = sp.block_diag([k for k, _ in blocks], format="csr")
+        M = sp.block_diag([m for _, m in blocks], format="csr")
+        self._full = (K, M)
         T = self.constraints.T
-        self._K = (T.T @ self.K_full @ T).tocsc()
-        self._M = (T.T @ self.M_full @ T).tocsc()
+        self._K = (T.T @ K @ T).tocsc()
+        self._M = (T.T @ M @ T).tocsc()
+        self._C = None
         self._finish(start)
 
     # -- layout ------------------------------------------------------------------------
