@@ -83,6 +83,42 @@ def edge_conditions(boundary: str | Mapping[str, str]) -> dict[str, str]:
     return out
 
 
+LOOP_PRESETS = ("free", "pinned", "clamped")
+
+
+def trim_conditions(boundary: str | Mapping[str, str], loops: tuple[str, ...]
+                    ) -> tuple[dict[str, str], dict[str, str]]:
+    """Presets of the rectangle's edges and of the trim loops of a trimmed surface.
+
+    A preset name holds every trim loop (the rectangle's edges then stay free); a mapping
+    names edges (``u0`` …) and loops (``outer``, ``hole1`` …), missing ones free. The
+    rectangle's edges of a trimmed surface are not held (the trimmed region has its loops
+    as boundary): any other preset there is refused.
+    """
+    if isinstance(boundary, str):
+        if boundary not in LOOP_PRESETS:
+            raise InputError(f"a trim loop's preset must be one of {LOOP_PRESETS}, got "
+                             f"{boundary!r}")
+        return {e: "free" for e in EDGES}, {name: boundary for name in loops}
+    if not isinstance(boundary, Mapping):
+        raise InputError(f"boundary must be a preset name or a mapping edge/loop -> preset, "
+                         f"got {type(boundary).__name__}")
+    unknown = set(boundary) - set(EDGES) - set(loops)
+    if unknown:
+        raise InputError(f"unknown boundary edge(s) or loop(s) {sorted(unknown)} of a trimmed "
+                         f"surface; its loops are {loops} (the edges {EDGES} stay free)")
+    edges = {e: boundary.get(e, "free") for e in EDGES}
+    held = [e for e, preset in edges.items() if preset != "free"]
+    if held:
+        raise InputError(f"boundary.{held[0]} = {edges[held[0]]!r}: a trimmed surface is "
+                         f"held on its trim loops {loops}, not on the rectangle's edges")
+    presets = {name: boundary.get(name, "free") for name in loops}
+    for name, preset in presets.items():
+        if preset not in LOOP_PRESETS:
+            raise InputError(f"boundary.{name} must be one of {LOOP_PRESETS}, got {preset!r}")
+    return edges, presets
+
+
 def end_constraints(basis: BSplineBasis, end: int, preset: str) -> sp.csr_matrix:
     """Rows ``D^j b(x_e)``, ``j < r``, with ``r = 0, 1, 2`` for free, pinned, clamped."""
     order = {"free": 0, "pole": 0, "pinned": 1, "clamped": 2}[preset]

@@ -255,7 +255,8 @@ def pointwise_factor(model: Model) -> float:
     if model not in _POINTWISE:
         M = model.matrices()[0]
         inverse = None
-        if model.physics == "parametric" and model.mass_matrix == "consistent":
+        if (model.physics == "parametric" and model.mass_matrix == "consistent"
+                and model.surface.trim is None):
             gu, gv = (np.diag(np.linalg.inv(g[0].toarray())) for g in (model.gram_u,
                                                                        model.gram_v))
             inverse = np.kron(gu, gv) / model.material.mass

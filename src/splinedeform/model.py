@@ -40,6 +40,7 @@ from .solvers.forcing import ReducedForcing
 from .solvers.system import KroneckerFactors, Reduction
 from .surface import Surface
 from .threads import owned
+from .trim.model_matrices import trimmed_system
 
 Array = NDArray[np.float64]
 METHODS = ("analytic", "newmark", "radau3", "radau5", "radau7", "genalpha", "rk45", "dop853",
@@ -71,6 +72,9 @@ class Model:
         ``parametric``: the paper's energy per unit parameter area (Kronecker matrices);
         ``intrinsic``: the same plate under tension measured on the initial surface
         (:mod:`splinedeform.physics.intrinsic`), independent of the parametrisation.
+        A trimmed surface (``surface.trim``) takes ``parametric`` over its trimmed region
+        (:mod:`splinedeform.trim.model_matrices`), with ``boundary`` naming its loops
+        (``{"outer": "clamped", "hole1": "free"}``).
 
     Examples
     --------
@@ -117,7 +121,9 @@ class Model:
         self.mass_matrix = mass_matrix
         self.rest = rest
         self.physics = physics
-        self.constraints: Constraints = build_constraints(
+        trimmed = None if surface.trim is None else trimmed_system(
+            surface, material, boundary, mass_matrix == "lumped", physics, fixed)
+        self.constraints: Constraints = trimmed.constraints if trimmed else build_constraints(
             surface.basis_u, surface.basis_v, boundary,
             None if fixed is None else np.asarray(fixed), surface.control_points)
         if self.constraints.n_free == 0:
@@ -134,11 +140,13 @@ class Model:
         self.gram_v = [gram_matrix(surface.basis_v, a) for a in range(top(surface.basis_v) + 1)]
         if physics == "intrinsic":
             K, M = intrinsic.matrices(surface, material, mass_matrix == "lumped")
+        elif trimmed:
+            K, M = trimmed.stiffness, trimmed.mass
         else:
             K, M = full_matrices(self.gram_u, self.gram_v, material, mass_matrix == "lumped")
         T = self.constraints.T
         self.K_full, self.M_full = K, M
-        reduced = None if physics == "intrinsic" else reduced_matrices(
+        reduced = None if physics == "intrinsic" or trimmed else reduced_matrices(
             self.gram_u, self.gram_v, material, mass_matrix == "lumped", M, self.constraints)
         self._K, self._M = reduced or ((T.T @ K @ T).tocsc(), (T.T @ M @ T).tocsc())
         if self._M.nnz:
@@ -147,7 +155,7 @@ class Model:
                    + material.rayleigh * self._K).tocsc()
         self._eigen: tuple[Array, Array] | None = None
         self._bases: dict[tuple, modal_basis.ModalBasis] = {}
-        self._rigid: tuple[int | None] | None = None
+        self._rigid: tuple[int | None] | None = (trimmed.rigid_modes,) if trimmed else None
         self.timings: dict[str, float] = {"assembly": time.perf_counter() - start}
 
     # -- layout --------------------------------------------------------------------
