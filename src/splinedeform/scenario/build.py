@@ -10,6 +10,7 @@ from typing import Any, Iterator
 
 from ..errors import InputError, ScenarioError
 from .spec import Scenario, SurfaceSpec
+from .trim_build import loop_presets, trimmed
 
 
 @dataclass
@@ -54,7 +55,7 @@ def surface_and_units(scenario: Scenario) -> tuple[Any, str | None]:
     spec = scenario.surface
     surface, units = (_surface_from_cad(scenario) if spec.shape == "cad"
                       else (_surface_of_shape(scenario), None))
-    return _refined(scenario, surface), units
+    return trimmed(scenario, _refined(scenario, surface)), units
 
 
 def _refined(scenario: Scenario, surface: Any) -> Any:
@@ -302,7 +303,8 @@ def _model_on(scenario: Scenario, surface: Any, units: str | None) -> Built:
     with _located(scenario, "material"):
         material = Material(**scenario.material.weights())
     with _located(scenario, "boundary"):
-        model = Model(surface, material, boundary=scenario.boundary.edges(), fixed=fixed,
+        model = Model(surface, material, boundary={**scenario.boundary.edges(),
+                                                   **loop_presets(scenario)}, fixed=fixed,
                       mass_matrix=scenario.material.mass_matrix,
                       physics=scenario.material.physics)
     return Built(surface=surface, model=model, load=None, fixed=fixed, units=units)

@@ -69,9 +69,14 @@ STIFFNESS_TERMS = (("w10", (1, 0), 1.0), ("w01", (0, 1), 1.0), ("w20", (2, 0), 1
                    ("w11", (1, 1), 2.0), ("w02", (0, 2), 1.0))
 
 
+def loop_keys(count: int) -> tuple[str, ...]:
+    """Boundary keys of ``count`` loops: ``outer``, then ``hole1``, ``hole2``, … in order."""
+    return ("outer",) + tuple(f"hole{k}" for k in range(1, count))
+
+
 def loop_names(domain: TrimDomain) -> tuple[str, ...]:
-    """Boundary keys of the loops: ``outer``, then ``hole1``, ``hole2``, … in order."""
-    return ("outer",) + tuple(f"hole{k}" for k in range(1, len(domain.holes) + 1))
+    """Boundary keys of the loops of ``domain`` (:func:`loop_keys`)."""
+    return loop_keys(len(domain.loops))
 
 
 def trim_grid(surface: Any) -> Grid:
