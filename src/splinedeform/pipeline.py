@@ -331,10 +331,15 @@ def _measure(result: RunResult) -> None:
         name = f"p{i} ({u:g}, {v:g})"
         result.probes[name] = histories[i - 1]
         result.probe_points[name] = (float(u), float(v))
-    uu, vv = surface.sample_parameters(scenario.output.resolution)
-    Bu = surface.basis_u.matrix(uu).toarray()
-    Bv = surface.basis_v.matrix(vv).toarray()
-    grid = np.einsum("ik,fklc,jl->fijc", Bu, D, Bv, optimize=True)
+    if surface.trim is not None:             # the displacement inside the trim loops only
+        from .export import tessellate_frames
+
+        grid = tessellate_frames(surface, D, scenario.output.resolution)[0]
+    else:
+        uu, vv = surface.sample_parameters(scenario.output.resolution)
+        Bu = surface.basis_u.matrix(uu).toarray()
+        Bv = surface.basis_v.matrix(vv).toarray()
+        grid = np.einsum("ik,fklc,jl->fijc", Bu, D, Bv, optimize=True)
     # |d| per frame, scaled so that the squares of a tiny d do not underflow
     size = float(np.abs(grid).max(initial=0.0))
     scale = size if 0.0 < size < np.inf else 1.0
