@@ -40,7 +40,6 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
-from ..basis import BSplineBasis
 from ..boundary import Constraints, build_constraints, trim_conditions
 from ..errors import InputError
 from ..material import Material
@@ -48,6 +47,7 @@ from ..solvers import rigid
 from .cells import Grid, loop_pieces
 from .loops import TrimDomain
 from .quadrature import TrimQuadrature, trim_quadrature
+from .surface_trim import trim_grid
 from .values import tensor_values
 from .web import web_basis
 
@@ -77,21 +77,6 @@ def loop_keys(count: int) -> tuple[str, ...]:
 def loop_names(domain: TrimDomain) -> tuple[str, ...]:
     """Boundary keys of the loops of ``domain`` (:func:`loop_keys`)."""
     return loop_keys(len(domain.loops))
-
-
-def trim_grid(surface: Any) -> Grid:
-    """The knot cells of a surface that can be trimmed: equal cells in both directions
-    (``uniform`` or ``open`` knots), one degree."""
-    bases = (surface.basis_u, surface.basis_v)
-    for name, basis in zip("uv", bases):
-        if not isinstance(basis, BSplineBasis) or basis.kind not in ("uniform", "open"):
-            kind = getattr(basis, "kind", type(basis).__name__)
-            raise InputError(f"a trimmed surface needs equal knot cells ('uniform' or 'open' "
-                             f"knots) in {name}, got {kind!r}")
-    if bases[0].degree != bases[1].degree:
-        raise InputError(f"a trimmed surface needs one degree in u and v, got "
-                         f"{bases[0].degree} and {bases[1].degree}")
-    return Grid((bases[0].cells, bases[1].cells), (bases[0].length, bases[1].length))
 
 
 def quadrature_of(surface: Any) -> TrimQuadrature:

@@ -6,7 +6,9 @@ from typing import Any
 
 import numpy as np
 
+from ..basis import BSplineBasis
 from ..errors import InputError
+from .cells import Grid
 from .loops import Loop, TrimDomain
 
 
@@ -22,9 +24,26 @@ def loop_outside(surface: Any, loop: Loop) -> str | None:
     return None
 
 
+def trim_grid(surface: Any) -> Grid:
+    """The knot cells of a surface that can be trimmed: equal cells in both directions
+    (``uniform`` or ``open`` knots), one degree."""
+    bases = (surface.basis_u, surface.basis_v)
+    for name, basis in zip("uv", bases):
+        if not isinstance(basis, BSplineBasis) or basis.kind not in ("uniform", "open"):
+            kind = getattr(basis, "kind", type(basis).__name__)
+            raise InputError(f"a trimmed surface needs equal knot cells ('uniform' or 'open' "
+                             f"knots) in {name}, got {kind!r}")
+    if bases[0].degree != bases[1].degree:
+        raise InputError(f"a trimmed surface needs one degree in u and v, got "
+                         f"{bases[0].degree} and {bases[1].degree}")
+    return Grid((bases[0].cells, bases[1].cells), (bases[0].length, bases[1].length))
+
+
 def checked_trim(surface: Any, domain: Any) -> TrimDomain:
     """``domain`` if it is a :class:`TrimDomain` whose loops all lie inside the parameter
-    rectangle of ``surface`` (:func:`loop_outside`)."""
+    rectangle of ``surface`` (:func:`loop_outside`), on a surface that can be trimmed
+    (:func:`trim_grid`)."""
+    trim_grid(surface)
     if not isinstance(domain, TrimDomain):
         raise InputError(f"a surface's trim must be a splinedeform.trim.TrimDomain, got "
                          f"{type(domain).__name__}")
