@@ -16,6 +16,7 @@ from splinedeform.scenario import (SHAPE_PARAMETERS, Scenario, build, build_load
                                    parse_scenario, scenario_to_toml, with_overrides)
 
 from tiny_scenario import BASE
+from trim_scenario import TRIMMED
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "scenario.md"
@@ -157,30 +158,6 @@ ANALYTIC = (BASE
 
 #: the free set listed point by point, as splinedeform sculpt paints it
 PAINTED = STATIC.replace('v1 = "pinned"\n', 'v1 = "pinned"\nfree_points = [[1, 1], [2, 2], [3, 3]]\n')
-
-#: a disc with a square window cut from a plane, held on its rim (docs/trim.md)
-TRIMMED = """
-[surface]
-shape = "plane"
-cells = 8
-knots = "uniform"
-[surface.trim]
-[[surface.trim.loops]]
-name = "rim"
-circle = { centre = [0.5, 0.5], radius = 0.4 }
-edge = "clamped"
-[[surface.trim.loops]]
-polygon = [[0.4, 0.4], [0.6, 0.4], [0.6, 0.6], [0.4, 0.6]]
-[material]
-w20 = 1.0
-w11 = 1.0
-w02 = 1.0
-[[load]]
-kind = "uniform"
-force = [0, 0, 1]
-[solve]
-kind = "static"
-"""
 
 COVERAGE = {"plane": PLANE, "newmark": NEWMARK, "modes": MODES, "static": STATIC,
             "analytic": ANALYTIC, "painted": PAINTED, "trimmed": TRIMMED}

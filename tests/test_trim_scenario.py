@@ -9,30 +9,7 @@ from typer.testing import CliRunner
 from splinedeform import cli
 from splinedeform.errors import ScenarioError
 from splinedeform.scenario import build, parse_scenario
-
-HEAD = """
-[surface]
-shape = "plane"
-cells = 10
-knots = "uniform"
-[surface.trim]
-"""
-RIM = """[[surface.trim.loops]]
-name = "rim"
-circle = { centre = [0.5, 0.5], radius = 0.4 }
-edge = "clamped"
-"""
-TAIL = """[material]
-w20 = 1.0
-w11 = 1.0
-w02 = 1.0
-[[load]]
-kind = "uniform"
-force = [0, 0, 1]
-[solve]
-kind = "static"
-"""
-
+from trim_scenario import HEAD, RIM, TAIL
 
 def error_of(loops: str, tail: str = TAIL) -> str:
     with pytest.raises(ScenarioError) as info:
