@@ -78,3 +78,23 @@ def test_a_trimmed_plate_runs_end_to_end(tmp_path):
                          for line in (out / "disc.obj").read_text().splitlines()
                          if line.startswith("v ")])
     assert np.hypot(vertices[:, 0] - 0.5, vertices[:, 1] - 0.5).max() < 0.4 + 1e-14
+
+
+def test_a_probe_outside_the_trimmed_region_is_located():
+    message = error_of(RIM, TAIL + "[output]\nprobes = [[0.05, 0.05]]\n")
+    assert "output.probes[1]" in message and "outside the trimmed region" in message
+
+
+def test_the_default_probe_lies_in_the_trimmed_region(tmp_path):
+    # a hole over the rectangle's centre: the probe moves to the nearest Gauss point of a
+    # whole inside cell, outside the hole
+    hole = "[[surface.trim.loops]]\ncircle = { centre = [0.5, 0.5], radius = 0.1 }\n"
+    scenario = tmp_path / "ring.toml"
+    scenario.write_text(HEAD + RIM + hole + TAIL + '[output]\nformats = ["report"]\n')
+    out = tmp_path / "out"
+    result = CliRunner().invoke(cli.app, ["run", str(scenario), "-o", str(out), "-q"])
+    assert result.exit_code == 0, result.output
+    name = next(k for k in json.loads((out / "report.json").read_text())["probes"]
+                if k.startswith("p1"))
+    u, v = (float(x) for x in name[name.index("(") + 1:name.index(")")].split(","))
+    assert 0.1 < np.hypot(u - 0.5, v - 0.5) < 0.4

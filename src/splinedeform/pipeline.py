@@ -358,8 +358,21 @@ def _measure(result: RunResult) -> None:
 
 
 def _domain_centre(surface: Any) -> tuple[float, float]:
+    """The rectangle's centre; on a trimmed surface whose region misses it, the Gauss
+    point of a whole cell inside the region nearest to it."""
+    import numpy as np
+
     (_, lu), (_, lv) = surface.domain
-    return (0.5 * lu, 0.5 * lv)
+    centre = (0.5 * lu, 0.5 * lv)
+    if surface.trim is None or surface.trim.contains(centre):
+        return centre
+    from .trim import INSIDE
+    from .trim.model_matrices import quadrature_of
+
+    quad = quadrature_of(surface)
+    points = quad.points[quad.classes[quad.cell[:, 0], quad.cell[:, 1]] == INSIDE]
+    best = points[np.argmin(np.hypot(points[:, 0] - centre[0], points[:, 1] - centre[1]))]
+    return (float(best[0]), float(best[1]))
 
 
 __all__ = ["ProgressCallback", "RunResult", "make_report", "planned_outputs", "run",

@@ -257,6 +257,9 @@ def _check_parameters(scenario: Scenario, surface: Any) -> None:
             if not basis.periodic and not -1e-12 <= x <= basis.length * (1 + 1e-12):
                 raise scenario.error(path, f"{name} = {x:g} is outside the parameter domain "
                                            f"[0, {basis.length:g}] of this surface")
+        if surface.trim is not None and not surface.trim.contains([u, v]):
+            raise scenario.error(path, f"(u, v) = ({u:g}, {v:g}) is outside the trimmed "
+                                       "region of this surface (surface.trim)")
 
 
 def build(scenario: Scenario) -> Built:
