@@ -80,3 +80,24 @@ def test_refusals_name_the_problem():
     with pytest.raises(InputError, match="equal knot cells"):
         sd.shapes.cylinder(cells=(8, 4)).with_trim(
             TrimDomain(PolygonLoop([[1, 0.5], [3, 0.5], [3, 1.5], [1, 1.5]])))
+
+
+def test_a_holed_rectangle_keeps_its_edges_in_the_mesh():
+    # the rectangle as outer loop: the grid's boundary vertices count as inside (the
+    # polygon's even–odd test alone is ambiguous there); area 1 − πr² less the hole's
+    # chords, s³/(12 r) each, to 3e-6 relative as for the disc
+    from splinedeform.trim.tessellate import surface_grid
+
+    rectangle = PolygonLoop([[0, 0], [1, 0], [1, 1], [0, 1]])
+    surface = sd.shapes.plane(cells=(6, 6)).with_trim(
+        TrimDomain(rectangle, (CircleLoop((0.5, 0.5), R),)))
+    u = np.linspace(0.0, 1.0, 21)
+    uv, faces = surface_grid(surface, u, u)
+    P = uv[faces]
+    e1, e2 = P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]
+    area = 0.5 * (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    edges = _boundary_edges(faces)
+    on_hole = np.abs(np.hypot(*(uv[edges] - 0.5).transpose(2, 0, 1)) - R).max(axis=1) < 1e-14
+    chords = np.linalg.norm(uv[edges[on_hole, 0]] - uv[edges[on_hole, 1]], axis=1)
+    exact = 1 - np.pi * R * R
+    assert abs((area.sum() - np.sum(chords ** 3) / (12 * R)) / exact - 1) < 3e-6

@@ -98,3 +98,19 @@ def test_the_default_probe_lies_in_the_trimmed_region(tmp_path):
                 if k.startswith("p1"))
     u, v = (float(x) for x in name[name.index("(") + 1:name.index(")")].split(","))
     assert 0.1 < np.hypot(u - 0.5, v - 0.5) < 0.4
+
+
+def test_holes_in_the_whole_rectangle_keep_its_edges():
+    text = (HEAD.replace("[surface.trim]", "[surface.trim]\nrectangle = true")
+            + '[[surface.trim.loops]]\nname = "bore"\n'
+              'circle = { centre = [0.5, 0.5], radius = 0.2 }\n'
+            + TAIL.replace("[[load]]", '[boundary]\nu0 = "clamped"\nv1 = "pinned"\n[[load]]'))
+    built = build(parse_scenario(text, source="holed.toml"))
+    assert built.model.constraints.edges == {"u0": "clamped", "u1": "free", "v0": "free",
+                                             "v1": "pinned", "outer": "free", "hole1": "free"}
+    # a point load inside the bore is refused at its key
+    loaded = text.replace('kind = "uniform"\nforce = [0, 0, 1]',
+                          'kind = "point"\nat = [0.5, 0.5]\nforce = [0, 0, 1]')
+    with pytest.raises(ScenarioError) as info:
+        build(parse_scenario(loaded, source="holed.toml"))
+    assert "load[1].at" in str(info.value) and "outside the trimmed region" in str(info.value)

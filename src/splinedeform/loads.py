@@ -24,6 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 from .errors import InputError
 from .quadrature import gauss_points, integrals
 from .surface import Surface
+from .trim.surface_trim import region_contains
 
 
 def _finite(value: float, what: str) -> float:
@@ -230,7 +231,7 @@ class Point(Load):
             if not basis.periodic and not 0.0 <= value <= basis.length:
                 raise InputError(f"point load at {name}={value:g} is outside the parameter "
                                  f"domain [0, {basis.length:g}]")
-        if surface.trim is not None and not surface.trim.contains([self.u, self.v]):
+        if surface.trim is not None and not region_contains(surface, [self.u, self.v]):
             raise InputError(f"point load at (u, v) = ({self.u:g}, {self.v:g}) is outside the "
                              "trimmed region of the surface")
         E = surface.evaluation_matrix(np.array([self.u]), np.array([self.v]))

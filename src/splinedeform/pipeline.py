@@ -364,7 +364,9 @@ def _domain_centre(surface: Any) -> tuple[float, float]:
 
     (_, lu), (_, lv) = surface.domain
     centre = (0.5 * lu, 0.5 * lv)
-    if surface.trim is None or surface.trim.contains(centre):
+    from .trim.surface_trim import region_contains
+
+    if surface.trim is None or region_contains(surface, centre):
         return centre
     from .trim import INSIDE
     from .trim.model_matrices import quadrature_of

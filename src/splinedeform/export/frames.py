@@ -82,12 +82,12 @@ def tessellate_frames(surface: Surface, nets: ArrayLike, resolution: int = 32
 def _clipped_frames(surface: Surface, nets: ArrayLike, u: NDArray[np.float64],
                     v: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """:func:`tessellate_frames` of a trimmed surface: one sparse product for all frames."""
-    from ..trim.tessellate import clipped_grid
+    from ..trim.tessellate import surface_grid
 
     P = np.asarray(nets, dtype=float)
     if P.shape[-3:] != (*surface.shape, 3):
         raise InputError(f"control nets must end in shape {(*surface.shape, 3)}, got {P.shape}")
-    uv, faces = clipped_grid(surface.trim, u, v)
+    uv, faces = surface_grid(surface, u, v)
     E = surface.evaluation_matrix(uv[:, 0], uv[:, 1])
     lead = P.shape[:-3]
     flat = np.moveaxis(P.reshape(-1, E.shape[1], 3), 0, 1).reshape(E.shape[1], -1)

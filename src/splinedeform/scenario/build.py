@@ -10,6 +10,7 @@ from typing import Any, Iterator
 
 from ..errors import InputError, ScenarioError
 from .spec import Scenario, SurfaceSpec
+from ..trim.surface_trim import region_contains
 from .trim_build import loop_presets, trimmed
 
 
@@ -257,7 +258,7 @@ def _check_parameters(scenario: Scenario, surface: Any) -> None:
             if not basis.periodic and not -1e-12 <= x <= basis.length * (1 + 1e-12):
                 raise scenario.error(path, f"{name} = {x:g} is outside the parameter domain "
                                            f"[0, {basis.length:g}] of this surface")
-        if surface.trim is not None and not surface.trim.contains([u, v]):
+        if surface.trim is not None and not region_contains(surface, [u, v]):
             raise scenario.error(path, f"(u, v) = ({u:g}, {v:g}) is outside the trimmed "
                                        "region of this surface (surface.trim)")
 

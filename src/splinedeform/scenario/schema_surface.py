@@ -84,7 +84,10 @@ class TrimLoop(_Table):
 class Trim(_Table):
     loops: list[TrimLoop] = Field(min_length=1, description=(
         "the trim loops, each `{name, polygon | circle | spline, edge}`: the first is the "
-        "outer loop, the others holes in it"))
+        "outer loop, the others holes in it (all holes with `rectangle`)"))
+    rectangle: Annotated[bool, Strict()] = Field(False, description=(
+        "the outer loop is the parameter rectangle itself: every loop is a hole in it, and "
+        "the rectangle's edges keep their `[boundary]` conditions"))
 
 
 class _Fitted(_Refined):
@@ -109,7 +112,8 @@ class _Fitted(_Refined):
             "a trimmed region in (u, v): `[[surface.trim.loops]]` tables, each a `polygon`, "
             "`circle` or `spline`, with a `name` and an `edge` condition (docs/trim.md); the "
             "model then lives on the region inside the outer loop and outside the holes "
-            "(physics `parametric`, equal knot cells, the rectangle's edges free)"),
+            "(physics `parametric`, equal knot cells; the rectangle's edges free unless "
+            "`rectangle`)"),
         json_schema_extra={"doc_default": "none (the whole rectangle)"})
 
 

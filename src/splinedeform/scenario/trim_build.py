@@ -12,9 +12,15 @@ from ..trim.model_matrices import loop_keys
 from ..trim.surface_trim import loop_outside
 
 
+def _keys(trim: Any) -> tuple[str, ...]:
+    """The loops' boundary keys: ``outer``, ``hole1``, … (all holes with ``rectangle``)."""
+    keys = loop_keys(len(trim.loops) + 1)
+    return keys[1:] if trim.rectangle else keys[:-1]
+
+
 def loop_labels(trim: Any) -> list[str]:
     """Each loop's name as given, else its boundary key (``outer``, ``hole1``, …)."""
-    return [loop.name or key for loop, key in zip(trim.loops, loop_keys(len(trim.loops)))]
+    return [loop.name or key for loop, key in zip(trim.loops, _keys(trim))]
 
 
 def trimmed(scenario: Any, surface: Any) -> Any:
@@ -46,11 +52,15 @@ def trimmed(scenario: Any, surface: Any) -> Any:
                 raise scenario.error(where[k], f"loop {labels[k]!r} crosses or touches loop "
                                      f"{labels[j]!r}; trim loops must not meet")
         loops.append(loop)
+    (_, lu), (_, lv) = surface.domain
+    if trim.rectangle:
+        loops.insert(0, PolygonLoop([[0.0, 0.0], [lu, 0.0], [lu, lv], [0.0, lv]]))
     try:
         domain = TrimDomain(loops[0], tuple(loops[1:]))
     except InputError as exc:
-        raise scenario.error("surface.trim.loops", f"{exc} (the first loop, {labels[0]!r}, is "
-                             "the outer loop; the others are its holes)") from None
+        outer = "the rectangle" if trim.rectangle else f"the first loop, {labels[0]!r},"
+        raise scenario.error("surface.trim.loops", f"{exc} ({outer} is the outer loop; the "
+                             "others are its holes)") from None
     try:
         return surface.with_trim(domain)
     except InputError as exc:
@@ -70,4 +80,4 @@ def loop_presets(scenario: Any) -> dict[str, str]:
     trim = scenario.surface.trim
     if trim is None:
         return {}
-    return dict(zip(loop_keys(len(trim.loops)), (loop.edge for loop in trim.loops)))
+    return dict(zip(_keys(trim), (loop.edge for loop in trim.loops)))

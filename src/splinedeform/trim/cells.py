@@ -129,13 +129,15 @@ def _spline_pieces(loop: SplineLoop, grid: Grid) -> tuple[NDArray, NDArray, NDAr
     return s[keep], t[keep], nxt_t[keep]
 
 
-def loop_pieces(domain: TrimDomain, grid: Grid) -> Pieces:
-    """Split every loop of ``domain`` at the grid lines, with the loop's orientation kept."""
+def loop_pieces(domain: TrimDomain, grid: Grid, loops: tuple | None = None) -> Pieces:
+    """Split every loop of ``domain`` (or the given ``loops`` of it) at the grid lines, with
+    the loop's orientation kept; ``Pieces.loop`` counts in the loops split."""
+    loops = domain.loops if loops is None else loops
     kinds, los, his, starts, ends, centres, radii = [], [], [], [], [], [], []
-    q = 1 + max([loop.degree for loop in domain.loops if isinstance(loop, SplineLoop)],
+    q = 1 + max([loop.degree for loop in loops if isinstance(loop, SplineLoop)],
                 default=0)
     polys = []
-    for loop in domain.loops:
+    for loop in loops:
         if isinstance(loop, SplineLoop):
             span, lo, hi = _spline_pieces(loop, grid)
             kinds.append(np.full(len(lo), 2))

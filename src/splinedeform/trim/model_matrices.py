@@ -47,7 +47,8 @@ from ..solvers import rigid
 from .cells import Grid, loop_pieces
 from .loops import TrimDomain
 from .quadrature import TrimQuadrature, trim_quadrature
-from .surface_trim import trim_grid
+from .holed import holed_quadrature, with_edges
+from .surface_trim import holed_rectangle, trim_grid
 from .values import tensor_values
 from .web import web_basis
 
@@ -84,8 +85,8 @@ def quadrature_of(surface: Any) -> TrimQuadrature:
     the ``2n`` per variable of the energies on inside cells); kept with the surface."""
     key = ("trim quadrature",)
     if key not in surface._cache:
-        surface._cache[key] = trim_quadrature(surface.trim, trim_grid(surface),
-                                              surface.basis_u.degree + 2)
+        rule = holed_quadrature if holed_rectangle(surface) else trim_quadrature
+        surface._cache[key] = rule(surface.trim, trim_grid(surface), surface.basis_u.degree + 2)
     return surface._cache[key]
 
 
@@ -135,7 +136,8 @@ def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str
     domain: TrimDomain = surface.trim
     grid = trim_grid(surface)
     names = loop_names(domain)
-    edges, loops = trim_conditions(boundary, names)
+    rectangle = holed_rectangle(surface)
+    edges, loops = trim_conditions(boundary, names, rectangle)
     held = {k: loops[name] for k, name in enumerate(names) if loops[name] != "free"}
     bending = max(material.w20, material.w11, material.w02)
     if held and bending and surface.basis_u.degree < 3:
@@ -157,22 +159,26 @@ def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str
         M = sp.diags(np.asarray(M.sum(axis=1)).ravel())
     if held:
         K = K + nitsche_terms(surface, material, grid, held)
-    web = web_basis(quad.classes, surface.basis_u.degree)
-    free_index = np.flatnonzero(web.inner.ravel())
-    constraints = Constraints(web.extension.tocsr(), None, None, free_index,
-                              {**edges, **loops}, False)
-    count = 0 if held else rigid.rigid_count(rigid.parametric_terms(material), *bases,
-                                             build_constraints(*bases, "free"))
+    if rectangle:
+        T, free_index = with_edges(surface, edges, quad.classes)
+    else:
+        web = web_basis(quad.classes, surface.basis_u.degree)
+        T, free_index = web.extension.tocsr(), np.flatnonzero(web.inner.ravel())
+    constraints = Constraints(T, None, None, free_index, {**edges, **loops}, False)
+    # held loops or edges leave no motion without energy (Nitsche's penalty, the edges'
+    # constraints); else the energy's polynomials, which the extension reproduces
+    count = 0 if held or set(edges.values()) != {"free"} else rigid.rigid_count(
+        rigid.parametric_terms(material), *bases, build_constraints(*bases, "free"))
     return TrimmedSystem(constraints, ((K + K.T) * 0.5).tocsr(), sp.csr_matrix(M), int(count))
 
 
-def loop_quadrature(domain: TrimDomain, grid: Grid, order: int
+def loop_quadrature(domain: TrimDomain, grid: Grid, order: int, loops: tuple | None = None
                     ) -> tuple[NDArray[np.float64], ...]:
-    """Gauss points along every loop piece: points ``(P, 2)``, arc-length weights ``(P,)``,
-    outward unit normals ``(P, 2)``, unit tangents ``(P, 2)`` (with ``Ω`` on their left)
-    and the loop index ``(P,)``."""
+    """Gauss points along every loop piece (of ``loops``, default all): points ``(P, 2)``,
+    arc-length weights ``(P,)``, outward unit normals ``(P, 2)``, unit tangents ``(P, 2)``
+    (with ``Ω`` on their left) and the loop index ``(P,)`` among those split."""
     xi, om = np.polynomial.legendre.leggauss(order)
-    pieces = loop_pieces(domain, grid)
+    pieces = loop_pieces(domain, grid, loops)
     half = 0.5 * (pieces.hi - pieces.lo)
     t = 0.5 * (pieces.lo + pieces.hi)[:, None] + half[:, None] * xi
     point, tangent = pieces.evaluate(t)
@@ -189,7 +195,11 @@ def nitsche_terms(surface: Any, material: Material, grid: Grid, held: Mapping[in
                   ) -> sp.csr_matrix:
     """Nitsche's symmetric terms and penalties of the held loops (module docstring)."""
     m = material
-    p, ds, n, s, loop = loop_quadrature(surface.trim, grid, surface.basis_u.degree + 2)
+    domain = surface.trim
+    first = 1 if holed_rectangle(surface) else 0       # the rectangle's edges are no loop
+    p, ds, n, s, loop = loop_quadrature(domain, grid, surface.basis_u.degree + 2,
+                                        domain.loops[first:])
+    loop = loop + first
     (_, lu), (_, lv) = surface.domain
     p = np.clip(p, 0.0, [lu, lv])
     orders = [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2), (3, 0), (2, 1), (1, 2), (0, 3)]

@@ -14,33 +14,50 @@ an area of about ``s³ / (12 r)`` per chord).
 
 from __future__ import annotations
 
+from typing import Any, Callable
+
 import numpy as np
 from numpy.typing import NDArray
 
 from ..surface import grid_faces
 from .loops import TrimDomain
+from .surface_trim import region_contains
 
 BISECTIONS = 60
 """Halvings of a crossing grid edge: ``2⁻⁶⁰`` of its length, below round-off."""
 
 
-def crossing_points(domain: TrimDomain, inside: NDArray[np.float64],
+Contains = Callable[[NDArray[np.float64]], NDArray[np.bool_]]
+
+
+def crossing_points(contains: Contains, inside: NDArray[np.float64],
                     outside: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Points on ``∂Ω`` between ``inside`` and ``outside`` points ``(E, 2)`` by bisection."""
+    """Points on ``∂Ω`` between ``inside`` and ``outside`` points ``(E, 2)`` by bisection
+    with the point-in-region test ``contains``."""
     a, b = inside.copy(), outside.copy()
     for _ in range(BISECTIONS):            # halvings of all edges at once
         mid = 0.5 * (a + b)
-        keep = domain.contains(mid)[:, None]
+        keep = contains(mid)[:, None]
         a, b = np.where(keep, mid, a), np.where(keep, b, mid)
     return 0.5 * (a + b)
 
 
-def clipped_grid(domain: TrimDomain, u: NDArray[np.float64], v: NDArray[np.float64]
+def surface_grid(surface: Any, u: NDArray[np.float64], v: NDArray[np.float64]
                  ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
-    """Parameters ``(N, 2)`` and faces ``(F, 3)`` of the grid ``u × v`` clipped to ``Ω``."""
+    """:func:`clipped_grid` of a trimmed surface's region (the rectangle's own edges inside
+    when it is the outer loop, :func:`~splinedeform.trim.surface_trim.region_contains`)."""
+    return clipped_grid(surface.trim, u, v, lambda p: region_contains(surface, p))
+
+
+def clipped_grid(domain: TrimDomain, u: NDArray[np.float64], v: NDArray[np.float64],
+                 contains: Contains | None = None
+                 ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """Parameters ``(N, 2)`` and faces ``(F, 3)`` of the grid ``u × v`` clipped to ``Ω``
+    (``contains`` its point test, default ``domain.contains``)."""
+    contains = domain.contains if contains is None else contains
     points = np.stack(np.meshgrid(u, v, indexing="ij"), axis=-1).reshape(-1, 2)
     faces = grid_faces(u.size, v.size)
-    inside = domain.contains(points)
+    inside = contains(points)
     count = inside[faces].sum(axis=1)
     whole = faces[count == 3]
     cut = faces[(count == 1) | (count == 2)]
@@ -59,7 +76,7 @@ def clipped_grid(domain: TrimDomain, u: NDArray[np.float64], v: NDArray[np.float
     end_in = inside[ends[:, 0]]
     start = np.where(end_in, ends[:, 0], ends[:, 1])
     stop = np.where(end_in, ends[:, 1], ends[:, 0])
-    crossings = crossing_points(domain, points[start], points[stop])
+    crossings = crossing_points(contains, points[start], points[stop])
     p_ab, p_ca = n + slot[:len(a)], n + slot[len(a):]
     one, two = lone == 1, lone == 2
     new = np.concatenate([

@@ -146,10 +146,10 @@ def _clipped_mode_geometry(surface: Surface, phi_net: NDArray[np.float64],
                            u: NDArray[np.float64], v: NDArray[np.float64], scale: float
                            ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
     """:func:`mode_geometry` on the grid clipped to the trim loops
-    (:func:`splinedeform.trim.tessellate.clipped_grid`)."""
-    from ..trim.tessellate import clipped_grid
+    (:func:`splinedeform.trim.tessellate.surface_grid`)."""
+    from ..trim.tessellate import surface_grid
 
-    uv, faces = clipped_grid(surface.trim, u, v)
+    uv, faces = surface_grid(surface, u, v)
     pu, pv = uv[:, 0], uv[:, 1]
     phi = surface.derivative(pu, pv, control_points=phi_net[..., None])[:, 0]
     x = surface.derivative(pu, pv)
