@@ -72,6 +72,8 @@ def test_refusals_name_the_problem():
         sd.Model(surface, membrane, boundary="pinned", fixed=np.zeros(surface.shape, bool))
     with pytest.raises(InputError, match="parametric"):
         sd.Model(surface, membrane, boundary="pinned", physics="intrinsic")
+    with pytest.raises(InputError, match="rest = 'none'"):
+        sd.Model(surface, membrane, boundary="pinned", rest="none")
     with pytest.raises(InputError, match="shell is not trimmed"):
         sd.ShellModel(surface, sd.ShellMaterial(1.0, 0.3, 0.01, 1.0))
     with pytest.raises(InputError, match="outside the trimmed region"):

@@ -122,7 +122,7 @@ class Model:
         self.rest = rest
         self.physics = physics
         trimmed = None if surface.trim is None else trimmed_system(
-            surface, material, boundary, mass_matrix == "lumped", physics, fixed)
+            surface, material, boundary, mass_matrix == "lumped", physics, fixed, rest)
         self.constraints: Constraints = trimmed.constraints if trimmed else build_constraints(
             surface.basis_u, surface.basis_v, boundary,
             None if fixed is None else np.asarray(fixed), surface.control_points)

@@ -124,8 +124,8 @@ class TrimmedSystem:
 
 
 def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str, str],
-                   lumped: bool = False, physics: str = "parametric", fixed: Any = None
-                   ) -> TrimmedSystem:
+                   lumped: bool = False, physics: str = "parametric", fixed: Any = None,
+                   rest: str = "initial") -> TrimmedSystem:
     """``K``, ``M`` (see the module docstring) and ``d = E d_free`` of a trimmed surface."""
     if physics != "parametric":
         raise InputError(f"a trimmed surface takes physics 'parametric' (its energy over the "
@@ -139,6 +139,10 @@ def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str
     rectangle = holed_rectangle(surface)
     edges, loops = trim_conditions(boundary, names, rectangle)
     held = {k: loops[name] for k, name in enumerate(names) if loops[name] != "free"}
+    if held and rest == "none":
+        raise InputError("rest = 'none' (the energy of the position itself) is not combined "
+                         "with pinned or clamped trim loops yet: Nitsche's terms hold the "
+                         "displacement, not the position; use rest = 'initial'")
     bending = max(material.w20, material.w11, material.w02)
     if held and bending and surface.basis_u.degree < 3:
         raise InputError("a pinned or clamped trim loop under bending weights needs degree "
