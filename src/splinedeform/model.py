@@ -38,6 +38,7 @@ from .solvers.forcing import ReducedForcing
 from .solvers.system import KroneckerFactors, Reduction
 from .surface import Surface
 from .threads import owned
+from .trim.model_matrices import trimmed_system
 
 Array = NDArray[np.float64]
 METHODS = ("analytic", "newmark", "radau3", "radau5", "radau7", "genalpha", "rk45", "dop853",
@@ -86,6 +87,9 @@ class Model:
         ``parametric``: the paper's energy per unit parameter area (Kronecker matrices);
         ``intrinsic``: the same plate under tension measured on the initial surface
         (:mod:`splinedeform.physics.intrinsic`), independent of the parametrisation.
+        A trimmed surface (``surface.trim``) takes ``parametric`` over its trimmed region
+        (:mod:`splinedeform.trim.model_matrices`), with ``boundary`` naming its loops
+        (``{"outer": "clamped", "hole1": "free"}``).
 
     Examples
     --------
@@ -110,7 +114,9 @@ class Model:
         self.mass_matrix = mass_matrix
         self.rest = rest
         self.physics = physics
-        self.constraints: Constraints = build_constraints(
+        trimmed = None if surface.trim is None else trimmed_system(
+            surface, material, boundary, mass_matrix == "lumped", physics, fixed, rest)
+        self.constraints: Constraints = trimmed.constraints if trimmed else build_constraints(
             surface.basis_u, surface.basis_v, boundary,
             None if fixed is None else np.asarray(fixed), surface.control_points)
         if self.constraints.n_free == 0:
@@ -127,8 +133,9 @@ class Model:
         # K and M on the whole net: assembled here only where the constrained matrices are
         # made from them, else when first asked for (K_full, M_full)
         self._full: tuple[sp.csr_matrix, sp.csr_matrix] | None = (
-            intrinsic.matrices(surface, material, lumped) if physics == "intrinsic" else None)
-        reduced = None if physics == "intrinsic" else reduced_matrices(
+            intrinsic.matrices(surface, material, lumped) if physics == "intrinsic"
+            else (trimmed.stiffness, trimmed.mass) if trimmed else None)
+        reduced = None if physics == "intrinsic" or trimmed else reduced_matrices(
             self.gram_u, self.gram_v, material, lumped, self.constraints)
         if reduced is None:
             T = self.constraints.T
@@ -138,6 +145,8 @@ class Model:
         else:
             self._K, self._M, self._C = reduced
         self._finish(start)
+        if trimmed:
+            self._rigid = (trimmed.rigid_modes,)
 
     def _finish(self, start: float) -> None:
         """Damping ``C_r = (γ/μ) M_r + β K_r`` (unless made with K_r), the checks of scale

@@ -9,6 +9,7 @@ tensor-product operator on the flattened net is ``A_u ⊗ A_v``.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -75,6 +76,9 @@ class Surface:
         Maximum distance to the map the net was fitted to (set by :mod:`splinedeform.shapes`).
     name : str
         A label used in reports.
+    trim : TrimDomain or None
+        The trimmed region in ``(u, v)`` (:mod:`splinedeform.trim`); ``None``: the whole
+        rectangle. Set by :meth:`with_trim`.
     """
 
     control_points: NDArray[np.float64]
@@ -82,6 +86,7 @@ class Surface:
     basis_v: Basis
     fit_error: float | None = None
     name: str = "surface"
+    trim: Any = None
     _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -137,6 +142,13 @@ class Surface:
         """The same bases with another control net (``fit_error`` dropped)."""
         return replace(self, control_points=control_points, fit_error=None,
                        name=self.name if name is None else name)
+
+    def with_trim(self, domain: Any) -> Surface:
+        """The same surface trimmed to ``domain`` (a :class:`~splinedeform.trim.TrimDomain`
+        inside the parameter rectangle), or untrimmed for ``None``."""
+        from .trim.surface_trim import checked_trim
+
+        return replace(self, trim=None if domain is None else checked_trim(self, domain))
 
     # -- evaluation -------------------------------------------------------------
     def evaluation_matrix(self, u: ArrayLike, v: ArrayLike, du: int = 0, dv: int = 0
