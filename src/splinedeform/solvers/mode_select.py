@@ -185,11 +185,12 @@ def _count_power(lam: Array, k: int) -> float:
 
 def _over_damped_count(k: int, lam: Array, gamma: float, beta: float) -> int:
     """The modes to compute so that the first over-damped one (``λ ≥ λ_o``,
-    :func:`.transient_correction.over_damped_from`) is among them, from ``k + 1`` computed:
+    :func:`.transient_correction.over_damped_from`) is among them, from ``k + 1`` computed
+    (``k`` where none is over-damped or one is computed already):
     the count below ``λ_o`` continued as the power of :func:`_count_power`, plus 10 % and
     8 modes (an estimate too low costs one more round on the same Krylov space)."""
     lam_o = over_damped_from(gamma, beta)
-    if lam[k] >= lam_o:
+    if lam[k] >= lam_o or not np.isfinite(lam_o):
         return k
     below = (k + 1.0) * (lam_o / lam[k]) ** _count_power(lam, k)
     return int(np.ceil(1.1 * below)) + 8
