@@ -164,12 +164,15 @@ class BlockLanczos:
         self._append(Q, MQ)
 
     def _reserve(self, size: int) -> None:
+        """Room for ``size`` basis vectors, at least twice the room before (copies add up
+        to at most the final size). Column-major: the vectors in use are one contiguous
+        prefix, and the memory of the columns not yet written is never touched."""
         if size <= self.V.shape[1]:
             return
-        size = max(size, int(1.5 * self.V.shape[1]))
+        size = min(self.n, max(size, 2 * self.V.shape[1]))
         for name in ("V", "MV"):
             old = getattr(self, name)
-            new = np.empty((self.n, size))
+            new = np.empty((self.n, size), order="F")
             new[:, :self.p] = old[:, :self.p]
             setattr(self, name, new)
         H = np.zeros((size, size))
