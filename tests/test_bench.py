@@ -411,3 +411,22 @@ def test_a_net_too_large_for_memory_is_refused_by_its_estimate(tmp_path):
     assert "sizes [100000]: a 100000 x 100000-cell net needs about" in result.output
     assert "more than the 4 GiB" in result.output and "internal error" not in result.output
     assert not (tmp_path / "b").exists()
+
+
+def test_the_dop853_check_runs_on_small_nets_only(monkeypatch):
+    """The all-modes solution is checked against DOP853 on the smallest nets, and only up to
+    YARDSTICK_CELLS cells per direction (beyond, the check alone outlasts the study's
+    budget several times: at 32² it had not finished after 480 s)."""
+    from dataclasses import replace
+
+    from splinedeform.bench import sweep
+
+    checked = []
+    monkeypatch.setattr(sweep, "YARDSTICK_CELLS", 3)
+    monkeypatch.setattr(sweep, "yardstick", lambda case, row, budget: checked.append(case.cells))
+    study = config.make_study(sizes=[3, 4], quick=True, methods=["radau7"],
+                              families=["clamped"])
+    study = replace(study, yardstick_sizes=2)
+    sweep.study_family("clamped", study, lambda text: None)
+    assert checked == [3]
+    assert config.YARDSTICK_CELLS == 16
