@@ -32,7 +32,10 @@ milliseconds after a jump of the bench plate needs them, as its over-damped mode
 no faster than ``1/β``) — unless the omitted modes are all over-damped and the transient
 correction (:mod:`.transient_correction`, bound ``Σ_j ‖R_j‖_M E_d``) meets the tolerance
 with fewer modes than the static one: then it is taken (:func:`_transient_count`), and the
-search does not stop before the computed modes reach the over-damped range. From 16
+search does not stop before the computed modes reach the over-damped range; it grows
+straight to an estimate of the first over-damped mode (:func:`_over_damped_count`; at 64²
+the bench plate's 281 modes came from 17, 65 and 329 computed, where four-fold growth
+computed 1 025). From 16
 modes the estimate is not trusted: a uniform load's ``‖R‖``, flat over the symmetric
 modes it does not excite, predicted 2 400 where 33 did.
 """
