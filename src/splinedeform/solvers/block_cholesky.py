@@ -21,7 +21,8 @@ block shift-invert Lanczos (:mod:`.sparse_eigen`) solves a block of vectors at a
 LAPACK's band solve (``dpbtrs``) takes the right-hand sides one by one, reading the whole
 band for each (memory-bound). Measured on the bench plate, one BLAS thread
 (benchmarks/results.md): at 128² (``N = 16 129``, ``b = 384``) the band solve took
-8.1 ms a vector, these sweeps 3.4 ms in blocks of 16 (:data:`CACHED_BAND`). The factor keeps ``2 N w``
+8.1 ms a vector, these sweeps 2.2 ms in blocks of 16 (:data:`CACHED_BAND`), the two
+solutions within 1.3e-12 of each other relative to their size. The factor keeps ``2 N w``
 numbers (twice the band's: the coupling blocks are stored dense).
 """
 
@@ -39,8 +40,8 @@ BLOCK_BYTES = 256 * 2**20
 """Largest storage ``16 N w`` bytes of a block factor (128² cubic: 99 MB)."""
 CACHED_BAND = 16 * 2**20
 """Band storage (bytes) up to which the band solve is kept: at 64² (6 MB) it solved 0.42 ms
-a vector in blocks of 8 against these sweeps' 0.79 ms, at 128² (50 MB) 8.1 ms against 6.4
-(blocks of 8), 3.4 (16) and 2.7 (32) (CPU time, one BLAS thread)."""
+a vector in blocks of 8 against these sweeps' 0.79 ms, at 128² (50 MB) 8.1 ms against 3.8
+(blocks of 8), 2.2 (16) and 1.5 (32) (CPU time, one BLAS thread, best of five)."""
 SMALLEST_BLOCK = 64
 FEW = 4
 """Blocks are at least this wide (fewer, larger products where the band is narrow)."""

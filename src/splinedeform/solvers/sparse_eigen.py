@@ -270,8 +270,8 @@ def block_size(want: int, wide: bool = False) -> int:
     fewer times in the orthogonalisation, which dominates from a few dozen pairs on with
     one BLAS thread: 291 pairs at 64² took 2.9 s with blocks of 2, 0.88 s with 8, 1.3 s
     with 16; 17, then 65, then 312 pairs on the same space 1.5 s growing the block from 2,
-    1.1 s with 8 from the start. At 128² (band solve 8.1 ms a vector, block sweeps 3.4 ms
-    in 16s) 200 pairs took 472 solves with blocks of 8 and 576 with 16.
+    1.1 s with 8 from the start. At 128² (band solve 8.1 ms a vector, block sweeps 2.2 ms
+    in blocks of 16) 200 pairs took 472 solves with blocks of 8 and 576 with 16.
     """
     if wide:
         return 16
