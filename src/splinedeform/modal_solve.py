@@ -243,7 +243,7 @@ def _largest_below(basis: Any, correction: Any, report: dict[str, Any], jumps: l
     response = ModalResponse(lam, gamma + beta * lam, zero, zero,
                              [(t_j, basis.project(merged[t_j])) for t_j in order], [])
     row = basis.phi[p]                          # a DenseBasis (automatic_basis)
-    d = response(times)[0][:, :, c] @ row + correction(times)[:, p, c]
+    d = response(times)[0][:, :, c] @ row + correction.coordinate(times, p, c)
     error = report["estimate"].relative(times) * report["scale"]
     return float(np.max(np.abs(d) - error))
 
