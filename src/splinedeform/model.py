@@ -28,6 +28,7 @@ from .errors import InputError, SingularSystemError
 from .loads import Load, as_load, static_time
 from .material import Material, check_scales
 from .physics import PHYSICS
+from .physics.coupling_model import c0_coupling
 from . import modal_solve
 from .modal_solve import check_count as _check_count
 from .solution import ModalSolution, Readout, SampledSolution, StaticSolution
@@ -86,6 +87,8 @@ class Model:
         ``parametric``: the paper's energy per unit parameter area (Kronecker matrices);
         ``intrinsic``: the same plate under tension measured on the initial surface
         (:mod:`splinedeform.physics.intrinsic`), independent of the parametrisation.
+        With bending weights, the rotation across each C0 knot line is tied by a penalty
+        (:mod:`splinedeform.physics.coupling_model`), which leaves no Kronecker factors.
 
     Examples
     --------
@@ -124,9 +127,12 @@ class Model:
             raise error
         self.gram_u, self.gram_v, K, M = patch_matrices(surface, material, physics,
                                                         mass_matrix == "lumped")
+        kinks = c0_coupling(surface, material, self.constraints.edges)
+        if kinks is not None:                  # the slopes tied across each C0 line
+            K, self.gram_u, self.gram_v = (K + kinks).tocsr(), None, None
         T = self.constraints.T
         self.K_full, self.M_full = K, M
-        reduced = None if physics == "intrinsic" else reduced_matrices(
+        reduced = None if physics == "intrinsic" or kinks is not None else reduced_matrices(
             self.gram_u, self.gram_v, material, mass_matrix == "lumped", M, self.constraints)
         self._K, self._M = reduced or ((T.T @ K @ T).tocsc(), (T.T @ M @ T).tocsc())
         self._finish(start)

@@ -33,10 +33,14 @@ if TYPE_CHECKING:
 Array = NDArray[np.float64]
 
 
+NO_FACTORS = ("a body of several patches, or a patch whose C0 lines are coupled, has no "
+              "Kronecker factors")
+
+
 def kronecker_reason(model: Any) -> str | None:
     """Why the Kronecker factors do not apply to ``model`` (``None`` if they do)."""
     if getattr(model, "gram_u", True) is None:
-        return "a body of several patches has no Kronecker factors"
+        return NO_FACTORS
     if getattr(model, "physics", "parametric") != "parametric":
         return "the surface metric varies over the parameters (no Kronecker factors)"
     if model.mass_matrix != "consistent":
@@ -49,7 +53,7 @@ def kronecker_reason(model: Any) -> str | None:
 def separable_reason(model: Any) -> str | None:
     """Why the separable fast path does not apply to ``model`` (``None`` if it does)."""
     if getattr(model, "gram_u", True) is None:
-        return "a body of several patches has no Kronecker factors"
+        return NO_FACTORS
     if getattr(model, "physics", "parametric") != "parametric":
         return "the surface metric varies over the parameters (no Kronecker factors)"
     if model.material.w11 != 0:

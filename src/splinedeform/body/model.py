@@ -5,8 +5,10 @@ are those of a single surface (:func:`splinedeform.assembly.patch_matrices`), so
 
 .. math:: K = \\operatorname{diag}(K_1, …, K_P), \\qquad M = \\operatorname{diag}(M_1, …, M_P),
 
-and the constraint map ``d = T d_free`` of :mod:`.constraints` merges the control points
-of conforming interfaces and poles and applies the edge conditions of boundary edges:
+plus the penalties coupling non-conforming interfaces and, with bending, the rotation
+across every interface and C0 line (:mod:`splinedeform.physics.coupling_model`); the
+constraint map ``d = T d_free`` of :mod:`.constraints` merges the control points of
+conforming interfaces and poles and applies the edge conditions of boundary edges:
 ``K_r = Tᵀ K T``, ``M_r = Tᵀ M T``, ``F_r = Tᵀ F``. Everything a solver or a solution needs
 (static, modes, the closed-form and numerical dynamics) is the single-surface model's
 (:class:`splinedeform.Model`), on these matrices.
@@ -30,8 +32,10 @@ from ..model import Model, check_options
 from ..readout import BodyReadout
 from ..solvers.system import Reduction
 from ..surface import Surface
+from ..physics.coupling_model import c0_coupling, interface_coupling
 from .body import Body
 from .constraints import boundary_presets, build_body_constraints
+from .interface import EDGES
 from .loads import OnPatch
 
 Array = NDArray[np.float64]
@@ -66,7 +70,7 @@ class BodyModel(Model):
     boundary : str or mapping, default "free"
         ``"free" | "pinned" | "clamped"`` for every boundary edge (an edge no other edge
         meets), or ``{(patch, edge): preset}`` (missing boundary edges are free). Interface
-        and pole edges have no preset: their control points are merged.
+        and pole edges have no preset: they are merged or coupled (Notes).
     mass_matrix : {"consistent", "lumped"}
     rest : {"initial", "none"}
     physics : {"intrinsic", "parametric"}, default "intrinsic"
@@ -80,8 +84,16 @@ class BodyModel(Model):
     Raises
     ------
     InputError
-        For a non-manifold edge (three or more patches on one edge), a non-conforming
-        interface, or bending weights across an interface (the surface is only C0 there).
+        For a non-manifold edge (three or more patches on one edge).
+
+    Notes
+    -----
+    Conforming interfaces, seams and poles are merged by the constraint map; a
+    non-conforming interface is coupled by a displacement penalty projected onto the finer
+    edge's splines (a penalised mortar condition); with bending weights, every interface
+    and C0 knot line also by a penalty on the slope jump across it. The factors come from
+    the material and the mesh (:mod:`splinedeform.physics.coupling_model`); the mass is
+    the patches' own.
 
     Examples
     --------
@@ -103,7 +115,7 @@ class BodyModel(Model):
             body = Body(body)
         check_options(material, mass_matrix, rest, physics)
         topology = body.topology
-        _refuse(topology, material)
+        _refuse(topology)
         self.body = body
         self.patches: tuple[Surface, ...] = body.patches
         self.surface = None            # no single surface: the read-out has the patches
@@ -122,6 +134,15 @@ class BodyModel(Model):
         blocks = [patch_matrices(s, material, physics, mass_matrix == "lumped")[2:]
                   for s in self.patches]
         self.K_full = sp.block_diag([k for k, _ in blocks], format="csr")
+        offsets = self.constraints.offsets
+        size = int(offsets[-1])
+        couplings = [interface_coupling(self.patches, topology.interfaces, material,
+                                        self.constraints.edges, offsets[:-1])]
+        couplings += [c0_coupling(s, material, {e: self.constraints.edges.get((p, e), "free")
+                                                for e in EDGES}, int(offsets[p]), size)
+                      for p, s in enumerate(self.patches)]
+        for K in (K for K in couplings if K is not None):
+            self.K_full = (self.K_full + K).tocsr()
         self.M_full = sp.block_diag([m for _, m in blocks], format="csr")
         T = self.constraints.T
         self._K = (T.T @ self.K_full @ T).tocsc()
@@ -194,28 +215,10 @@ class BodyModel(Model):
         return int(np.sum(~held))
 
 
-def _refuse(topology: Any, material: Material) -> None:
-    """Refuse what the merged constraint map cannot couple (see :class:`BodyModel`)."""
+def _refuse(topology: Any) -> None:
+    """Refuse what neither the constraint map nor a penalty couples (see :class:`BodyModel`)."""
     if topology.non_manifold:
         group = topology.non_manifold[0]
         names = ", ".join(f"patch {p} edge {e}" for p, e in group)
         raise InputError(f"non-manifold edge: {len(group)} patch edges meet on one curve "
                          f"({names}); a body's edge joins at most two patch edges")
-    bad = [i for i in topology.interfaces if not i.conforming]
-    if bad:
-        i = bad[0]
-        raise InputError(f"non-conforming interface between patch {i.a} edge {i.edge_a} and "
-                         f"patch {i.b} edge {i.edge_b} (different knots, degrees or control "
-                         "points along the edge): refine to conforming (Body.conforming() "
-                         "inserts the missing knots where the degrees match) or wait for "
-                         "penalty coupling")
-    bending = [k for k in ("w20", "w11", "w02") if getattr(material, k)]
-    if bending and topology.interfaces:
-        i = topology.interfaces[0]
-        raise InputError(
-            f"bending weight {bending[0]} needs a C1 surface, but the patches meet at "
-            f"{len(topology.interfaces)} interface(s) (e.g. patch {i.a} edge {i.edge_a} with "
-            f"patch {i.b} edge {i.edge_b}) where merged control points make it only C0: the "
-            "surface may kink there, where bending energy is undefined, and would bend like "
-            "a hinge. The rotation across an interface is not coupled yet; use tension "
-            "weights only (w10, w01), or one patch")
