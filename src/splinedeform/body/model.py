@@ -84,7 +84,8 @@ class BodyModel(Model):
     Raises
     ------
     InputError
-        For a non-manifold edge (three or more patches on one edge).
+        For a non-manifold edge (three or more patches on one edge), or an interface whose
+        two edges are parametrised differently along the curve (not an affine map).
 
     Notes
     -----
@@ -222,3 +223,9 @@ def _refuse(topology: Any) -> None:
         names = ", ".join(f"patch {p} edge {e}" for p, e in group)
         raise InputError(f"non-manifold edge: {len(group)} patch edges meet on one curve "
                          f"({names}); a body's edge joins at most two patch edges")
+    for i, aligned in zip(topology.interfaces, topology.aligned):
+        if not aligned:
+            raise InputError(f"interface between patch {i.a} edge {i.edge_a} and patch {i.b} "
+                             f"edge {i.edge_b}: the edges meet, but their parametrisations "
+                             "along the curve are not an affine map of each other, which the "
+                             "coupling follows; reparametrise one of the two patches")
