@@ -202,9 +202,18 @@ class BodyModel(Model):
     def rigid_modes(self) -> int | None:
         """Dimension of ``null K_r``: with tension in both directions the energy vanishes on
         constant displacements only, one per connected part of the body that no pinned or
-        clamped edge holds; ``None`` (unknown) without tension."""
+        clamped edge holds. Without tension but with bending in both directions
+        (``w20, w02 > 0``) it is 0 where a clamped edge holds every part: a field without
+        energy is a polynomial with ``d_uu = d_vv = 0`` (``Δ d = 0`` intrinsic) on each span,
+        which vanishes with its value and slope on a segment (unique continuation), and the
+        merged points and the penalties carry value and slope across every span border and
+        interface. ``None`` (unknown) otherwise."""
         m = self.material
-        if not (m.w10 > 0 and m.w01 > 0):
+        if m.w10 > 0 and m.w01 > 0:
+            holds = ("pinned", "clamped")
+        elif m.w20 > 0 and m.w02 > 0:
+            holds = ("clamped",)
+        else:
             return None
         n = len(self.patches)
         links = [(i.a, i.b) for i in self.body.topology.interfaces] or [(0, 0)]
@@ -212,7 +221,9 @@ class BodyModel(Model):
         parts, label = connected_components(graph, directed=False)
         held = np.zeros(parts, dtype=bool)
         for (p, _), preset in self.constraints.edges.items():
-            held[label[p]] |= preset != "free"
+            held[label[p]] |= preset in holds
+        if holds == ("clamped",):
+            return 0 if held.all() else None
         return int(np.sum(~held))
 
 
