@@ -60,7 +60,7 @@ def test_a_decade_of_penalty_moves_the_body_less_than_its_discretisation_error(
     for scale in (10 ** -0.5, 1.0, 10 ** 0.5):
         monkeypatch.setattr(coupling, "PENALTY", scale * 1e5)
         answers.append(centre(non_conforming())[0])
-    assert np.ptp(answers) <= error
+    assert np.ptp(answers) <= error      # measured 6.9e-6 of the deflection against 1.4e-4
 
 
 def test_conforming_halves_with_bending_are_the_smooth_plate():
@@ -106,11 +106,11 @@ def test_a_shell_with_a_c0_line_sags_like_the_smooth_shell():
     w_smooth, w = (float(m.static(LOAD).displacement(0.5, 0.5)[2]) * D
                    for m in (smooth, kinked))
     # the smooth 8 × 8 shell is 1.4e-4 off the closed form; the coupled C0 line within a
-    # tenth of that of it (the penalty's error; measured 3e-6)
+    # tenth of that of it (the penalty's error; measured 1.7e-6)
     assert abs(w_smooth / CLAMPED_PLATE_CENTRE - 1) <= 2e-4
     assert abs(w - w_smooth) <= 1.4e-5 * w_smooth
     net = kinked.static(LOAD).net_displacement()[..., 2:]
-    # the slope jump across the line against the largest slope: 1e-5 (measured 5e-6)
+    # the slope jump across the line against the largest slope: 1e-5 (measured 7.6e-6)
     assert slope_jump(kinked_surface, net) <= 1e-5
 
 
