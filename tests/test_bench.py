@@ -325,6 +325,9 @@ def test_regimes_run_and_report_their_lines():
     assert ("horizon", "heavy damping, 3 periods") in found
     assert ("horizon", "light damping, 1 period") in found
     assert ("probes", "5 probes") in found and ("probes", "whole control nets") in found
+    # one state asks dynamic for its one time (modes chosen for it)
+    state = [r for r in rows if r.regime == "one state" and r.solver == "analytic"]
+    assert state and state[0].setting.startswith("default call, times given")
     for r in rows:
         if r.status == "ok":
             assert r.error <= config.QUICK.target

@@ -150,3 +150,4 @@ def test_modes_of_a_clamped_patch_with_a_c0_line_are_the_smooth_patch_modes():
     # the C0 space tied back to C1 at u = 1/2: the penalty's error, largest (1.9e-5
     # measured) for the mode antisymmetric across the line, held to 5e-5
     np.testing.assert_allclose(kinked.frequencies(4), smooth.frequencies(4), rtol=5e-5)
+

@@ -16,6 +16,7 @@ from splinedeform.scenario import (SHAPE_PARAMETERS, Scenario, build, build_load
                                    parse_scenario, scenario_to_toml, with_overrides)
 
 from tiny_scenario import BASE
+from trim_scenario import TRIMMED
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "scenario.md"
@@ -159,7 +160,7 @@ ANALYTIC = (BASE
 PAINTED = STATIC.replace('v1 = "pinned"\n', 'v1 = "pinned"\nfree_points = [[1, 1], [2, 2], [3, 3]]\n')
 
 COVERAGE = {"plane": PLANE, "newmark": NEWMARK, "modes": MODES, "static": STATIC,
-            "analytic": ANALYTIC, "painted": PAINTED}
+            "analytic": ANALYTIC, "painted": PAINTED, "trimmed": TRIMMED}
 
 
 def shape_scenario(shape: str, params: dict[str, object]) -> str:
@@ -182,7 +183,9 @@ FILE_TEXTS = [file_scenario("net.json", "frame = 0"),
               file_scenario("grid.npy", 'cells = 3\ndegree = 2\nknots = ["open", "open"]\n'
                                         'method = "l2"'),
               file_scenario("patch.3dm", 'face = 1\nunits = "in"\nrefine = {u = 2, v = 1}\n'
-                                         'elevate = [0, 1]').replace('"file"', '"cad"')]
+                                         'elevate = [0, 1]').replace('"file"', '"cad"'),
+              # several faces of a CAD file: run by tests/test_cad_body.py on files built there
+              file_scenario("solids.3dm", 'faces = ["box"]').replace('"file"', '"cad"')]
 
 
 def all_test_texts() -> list[str]:

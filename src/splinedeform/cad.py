@@ -18,6 +18,7 @@ import os
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -30,6 +31,9 @@ from .errors import InputError, InputWarning
 from .export.atomic import atomic_path
 from .knots import KnotVectorBasis, RationalBasis
 from .surface import Basis, Surface
+
+if TYPE_CHECKING:
+    from .trim.loops import TrimDomain
 
 #: relative tolerance for weights to count as a product ``a_i b_j`` (or as all equal)
 WEIGHT_TOL = 1e-12
@@ -191,13 +195,20 @@ CAD_SUFFIXES = {".3dm": "openNURBS", ".igs": "IGES", ".iges": "IGES", ".stp": "S
                 ".step": "STEP"}
 
 
-def read_cad(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
-    """Surface number ``face`` of a CAD file, chosen by its suffix (see :data:`CAD_SUFFIXES`)."""
-    path = Path(path)
+def cad_kind(path: Path) -> str:
+    """The format of a CAD file by its suffix (a value of :data:`CAD_SUFFIXES`); an
+    ``InputError`` for any other suffix."""
     kind = CAD_SUFFIXES.get(path.suffix.lower())
     if kind is None:
         raise InputError(f"{path}: not a CAD file (expected one of "
                          f"{', '.join(CAD_SUFFIXES)}), got suffix {path.suffix or 'none'!r}")
+    return kind
+
+
+def read_cad(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
+    """Surface number ``face`` of a CAD file, chosen by its suffix (see :data:`CAD_SUFFIXES`)."""
+    path = Path(path)
+    kind = cad_kind(path)
     if kind == "openNURBS":
         return read_3dm(path, face)
     from .cad_step import read_step   # STEP and IGES: OpenCASCADE, the 'cad-step' extra
@@ -206,17 +217,22 @@ def read_cad(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
 
 
 def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch],
-              names: list[str] | None = None, units: str | None = None) -> Path:
+              names: list[str] | None = None, units: str | None = None,
+              trims: list[TrimDomain | None] | None = None) -> Path:
     """Write ``patches`` as NURBS surfaces to a ``.3dm`` file (atomically); return its path.
 
     ``names`` label the objects (openNURBS object names), one per patch. ``units`` (a key
     of :data:`splinedeform.cad_units.UNITS`; default: the first patch's) is the file's
     ``ModelUnitSystem``; ``None`` when not known (openNURBS ``UnitSystem.None``).
+    ``trims`` (one per patch, None for an untrimmed one) are written beside their surface
+    as curves in its ``(u, v)`` (:func:`splinedeform.cad_trims_3dm.add_trim_curves`).
     """
     r3 = _rhino3dm()
     path = Path(path)
     if names is not None and len(names) != len(patches):
         raise InputError(f"{len(names)} object names for {len(patches)} surfaces")
+    if trims is not None and len(trims) != len(patches):
+        raise InputError(f"{len(trims)} trims for {len(patches)} surfaces")
     if units is None and patches:
         units = patches[0].units
     model = r3.File3dm()
@@ -236,6 +252,11 @@ def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch],
         if names is not None:
             attributes.Name = names[index]
         model.Objects.AddSurface(srf, attributes)
+        if trims is not None and trims[index] is not None:
+            from .cad_trims_3dm import add_trim_curves
+
+            add_trim_curves(model, r3, trims[index], len(model.Objects) - 1,
+                            names[index] if names is not None else f"surface {index}")
     with atomic_path(path) as tmp:
         if not model.Write(str(tmp), 7):
             raise InputError(f"{path}: openNURBS could not write the file")
@@ -262,11 +283,13 @@ def frame_patches(surface: Surface, times: NDArray[np.float64], nets: NDArray[np
 
 def write_frames_3dm(path: str | os.PathLike, surface: Surface, times: NDArray[np.float64],
                      nets: NDArray[np.float64], label: str = "t",
-                     units: str | None = None) -> Path:
+                     units: str | None = None, trim: TrimDomain | None = None) -> Path:
     """The initial surface and every frame as named NURBS surfaces in one ``.3dm`` file
     (object ``k + 1`` is frame ``k``; see :func:`frame_patches`), in ``units`` (see
-    :func:`write_3dm`). Written atomically."""
-    return write_3dm(path, *frame_patches(surface, times, nets, label), units=units)
+    :func:`write_3dm`), each with the trim loops ``trim`` when given. Written atomically."""
+    patches, names = frame_patches(surface, times, nets, label)
+    return write_3dm(path, patches, names, units=units,
+                     trims=None if trim is None else [trim] * len(patches))
 
 
 def read_3dm(path: str | os.PathLike, face: int = 0) -> NurbsPatch:

@@ -102,6 +102,12 @@ def list_3dm_arrays(path: Path) -> dict[str, Any]:
                 entry["closed"] = (bool(surface.IsClosed(0)), bool(surface.IsClosed(1)))
                 entry["periodic"] = (bool(surface.IsPeriodic(0)), bool(surface.IsPeriodic(1)))
                 entry.update(_patch_from_rhino(surface.ToNurbsSurface(), f"{path} object {index}"))
+                from .cad_trims import listed
+                from .cad_trims_3dm import member_trims
+
+                entry.update(listed(lambda: member_trims(
+                    model, r3, index if kind == "surface" else geometry, member,
+                    f"{path} face {len(faces)}")))
             except InputError as exc:
                 entry["error"] = str(exc)
             faces.append(entry)
@@ -174,3 +180,38 @@ def _patch_from_rhino(srf: Any, source: str) -> dict[str, Any]:
 
 def _xyzw(p) -> tuple[float, float, float, float]:
     return p.X, p.Y, p.Z, p.W
+
+
+#: interior points sampled along every Brep edge for the topology (ends left out: they
+#: lie on two sides of a face)
+EDGE_SAMPLES = 9
+
+
+def list_3dm_body(path: Path) -> dict[str, Any]:
+    """:func:`list_3dm_arrays` and the Brep edges: ``edges`` is one entry per edge of
+    every Brep (an extrusion's too), ``{"faces": [face number per trim], "points":
+    (EDGE_SAMPLES, 3) interior points}``, faces numbered as in the listing; a seam has
+    its face twice, a pole (a trim without an edge) is left out (run in the child)."""
+    data = list_3dm_arrays(path)
+    r3 = _rhino3dm()
+    model = r3.File3dm.Read(str(path))
+    edges, first = [], 0
+    t = (np.arange(EDGE_SAMPLES) + 0.5) / EDGE_SAMPLES
+    for _, _, geometry in _objects(model, r3):
+        if not isinstance(geometry, r3.Brep):
+            first += 1
+            continue
+        uses: dict[int, list[int]] = {}
+        for number, brep_face in enumerate(geometry.Faces):
+            for loop in brep_face.Loops:
+                for trim in loop.Trims:
+                    if trim.EdgeIndex >= 0:
+                        uses.setdefault(trim.EdgeIndex, []).append(first + number)
+        for index, faces in sorted(uses.items()):
+            edge = geometry.Edges[index]
+            d = edge.Domain
+            edges.append({"faces": faces, "points": np.array(
+                [_xyz(edge.PointAt(d.T0 + (d.T1 - d.T0) * s)) for s in t])})
+        first += len(geometry.Faces)
+    data["edges"] = edges
+    return data

@@ -26,8 +26,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .cad import CAD_SUFFIXES, SEAM_TOL, WEIGHT_TOL, weight_factors
-from .cad_child import check_cad_file, read_in_child
+from .cad import SEAM_TOL, WEIGHT_TOL, weight_factors
+from .cad_trims import trim_summary
 from .errors import InputError
 from .knots import KnotVectorBasis
 from .quadrature import gauss_points
@@ -46,28 +46,19 @@ def read_faces(path: str | os.PathLike) -> dict[str, Any]:
     ``degrees``, ``net``, ``weights``, ``trimmed``, ``closed``, ``periodic``, ``c0_knots``,
     ``degenerate``, ``area`` (of the untrimmed surface) and ``trimmed_area`` (inside the
     face's loops, by OpenCASCADE; None for ``.3dm``), or ``error`` for a face that cannot
-    be read. Knot values are the file's parameters."""
+    be read. Knot values are the file's parameters. ``topology`` holds the counts of
+    shared, boundary, seam, non-manifold and off-side edges of the whole file and its
+    interfaces (:mod:`splinedeform.cad_topology`)."""
+    from .cad_body import patches_of, read_listing
+    from .cad_topology import body_topology
+
     path = Path(path)
-    kind = CAD_SUFFIXES.get(path.suffix.lower())
-    if kind is None:
-        raise InputError(f"{path}: not a CAD file (expected one of "
-                         f"{', '.join(CAD_SUFFIXES)}), got suffix {path.suffix or 'none'!r}")
-    check_cad_file(path)
-    if kind == "openNURBS":
-        from .cad_3dm_read import _rhino3dm, list_3dm_arrays
-
-        _rhino3dm()
-        data = read_in_child(list_3dm_arrays, path, library="openNURBS (rhino3dm)")
-    else:
-        import importlib.util
-
-        from .cad_step_read import MISSING, list_step_arrays
-
-        if importlib.util.find_spec("OCP") is None:  # pragma: no cover - the installation
-            raise InputError(MISSING)
-        data = read_in_child(list_step_arrays, path, library="OpenCASCADE")
+    data = read_listing(path)
+    patches = patches_of(data)
+    topology = body_topology(patches, data["edges"], range(len(patches)))
     faces = [_describe(number, entry) for number, entry in enumerate(data["faces"])]
-    return {"file": str(path), "units": data["units"], "faces": faces}
+    return {"file": str(path), "units": data["units"], "faces": faces,
+            "topology": topology.as_dict()}
 
 
 def _describe(number: int, entry: dict[str, Any]) -> dict[str, Any]:
@@ -81,14 +72,31 @@ def _describe(number: int, entry: dict[str, Any]) -> dict[str, Any]:
     points, w = np.asarray(entry["points"], float), np.asarray(entry["weights"], float)
     whole = area(bases, points, w)
     inside = entry.get("trimmed_area")
-    trimmed = bool(entry["trimmed"]) or (inside is not None and
-                                         abs(inside) < whole * (1 - TRIM_AREA_TOL))
+    loops = trim_summary(entry, f"face {number}")
+    fraction = loops["trimmed_fraction"]
+    trimmed = is_trimmed(entry, whole) or (fraction is not None
+                                           and fraction < 1 - TRIM_AREA_TOL)
     return {**out, "degrees": list(degrees), "net": list(w.shape), "weights": _weights(w),
             "trimmed": trimmed, "closed": [bool(c) for c in entry["closed"]],
             "periodic": [bool(c) for c in entry["periodic"]],
             "c0_knots": {d: [float(x) for x in b.c0_knots] for d, b in zip("uv", bases)},
             "degenerate": degenerate_edges(points), "area": whole,
-            "trimmed_area": None if inside is None else abs(float(inside))}
+            "trimmed_area": None if inside is None else abs(float(inside)),
+            **loops}
+
+
+def is_trimmed(entry: dict[str, Any], whole: float | None = None) -> bool:
+    """Whether a listed face is trimmed: so read, or (STEP / IGES) its area inside its loops
+    is below its surface's ``whole`` area (computed if not given) by :data:`TRIM_AREA_TOL`."""
+    inside = entry.get("trimmed_area")
+    if entry["trimmed"] or inside is None:
+        return bool(entry["trimmed"])
+    if whole is None:
+        bases = [KnotVectorBasis(int(n), np.asarray(t, dtype=float))
+                 for n, t in zip(entry["degrees"], (entry["knots_u"], entry["knots_v"]))]
+        whole = area(bases, np.asarray(entry["points"], float),
+                     np.asarray(entry["weights"], float))
+    return bool(abs(inside) < whole * (1 - TRIM_AREA_TOL))
 
 
 def _weights(w: NDArray[np.float64]) -> str:
@@ -128,7 +136,7 @@ def area(bases: list[KnotVectorBasis], points: NDArray[np.float64],
 def faces_text(listing: dict[str, Any]) -> str:
     """The listing as a table, one line per face."""
     head = ("face", "object", "name", "layer", "kind", "degree", "net", "weights", "trimmed",
-            "closed", "periodic", "C0 knots", "poles", "area")
+            "closed", "periodic", "C0 knots", "poles", "area", "loops", "inside")
     rows = []
     for f in listing["faces"]:
         if "error" in f:
@@ -141,7 +149,7 @@ def faces_text(listing: dict[str, Any]) -> str:
                      f["kind"], "x".join(map(str, f["degrees"])), "x".join(map(str, f["net"])),
                      f["weights"], "yes" if f["trimmed"] else "no", uv(f["closed"]),
                      uv(f["periodic"]), c0, ",".join(f["degenerate"]) or "-",
-                     f"{f['area']:.6g}"))
+                     f"{f['area']:.6g}", *_loops_text(f)))
     widths = [max([len(head[k])] + [len(r[k]) for r in rows if len(r) > k])
               for k in range(len(head))]
     widths[5] = max([len(head[5])] + [len(r[5]) for r in rows if len(r) > 6])
@@ -149,7 +157,31 @@ def faces_text(listing: dict[str, Any]) -> str:
              f"{listing['units'] or 'not declared'}",
              "  ".join(h.ljust(wd) for h, wd in zip(head, widths)).rstrip()]
     lines += ["  ".join(c.ljust(wd) for c, wd in zip(r, widths)).rstrip() for r in rows]
+    if "topology" in listing:
+        lines.append(topology_line(listing["topology"]))
     return "\n".join(lines) + "\n"
+
+
+def topology_line(topology: dict[str, Any]) -> str:
+    """``edges: 12 shared, 0 boundary, 0 seams, 0 non-manifold`` (and the edges on no side
+    of their face's rectangle, and the interfaces found, conforming or not)."""
+    conforming = sum(i["conforming"] for i in topology["interfaces"])
+    line = (f"edges: {topology['shared']} shared, {topology['boundary']} boundary, "
+            f"{topology['seam']} seam(s), {topology['non_manifold']} non-manifold")
+    if topology["off_sides"]:
+        line += f", {topology['off_sides']} on trimming loops (not joined)"
+    return (line + f"; {len(topology['interfaces'])} interface(s), {conforming} conforming")
+
+
+def _loops_text(face: dict[str, Any]) -> tuple[str, str]:
+    """``("1+2", "87.2%")``: outer + inner loops and the part of the parameter box inside
+    them; ``("unread", "-")`` where the loops cannot be read, ``("-", "-")`` where there
+    are none."""
+    if face.get("trim_error"):
+        return "unread", "-"
+    if face["loops"] is None:
+        return "-", "-"
+    return f"{face['loops'][0]}+{face['loops'][1]}", f"{100 * face['trimmed_fraction']:.4g}%"
 
 
 def faces_json(listing: dict[str, Any]) -> str:

@@ -32,6 +32,8 @@ __all__ = ["IGES_SUFFIXES", "STEP_SUFFIXES", "bspline_surface", "read_step", "wr
 
 #: OpenCASCADE tolerance for the natural edges of a written face (model units)
 EDGE_TOLERANCE = 1e-9
+#: edges of written faces closer than this fraction of the patches' size are sewn into one
+SEW_TOLERANCE = 1e-7
 
 def _collections() -> tuple[Any, Any, Any, Any]:
     """``(Array1 of double, Array1 of int, Array2 of double, Array2 of gp_Pnt)``.
@@ -79,12 +81,15 @@ def bspline_surface(patch: NurbsPatch, scale: float = 1.0) -> Any:
 
 
 def write_step(path: str | os.PathLike, patches: list[NurbsPatch],
-               units: str | None = None) -> Path:
+               units: str | None = None, shell: bool = False) -> Path:
     """Write ``patches`` as untrimmed B-spline faces of one compound to a STEP or IGES
     file, chosen by the suffix (atomically); return its path.
 
     ``units`` (a key of :data:`splinedeform.cad_units.UNITS`; default: the first patch's,
     millimetres if that is not known) is the unit of the patches' coordinates and of the file.
+    With ``shell``, the faces are sewn where their edges meet (OpenCASCADE's
+    ``BRepBuilderAPI_Sewing``, within :data:`SEW_TOLERANCE` of the patches' size): one
+    shell whose faces share their common edges, as the body they came from.
     """
     ocp()
     from OCP.BRep import BRep_Builder
@@ -102,9 +107,12 @@ def write_step(path: str | os.PathLike, patches: list[NurbsPatch],
     scale, name = millimetres(units), occt_name(units)
     compound, builder = TopoDS_Compound(), BRep_Builder()
     builder.MakeCompound(compound)
-    for patch in patches:
-        builder.Add(compound, BRepBuilderAPI_MakeFace(bspline_surface(patch, scale),
-                                                      EDGE_TOLERANCE * scale).Face())
+    faces = [BRepBuilderAPI_MakeFace(bspline_surface(patch, scale),
+                                     EDGE_TOLERANCE * scale).Face() for patch in patches]
+    for face in faces:
+        builder.Add(compound, face)
+    if shell and patches:
+        compound = _sewn(faces, patches, scale)
     with atomic_path(path) as tmp:
         if suffix in STEP_SUFFIXES:
             from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
@@ -123,6 +131,19 @@ def write_step(path: str | os.PathLike, patches: list[NurbsPatch],
         if not ok:
             raise InputError(f"{path}: OpenCASCADE could not write the file")
     return path
+
+
+def _sewn(faces: list[Any], patches: list[NurbsPatch], scale: float) -> Any:
+    """The faces sewn into a shell (see :func:`write_step`)."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
+
+    points = np.concatenate([np.asarray(p.points, float).reshape(-1, 3) for p in patches])
+    size = float(np.linalg.norm(np.ptp(points, axis=0))) * scale
+    sewing = BRepBuilderAPI_Sewing(SEW_TOLERANCE * max(size, 1e-300))
+    for face in faces:
+        sewing.Add(face)
+    sewing.Perform()
+    return sewing.SewedShape()
 
 
 def write_frames_step(path: str | os.PathLike, surface: Any, times: Any, nets: Any,

@@ -24,6 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 from .errors import InputError
 from .quadrature import gauss_points, integrals
 from .surface import Surface
+from .trim.surface_trim import region_contains
 
 
 def _finite(value: float, what: str) -> float:
@@ -230,6 +231,9 @@ class Point(Load):
             if not basis.periodic and not 0.0 <= value <= basis.length:
                 raise InputError(f"point load at {name}={value:g} is outside the parameter "
                                  f"domain [0, {basis.length:g}]")
+        if surface.trim is not None and not region_contains(surface, [self.u, self.v]):
+            raise InputError(f"point load at (u, v) = ({self.u:g}, {self.v:g}) is outside the "
+                             "trimmed region of the surface")
         E = surface.evaluation_matrix(np.array([self.u]), np.array([self.v]))
         return np.asarray(E.T.toarray()) * self.force[None, :]
 
@@ -246,6 +250,8 @@ class Uniform(Load):
         object.__setattr__(self, "profile", _profile(self.profile))
 
     def field_vector(self, surface: Surface, t: float = 0.0) -> NDArray[np.float64]:
+        if surface.trim is not None:
+            return project(surface, lambda U, V: np.broadcast_to(self.force, U.shape + (3,)))
         weights = np.outer(integrals(surface.basis_u), integrals(surface.basis_v)).ravel()
         return weights[:, None] * self.force[None, :]
 
@@ -256,8 +262,14 @@ def project(surface: Surface, values: Callable[[NDArray, NDArray], NDArray],
 
     ``values(U, V)`` gets 2-D parameter grids ``(Q_u, Q_v)`` and returns ``(Q_u, Q_v, 3)``.
     With ``n + 1 + extra_points`` points per cell and direction; computed as
-    ``B_uᵀ W_u f W_v B_v`` (two sparse products per coordinate).
+    ``B_uᵀ W_u f W_v B_v`` (two sparse products per coordinate). A trimmed surface
+    integrates over its trimmed region (:func:`splinedeform.trim.model_matrices.project`,
+    ``values`` then gets the points' parameter arrays ``(Q,)``).
     """
+    if surface.trim is not None:
+        from .trim.model_matrices import project as project_trimmed
+
+        return project_trimmed(surface, values)
     bu, bv = surface.basis_u, surface.basis_v
     xu, wu = gauss_points(bu, bu.degree + 1 + extra_points)
     xv, wv = gauss_points(bv, bv.degree + 1 + extra_points)

@@ -256,7 +256,8 @@ def pointwise_factor(model: Model) -> float:
         M = model.matrices()[0]
         inverse = None
         if (model.physics == "parametric" and model.mass_matrix == "consistent"
-                and model.gram_u is not None):          # one patch: M = μ G0u⊗G0v
+                and model.gram_u is not None                # one patch: M = μ G0u⊗G0v
+                and getattr(model.surface, "trim", None) is None):
             gu, gv = (np.diag(np.linalg.inv(g[0].toarray())) for g in (model.gram_u,
                                                                        model.gram_v))
             inverse = np.kron(gu, gv) / model.material.mass

@@ -21,13 +21,13 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
-from .assembly import (_largest, check_bending, full_matrices, mass,  # noqa: F401
-                       patch_matrices, reduced_matrices, stiffness)
+from .assembly import (_largest, check_bending, full_matrices, gram_matrices,  # noqa: F401
+                       mass, reduced_matrices, stiffness)
 from .boundary import Constraints, build_constraints
 from .errors import InputError, SingularSystemError
 from .loads import Load, as_load, static_time
 from .material import Material, check_scales
-from .physics import PHYSICS
+from .physics import PHYSICS, intrinsic
 from .physics.coupling_model import c0_coupling
 from . import modal_solve
 from .modal_solve import check_count as _check_count
@@ -39,6 +39,7 @@ from .solvers.forcing import ReducedForcing
 from .solvers.system import KroneckerFactors, Reduction
 from .surface import Surface
 from .threads import owned
+from .trim.model_matrices import trimmed_system
 
 Array = NDArray[np.float64]
 METHODS = ("analytic", "newmark", "radau3", "radau5", "radau7", "genalpha", "rk45", "dop853",
@@ -87,7 +88,10 @@ class Model:
         ``parametric``: the paper's energy per unit parameter area (Kronecker matrices);
         ``intrinsic``: the same plate under tension measured on the initial surface
         (:mod:`splinedeform.physics.intrinsic`), independent of the parametrisation.
-        With bending weights, the rotation across each C0 knot line is tied by a penalty
+        A trimmed surface (``surface.trim``) takes ``parametric`` over its trimmed region
+        (:mod:`splinedeform.trim.model_matrices`), with ``boundary`` naming its loops
+        (``{"outer": "clamped", "hole1": "free"}``). With bending weights, the rotation
+        across each C0 knot line is tied by a penalty
         (:mod:`splinedeform.physics.coupling_model`), which leaves no Kronecker factors.
 
     Examples
@@ -113,7 +117,9 @@ class Model:
         self.mass_matrix = mass_matrix
         self.rest = rest
         self.physics = physics
-        self.constraints: Constraints = build_constraints(
+        trimmed = None if surface.trim is None else trimmed_system(
+            surface, material, boundary, mass_matrix == "lumped", physics, fixed, rest)
+        self.constraints: Constraints = trimmed.constraints if trimmed else build_constraints(
             surface.basis_u, surface.basis_v, boundary,
             None if fixed is None else np.asarray(fixed), surface.control_points)
         if self.constraints.n_free == 0:
@@ -125,29 +131,59 @@ class Model:
                 "(surface.cells; a CAD or control net surface: insert knots with surface.refine)")
             error.key = "boundary"  # type: ignore[attr-defined]
             raise error
-        self.gram_u, self.gram_v, K, M = patch_matrices(surface, material, physics,
-                                                        mass_matrix == "lumped")
+        lumped = mass_matrix == "lumped"
+        self.gram_u, self.gram_v = gram_matrices(surface)
+        # K and M on the whole net: assembled here only where the constrained matrices are
+        # made from them, else when first asked for (K_full, M_full)
+        self._full: tuple[sp.csr_matrix, sp.csr_matrix] | None = (
+            intrinsic.matrices(surface, material, lumped) if physics == "intrinsic"
+            else (trimmed.stiffness, trimmed.mass) if trimmed else None)
         kinks = c0_coupling(surface, material, self.constraints.edges)
         if kinks is not None:                  # the slopes tied across each C0 line
-            K, self.gram_u, self.gram_v = (K + kinks).tocsr(), None, None
-        T = self.constraints.T
-        self.K_full, self.M_full = K, M
-        reduced = None if physics == "intrinsic" or kinks is not None else reduced_matrices(
-            self.gram_u, self.gram_v, material, mass_matrix == "lumped", M, self.constraints)
-        self._K, self._M = reduced or ((T.T @ K @ T).tocsc(), (T.T @ M @ T).tocsc())
+            K, M = self._full_matrices()
+            self._full, self.gram_u, self.gram_v = ((K + kinks).tocsr(), M), None, None
+        reduced = None if physics == "intrinsic" or trimmed or kinks is not None else \
+            reduced_matrices(self.gram_u, self.gram_v, material, lumped, self.constraints)
+        if reduced is None:
+            T = self.constraints.T
+            K, M = self._full_matrices()
+            self._K, self._M = (T.T @ K @ T).tocsc(), (T.T @ M @ T).tocsc()
+            self._C: sp.csc_matrix | None = None
+        else:
+            self._K, self._M, self._C = reduced
         self._finish(start)
+        if trimmed:
+            self._rigid = (trimmed.rigid_modes,)
 
     def _finish(self, start: float) -> None:
-        """Damping ``C_r = (γ/μ) M_r + β K_r``, the checks of scale and the caches."""
+        """Damping ``C_r = (γ/μ) M_r + β K_r`` (unless made with K_r), the checks of scale
+        and the caches."""
         material = self.material
+        if getattr(self, "_C", None) is None:
+            self._C = ((material.damping / material.mass) * self._M
+                       + material.rayleigh * self._K).tocsc()
         if self._M.nnz:
             check_scales(material, _largest(self._K), _largest(self._M))
-        self._C = ((material.damping / material.mass) * self._M
-                   + material.rayleigh * self._K).tocsc()
         self._eigen: tuple[Array, Array] | None = None
         self._bases: dict[tuple, modal_basis.ModalBasis] = {}
         self._rigid: tuple[int | None] | None = None
         self.timings: dict[str, float] = {"assembly": time.perf_counter() - start}
+
+    def _full_matrices(self) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        if self._full is None:
+            self._full = full_matrices(self.gram_u, self.gram_v, self.material,
+                                       self.mass_matrix == "lumped")
+        return self._full
+
+    @property
+    def K_full(self) -> sp.csr_matrix:
+        """Stiffness ``K`` of the whole net, before constraints (assembled when first used)."""
+        return self._full_matrices()[0]
+
+    @property
+    def M_full(self) -> sp.csr_matrix:
+        """Mass ``M`` of the whole net, before constraints (assembled when first used)."""
+        return self._full_matrices()[1]
 
     # -- layout --------------------------------------------------------------------
     @property

@@ -331,10 +331,15 @@ def _measure(result: RunResult) -> None:
         name = f"p{i} ({u:g}, {v:g})"
         result.probes[name] = histories[i - 1]
         result.probe_points[name] = (float(u), float(v))
-    uu, vv = surface.sample_parameters(scenario.output.resolution)
-    Bu = surface.basis_u.matrix(uu).toarray()
-    Bv = surface.basis_v.matrix(vv).toarray()
-    grid = np.einsum("ik,fklc,jl->fijc", Bu, D, Bv, optimize=True)
+    if surface.trim is not None:             # the displacement inside the trim loops only
+        from .export import tessellate_frames
+
+        grid = tessellate_frames(surface, D, scenario.output.resolution)[0]
+    else:
+        uu, vv = surface.sample_parameters(scenario.output.resolution)
+        Bu = surface.basis_u.matrix(uu).toarray()
+        Bv = surface.basis_v.matrix(vv).toarray()
+        grid = np.einsum("ik,fklc,jl->fijc", Bu, D, Bv, optimize=True)
     # |d| per frame, scaled so that the squares of a tiny d do not underflow
     size = float(np.abs(grid).max(initial=0.0))
     scale = size if 0.0 < size < np.inf else 1.0
@@ -353,8 +358,23 @@ def _measure(result: RunResult) -> None:
 
 
 def _domain_centre(surface: Any) -> tuple[float, float]:
+    """The rectangle's centre; on a trimmed surface whose region misses it, the Gauss
+    point of a whole cell inside the region nearest to it."""
+    import numpy as np
+
     (_, lu), (_, lv) = surface.domain
-    return (0.5 * lu, 0.5 * lv)
+    centre = (0.5 * lu, 0.5 * lv)
+    from .trim.surface_trim import region_contains
+
+    if surface.trim is None or region_contains(surface, centre):
+        return centre
+    from .trim import INSIDE
+    from .trim.model_matrices import quadrature_of
+
+    quad = quadrature_of(surface)
+    points = quad.points[quad.classes[quad.cell[:, 0], quad.cell[:, 1]] == INSIDE]
+    best = points[np.argmin(np.hypot(points[:, 0] - centre[0], points[:, 1] - centre[1]))]
+    return (float(best[0]), float(best[1]))
 
 
 __all__ = ["ProgressCallback", "RunResult", "make_report", "planned_outputs", "run",

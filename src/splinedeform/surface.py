@@ -9,12 +9,14 @@ tensor-product operator on the flattened net is ``A_u ⊗ A_v``.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
 from .basis import BSplineBasis
+from .collocation import collocate
 from .deboor import BLOCK
 from .patches import evaluate_patch_point, evaluate_patches, patches_when_worth
 from .spans import scalar_bernstein
@@ -74,6 +76,9 @@ class Surface:
         Maximum distance to the map the net was fitted to (set by :mod:`splinedeform.shapes`).
     name : str
         A label used in reports.
+    trim : TrimDomain or None
+        The trimmed region in ``(u, v)`` (:mod:`splinedeform.trim`); ``None``: the whole
+        rectangle. Set by :meth:`with_trim`.
     """
 
     control_points: NDArray[np.float64]
@@ -81,6 +86,7 @@ class Surface:
     basis_v: Basis
     fit_error: float | None = None
     name: str = "surface"
+    trim: Any = None
     _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -136,6 +142,13 @@ class Surface:
         """The same bases with another control net (``fit_error`` dropped)."""
         return replace(self, control_points=control_points, fit_error=None,
                        name=self.name if name is None else name)
+
+    def with_trim(self, domain: Any) -> Surface:
+        """The same surface trimmed to ``domain`` (a :class:`~splinedeform.trim.TrimDomain`
+        inside the parameter rectangle), or untrimmed for ``None``."""
+        from .trim.surface_trim import checked_trim
+
+        return replace(self, trim=None if domain is None else checked_trim(self, domain))
 
     # -- evaluation -------------------------------------------------------------
     def evaluation_matrix(self, u: ArrayLike, v: ArrayLike, du: int = 0, dv: int = 0
@@ -222,15 +235,28 @@ class Surface:
                       control_points: ArrayLike | None = None) -> NDArray[np.float64]:
         """Tensor grid evaluation ``X[i, j] = Σ_kl p_kl D^du b_k(u_i) D^dv b_l(v_j)``.
 
-        Two sparse products ``B_u P B_vᵀ`` per coordinate; result ``(len(u), len(v), 3)``.
+        Two sparse products ``X_c = B_u P_c B_vᵀ`` for all coordinates ``c`` at once, with
+        the collocation matrices ``B_u``, ``B_v`` of the two bases (one evaluation where
+        both directions share a basis and an order); result ``(len(u), len(v), c)``.
         """
         P = self.control_points if control_points is None else np.asarray(control_points, float)
-        Bu = _collocation(self.basis_u, u, du)
-        Bv = _collocation(self.basis_v, v, dv)
-        n_u, n_v = self.shape
-        tmp = (Bu @ P.reshape(n_u, -1)).reshape(Bu.shape[0], n_v, -1)   # (Nu, n_v, c)
-        out = Bv @ tmp.transpose(1, 0, 2).reshape(n_v, -1)               # (Nv, Nu*c)
-        return np.asarray(out).reshape(Bv.shape[0], Bu.shape[0], -1).transpose(1, 0, 2)
+        u = np.atleast_1d(np.asarray(u, dtype=float)).ravel()
+        v = np.atleast_1d(np.asarray(v, dtype=float)).ravel()
+        if du == dv and self.basis_u is self.basis_v:     # one evaluation for both
+            index, values = self.basis_u.nonzero(np.concatenate([u, v]), du)
+            Bu = index[:u.size], values[:u.size]
+            Bv = index[u.size:], values[u.size:]
+        else:
+            Bu, Bv = self.basis_u.nonzero(u, du), self.basis_v.nonzero(v, dv)
+        n_u, n_v = P.shape[:2]
+        along_u = collocate(*Bu, P.reshape(n_u, -1))            # (N_u, n_v · c), C order
+        width = along_u.shape[1] // n_v
+        # (N_u, n_v, c) -> (n_v, N_u, c): the rows moved as records of c numbers, which
+        # numpy copies faster than the strided three-number blocks of a float transpose
+        record = np.dtype((np.void, width * along_u.itemsize))
+        rows = np.ascontiguousarray(along_u.view(record).reshape(u.size, n_v).T)
+        out = collocate(*Bv, rows.view(np.float64).reshape(n_v, -1))   # (N_v, N_u · c)
+        return out.reshape(v.size, u.size, width).transpose(1, 0, 2)
 
     def normal(self, u: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
         """Unit normal ``n = x_u × x_v / |x_u × x_v|``; raises where the surface is degenerate."""
@@ -266,19 +292,6 @@ class Surface:
         u, v = self.sample_parameters(resolution)
         vertices = self.evaluate_grid(u, v, control_points=control_points).reshape(-1, 3)
         return vertices, grid_faces(u.size, v.size)
-
-
-def _collocation(basis: Basis, x: ArrayLike, derivative: int) -> sp.csr_array:
-    """``A_{ij} = D^derivative b_j(x_i)`` as a sparse array built from its CSR arrays.
-
-    The same matrix as ``basis.matrix``; ``csr_array`` skips the ``np.matrix`` layer of
-    ``csr_matrix``, whose construction costs more than these products on small grids.
-    """
-    x = np.atleast_1d(np.asarray(x, dtype=float)).ravel()
-    index, values = basis.nonzero(x, derivative)
-    width = index.shape[-1]
-    indptr = np.arange(0, x.size * width + 1, width)
-    return sp.csr_array((values.ravel(), index.ravel(), indptr), shape=(x.size, basis.size))
 
 
 def knots_summary(basis: Basis) -> str:

@@ -134,7 +134,8 @@ class BodyModel(Model):
             raise error
         blocks = [patch_matrices(s, material, physics, mass_matrix == "lumped")[2:]
                   for s in self.patches]
-        self.K_full = sp.block_diag([k for k, _ in blocks], format="csr")
+        K = sp.block_diag([k for k, _ in blocks], format="csr")
+        M = sp.block_diag([m for _, m in blocks], format="csr")
         offsets = self.constraints.offsets
         size = int(offsets[-1])
         couplings = [interface_coupling(self.patches, topology.interfaces, material,
@@ -142,12 +143,13 @@ class BodyModel(Model):
         couplings += [c0_coupling(s, material, {e: self.constraints.edges.get((p, e), "free")
                                                 for e in EDGES}, int(offsets[p]), size)
                       for p, s in enumerate(self.patches)]
-        for K in (K for K in couplings if K is not None):
-            self.K_full = (self.K_full + K).tocsr()
-        self.M_full = sp.block_diag([m for _, m in blocks], format="csr")
+        for penalty in (c for c in couplings if c is not None):
+            K = (K + penalty).tocsr()
+        self._full = (K, M)
         T = self.constraints.T
-        self._K = (T.T @ self.K_full @ T).tocsc()
-        self._M = (T.T @ self.M_full @ T).tocsc()
+        self._K = (T.T @ K @ T).tocsc()
+        self._M = (T.T @ M @ T).tocsc()
+        self._C = None
         self._finish(start)
 
     # -- layout ------------------------------------------------------------------------

@@ -7,6 +7,7 @@ in the target folder, which then replaces the target with :func:`os.replace`.
 * :mod:`.mesh` — triangle meshes (.obj with normals, .stl, .ply, .vtu, .vtk);
 * :mod:`.weld` — welded meshes of closed and degenerate surfaces, vertex normals;
 * :mod:`.series` — ParaView ``.pvd`` + ``.vtu`` time series;
+* :mod:`.body` — a body's patches in one .3dm / STEP file, one welded mesh or series;
 * :mod:`.modes` — vibration modes as displacement fields of one ``.vtu``;
 * :mod:`.nets` — control nets as JSON / NPZ with their full knot vectors;
 * :mod:`.report` — ``report.json`` and ``report.md``;

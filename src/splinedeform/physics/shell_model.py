@@ -82,6 +82,9 @@ class ShellModel:
         start = time.perf_counter()
         if not isinstance(material, ShellMaterial):
             raise InputError("a shell needs a ShellMaterial(E, nu, thickness, density)")
+        if getattr(surface, "trim", None) is not None:
+            raise InputError("the shell is not trimmed yet: a trimmed surface takes the "
+                             "parametric Model (docs/trim.md)")
         self.surface, self.material = surface, material
         self.physics = "shell"
         self.K_full, self.M_full = matrices(surface, material)

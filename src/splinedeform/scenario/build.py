@@ -10,6 +10,8 @@ from typing import Any, Iterator
 
 from ..errors import InputError, ScenarioError
 from .spec import Scenario, SurfaceSpec
+from ..trim.surface_trim import region_contains
+from .trim_build import loop_presets, trimmed
 
 
 @dataclass
@@ -54,7 +56,7 @@ def surface_and_units(scenario: Scenario) -> tuple[Any, str | None]:
     spec = scenario.surface
     surface, units = (_surface_from_cad(scenario) if spec.shape == "cad"
                       else (_surface_of_shape(scenario), None))
-    return _refined(scenario, surface), units
+    return trimmed(scenario, _refined(scenario, surface)), units
 
 
 def _refined(scenario: Scenario, surface: Any) -> Any:
@@ -103,17 +105,60 @@ def _fit_options(spec: SurfaceSpec) -> dict[str, Any]:
 
 def _surface_from_cad(scenario: Scenario) -> tuple[Any, str | None]:
     """Surface ``face`` of a CAD file, as a deformable NURBS surface (trimming dropped),
-    and its unit: ``surface.units`` if given, else the file's."""
+    and its unit: ``surface.units`` if given, else the file's; with ``faces``, the body
+    of the faces chosen (:func:`_body_from_cad`)."""
     from ..cad import read_cad, surface_from_patch
 
     path = scenario.surface.path
     assert path is not None
     face = scenario.surface.parameters["face"]
+    if scenario.surface.parameters.get("faces") is not None:
+        body, face, units = _body_from_cad(scenario)
+        if body is not None:
+            return body, scenario.surface.parameters.get("units") or units
     with _located(scenario, "surface.path"):
         patch = read_cad(path, face)
         surface = surface_from_patch(patch, name=f"{path.stem} face {face}",
                                      source=f"{path} face {face}")
     return surface, scenario.surface.parameters.get("units") or patch.units
+
+
+def _body_from_cad(scenario: Scenario) -> tuple[Any, int, str | None]:
+    """``(body, face, units)`` of ``surface.faces``: one face chosen gives no body and
+    that face (read as ``face`` is); several give a ``Body`` of their surfaces and the
+    file's interfaces, which needs :class:`~splinedeform.body.model.BodyModel` to run."""
+    from ..cad_body import body_of, choose_faces, read_listing
+
+    spec, raw = scenario.surface, scenario.raw.get("surface", {})
+    if "face" in raw:
+        raise scenario.error("surface.faces", "give face (one face) or faces (a body), "
+                                              "not both")
+    path, faces = spec.path, spec.parameters["faces"]
+    with _located(scenario, "surface.path"):
+        listing = read_listing(path)
+        if not listing["faces"]:
+            raise InputError(f"{path}: the file holds no surface")
+    with _located(scenario, "surface.faces"):
+        chosen = choose_faces(listing, list(faces) if isinstance(faces, tuple) else faces,
+                              str(path))
+    if len(chosen) == 1:
+        return None, chosen[0], listing["units"]
+    with _located(scenario, "surface.faces"):
+        surfaces, topology, info = body_of(path, listing, chosen)
+    try:
+        from ..body.body import Body
+        from ..body.model import BodyModel  # noqa: F401  (what runs a body)
+    except ImportError:
+        counts = topology.counts
+        raise scenario.error("surface.faces", (
+            f"multi-face bodies are read ({len(surfaces)} faces, {counts['shared']} shared "
+            f"edges, {counts['seam']} seam(s)); running them needs BodyModel "
+            "(splinedeform.body.model), which this version lacks: choose one face with "
+            "face = k")) from None
+    for key in ("refine", "elevate"):
+        if getattr(spec, key) != (0, 0):
+            raise scenario.error(f"surface.{key}", "applies to one face, not yet to a body")
+    return Body(surfaces, topology.interfaces), chosen[0], info["units"]
 
 
 def _surface_from_file(scenario: Scenario) -> Any:
@@ -256,6 +301,9 @@ def _check_parameters(scenario: Scenario, surface: Any) -> None:
             if not basis.periodic and not -1e-12 <= x <= basis.length * (1 + 1e-12):
                 raise scenario.error(path, f"{name} = {x:g} is outside the parameter domain "
                                            f"[0, {basis.length:g}] of this surface")
+        if surface.trim is not None and not region_contains(surface, [u, v]):
+            raise scenario.error(path, f"(u, v) = ({u:g}, {v:g}) is outside the trimmed "
+                                       "region of this surface (surface.trim)")
 
 
 def build(scenario: Scenario) -> Built:
@@ -302,7 +350,8 @@ def _model_on(scenario: Scenario, surface: Any, units: str | None) -> Built:
     with _located(scenario, "material"):
         material = Material(**scenario.material.weights())
     with _located(scenario, "boundary"):
-        model = Model(surface, material, boundary=scenario.boundary.edges(), fixed=fixed,
+        model = Model(surface, material, boundary={**scenario.boundary.edges(),
+                                                   **loop_presets(scenario)}, fixed=fixed,
                       mass_matrix=scenario.material.mass_matrix,
                       physics=scenario.material.physics)
     return Built(surface=surface, model=model, load=None, fixed=fixed, units=units)

@@ -1,0 +1,149 @@
+"""Outputs of a body: every patch's deformed net in one file.
+
+* ``.3dm``: one NURBS surface per patch, named, in the body's unit
+  (:func:`splinedeform.cad.write_3dm`);
+* STEP / IGES: one B-spline face per patch in one file, sewn into a shell where the
+  patches meet (:func:`splinedeform.cad_step.write_step`);
+* a welded mesh (``.vtu``, ``.vtk``, ``.obj``, ``.stl``, ``.ply``): each patch sampled on
+  its ``r × r`` parameter grid, ``X_k = B_u P_k B_vᵀ`` (:func:`.frames.tessellate_frames`),
+  the grids put side by side and their points merged where they coincide at rest and in
+  every frame (:func:`.weld.weld`): the points of a shared edge or a closed seam are one
+  point, so the mesh is connected across the body;
+* a ParaView series (``.pvd`` + one welded ``.vtu`` per frame), the rest points with the
+  point data ``displacement`` and ``displacement_magnitude`` as
+  :func:`.series.write_time_series` writes for one surface, and ``patch`` (the index of
+  the patch a point was first sampled on).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import InputError
+from ..surface import Surface
+from .atomic import _check_stem, write_text
+from .frames import check_frames, check_net, tessellate_frames
+from .mesh import write_mesh
+from .series import _output_folder, frame_file_names, pvd_text
+from .weld import weld
+
+
+def _check_body(surfaces: Sequence[Surface], nets: Sequence[ArrayLike], what: str
+                ) -> list[NDArray[np.float64]]:
+    """One net per surface, each checked (:func:`.frames.check_net`)."""
+    if len(nets) != len(surfaces) or not surfaces:
+        raise InputError(f"a body of {len(surfaces)} patch(es) needs as many {what}s, got "
+                         f"{len(nets)}")
+    return [check_net(s, P, f"{what} of patch {k}") for k, (s, P) in
+            enumerate(zip(surfaces, nets))]
+
+
+def body_patches(surfaces: Sequence[Surface], nets: Sequence[ArrayLike],
+                 units: str | None = None) -> list:
+    """The NURBS patch of every surface with its net (same degrees, knots, weights)."""
+    from dataclasses import replace
+
+    from ..cad import patch_from_surface
+
+    return [replace(patch_from_surface(s, P), units=units)
+            for s, P in zip(surfaces, _check_body(surfaces, nets, "control net"))]
+
+
+def write_body_3dm(path: str | os.PathLike, surfaces: Sequence[Surface],
+                   nets: Sequence[ArrayLike], names: Sequence[str] | None = None,
+                   units: str | None = None) -> Path:
+    """Every patch with its net as a named NURBS surface of one ``.3dm`` file, in
+    ``units`` (the file's ``ModelUnitSystem``); names default to the surfaces' names."""
+    from ..cad import write_3dm
+
+    names = [s.name for s in surfaces] if names is None else list(names)
+    return write_3dm(path, body_patches(surfaces, nets, units), names=names, units=units)
+
+
+def write_body_step(path: str | os.PathLike, surfaces: Sequence[Surface],
+                    nets: Sequence[ArrayLike], units: str | None = None,
+                    shell: bool = True) -> Path:
+    """Every patch with its net as a B-spline face of one STEP or IGES file (by the
+    suffix), in ``units``; with ``shell`` the faces are sewn where they meet into one
+    shell (:func:`splinedeform.cad_step.write_step`)."""
+    from ..cad_step import write_step
+
+    return write_step(path, body_patches(surfaces, nets, units), units=units, shell=shell)
+
+
+def welded_body(surfaces: Sequence[Surface], frames: Sequence[ArrayLike], resolution: int = 32
+                ) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.int64]]:
+    """The body's welded mesh in every frame (see the module docstring).
+
+    Parameters
+    ----------
+    surfaces : sequence of Surface
+    frames : sequence of array_like, shape ``(G, n_u, n_v, 3)`` each
+        The ``G`` nets of each patch (the same ``G`` for all).
+    resolution : int
+        Samples per direction of each patch.
+
+    Returns
+    -------
+    points : ndarray, shape ``(G, N, 3)``
+    faces : ndarray of int, shape ``(M, 3)``
+    patch : ndarray of int, shape ``(N,)``
+        The patch each point was first sampled on.
+    """
+    blocks, faces, owner, offset = [], [], [], 0
+    for k, (surface, P) in enumerate(zip(surfaces, frames)):
+        X, F = tessellate_frames(surface, P, resolution)
+        blocks.append(X)
+        faces.append(F + offset)
+        owner.append(np.full(X.shape[1], k))
+        offset += X.shape[1]
+    X = np.concatenate(blocks, axis=1)
+    keep, welded = weld(X, np.concatenate(faces))
+    return X[:, keep], welded, np.concatenate(owner)[keep]
+
+
+def write_body_mesh(path: str | os.PathLike, surfaces: Sequence[Surface],
+                    nets: Sequence[ArrayLike], rest_nets: Sequence[ArrayLike] | None = None,
+                    resolution: int = 32) -> Path:
+    """The deformed body as one welded mesh (the format by the suffix, see
+    :func:`.mesh.write_mesh`), with ``patch`` and, given the rest nets, ``displacement``
+    (deformed minus rest) as point data; points are welded where they coincide in both."""
+    P = _check_body(surfaces, nets, "control net")
+    rest = P if rest_nets is None else _check_body(surfaces, rest_nets, "rest net")
+    X, faces, patch = welded_body(surfaces, [np.stack([r, p]) for r, p in zip(rest, P)],
+                                  resolution)
+    data: dict[str, NDArray] = {"patch": patch.astype(float)}
+    if rest_nets is not None:
+        data["displacement"] = X[1] - X[0]
+    return write_mesh(path, X[1], faces, data)
+
+
+def write_body_series(directory: str | os.PathLike, stem: str, surfaces: Sequence[Surface],
+                      rest_nets: Sequence[ArrayLike], times: ArrayLike,
+                      nets: Sequence[ArrayLike], resolution: int = 32) -> Path:
+    """The body's motion as a ParaView series ``stem.pvd`` + ``stem_0000.vtu`` … (see the
+    module docstring); ``nets[k]`` has shape ``(F, n_u, n_v, 3)``, the frames of patch
+    ``k`` at ``times``. Returns the ``.pvd`` file (written last)."""
+    _check_stem(stem)
+    rest = _check_body(surfaces, rest_nets, "rest net")
+    if len(nets) != len(surfaces):
+        raise InputError(f"a body of {len(surfaces)} patch(es) needs as many frame sets, "
+                         f"got {len(nets)}")
+    checked = [check_frames(s, times, P) for s, P in zip(surfaces, nets)]
+    t = checked[0][0]
+    X, faces, patch = welded_body(
+        surfaces, [np.concatenate([r[None], P]) for r, (_, P) in zip(rest, checked)],
+        resolution)
+    folder = _output_folder(directory)
+    names = frame_file_names(stem, t.size)
+    for f, name in enumerate(names):
+        d = X[f + 1] - X[0]
+        write_mesh(folder / name, X[0], faces,
+                   {"displacement": d, "displacement_magnitude": np.linalg.norm(d, axis=1),
+                    "patch": patch.astype(float)})
+    return write_text(folder / f"{stem}.pvd", pvd_text(list(zip(t.tolist(), names))))
