@@ -20,7 +20,6 @@ import numpy as np
 import scipy.sparse as sp
 
 from .errors import InputError
-from .knots import c0_refusal
 from .material import Material
 from .physics import intrinsic
 from .quadrature import gram_matrix
@@ -154,20 +153,15 @@ def kronecker_sums(sums: Sequence[Sequence[tuple[float, sp.spmatrix, sp.spmatrix
 def check_bending(surface: Surface, material: Material) -> None:
     """Refuse bending weights that a patch's bases cannot carry.
 
-    ``w20`` (``w02``) needs degree ``>= 2`` in ``u`` (``v``) and a ``C^1`` basis there: at a
-    ``C^0`` knot line the surface may kink and ``d_uu`` is not square integrable.
+    ``w20`` (``w02``) needs degree ``>= 2`` in ``u`` (``v``) (second derivatives). A
+    ``C^0`` knot line is integrated span by span, and the model couples the rotation
+    across it (:mod:`splinedeform.physics.coupling_model`).
     """
     for name, basis, weight in (("u", surface.basis_u, material.w20),
                                 ("v", surface.basis_v, material.w02)):
         if weight and basis.degree < 2:
             raise InputError(f"bending weight w{'20' if name == 'u' else '02'} needs degree "
                              f">= 2 in {name} (second derivatives), got {basis.degree}")
-        if weight and getattr(basis, "continuity", basis.degree - 1) < 1:
-            key = f"w{'20' if name == 'u' else '02'}"
-            error = InputError(c0_refusal(basis, name, f"bending weight {key}")
-                               + "; or use tension weights only (w10, w01)")
-            error.key = f"material.{key}"  # type: ignore[attr-defined]
-            raise error
 
 
 def gram_matrices(surface: Surface) -> tuple[list[sp.csr_matrix], list[sp.csr_matrix]]:

@@ -28,6 +28,7 @@ from .errors import InputError, SingularSystemError
 from .loads import Load, as_load, static_time
 from .material import Material, check_scales
 from .physics import PHYSICS, intrinsic
+from .physics.coupling_model import c0_coupling
 from . import modal_solve
 from .modal_solve import check_count as _check_count
 from .solution import ModalSolution, Readout, SampledSolution, StaticSolution
@@ -89,7 +90,9 @@ class Model:
         (:mod:`splinedeform.physics.intrinsic`), independent of the parametrisation.
         A trimmed surface (``surface.trim``) takes ``parametric`` over its trimmed region
         (:mod:`splinedeform.trim.model_matrices`), with ``boundary`` naming its loops
-        (``{"outer": "clamped", "hole1": "free"}``).
+        (``{"outer": "clamped", "hole1": "free"}``). With bending weights, the rotation
+        across each C0 knot line is tied by a penalty
+        (:mod:`splinedeform.physics.coupling_model`), which leaves no Kronecker factors.
 
     Examples
     --------
@@ -135,8 +138,12 @@ class Model:
         self._full: tuple[sp.csr_matrix, sp.csr_matrix] | None = (
             intrinsic.matrices(surface, material, lumped) if physics == "intrinsic"
             else (trimmed.stiffness, trimmed.mass) if trimmed else None)
-        reduced = None if physics == "intrinsic" or trimmed else reduced_matrices(
-            self.gram_u, self.gram_v, material, lumped, self.constraints)
+        kinks = c0_coupling(surface, material, self.constraints.edges)
+        if kinks is not None:                  # the slopes tied across each C0 line
+            K, M = self._full_matrices()
+            self._full, self.gram_u, self.gram_v = ((K + kinks).tocsr(), M), None, None
+        reduced = None if physics == "intrinsic" or trimmed or kinks is not None else \
+            reduced_matrices(self.gram_u, self.gram_v, material, lumped, self.constraints)
         if reduced is None:
             T = self.constraints.T
             K, M = self._full_matrices()
