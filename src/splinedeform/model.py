@@ -21,49 +21,30 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
-from .assembly import (_largest, check_bending, full_matrices, gram_matrices,  # noqa: F401
-                       mass, reduced_matrices, stiffness)
+from .assembly import (_largest, check_bending, full_matrices, gram_matrices,
+                       reduced_matrices)
 from .boundary import Constraints, build_constraints
 from .errors import InputError, SingularSystemError
 from .loads import Load, as_load, static_time
 from .material import Material, check_scales
-from .physics import PHYSICS, intrinsic
+from .physics import intrinsic
 from .physics.coupling_model import c0_coupling
 from . import modal_solve
 from .modal_solve import check_count as _check_count
 from .solution import ModalSolution, Readout, SampledSolution, StaticSolution
 from . import spectrum
 from .solvers import modal_basis, numeric
-from .solvers.factor import factorise
 from .solvers.forcing import ReducedForcing
 from .solvers.system import KroneckerFactors, Reduction
 from .surface import Surface
 from .threads import owned
+from .static_solve import check_options, solve_stiffness  # noqa: F401
 from .trim.model_matrices import trimmed_system
 
 Array = NDArray[np.float64]
 METHODS = ("analytic", "newmark", "radau3", "radau5", "radau7", "genalpha", "rk45", "dop853",
            "radau", "bdf")
-STATIC_TRUST = 1e-6
-"""Largest estimated relative error accepted from an ill-conditioned static solve."""
 STEP_METHODS = ("newmark", "radau3", "radau5", "radau7", "genalpha")   # take a step dt
-
-
-def check_options(material: Material, mass_matrix: str, rest: str, physics: str) -> None:
-    """Refuse a material that is not one, and unknown mass, rest or physics options."""
-    if not isinstance(material, Material):
-        raise InputError(f"material must be a splinedeform.Material, got "
-                         f"{type(material).__name__}")
-    if mass_matrix not in ("consistent", "lumped"):
-        raise InputError(f"mass_matrix must be 'consistent' or 'lumped', got {mass_matrix!r}")
-    if rest not in ("initial", "none"):
-        raise InputError(f"rest must be 'initial' or 'none', got {rest!r}")
-    if physics == "shell":
-        raise InputError("physics 'shell' couples x, y and z and has its own material: use "
-                         "splinedeform.ShellModel(surface, ShellMaterial(E, nu, thickness, "
-                         "density), boundary)")
-    if physics not in PHYSICS:
-        raise InputError(f"physics must be one of {PHYSICS}, got {physics!r}")
 
 
 class Model:
@@ -257,38 +238,7 @@ class Model:
         return StaticSolution(self.readout, d, F, {"static": time.perf_counter() - start})
 
     def _solve_stiffness(self, F: Array) -> Array:
-        message = ("the stiffness matrix is singular for these boundary conditions and weights "
-                   f"(edges {self.constraints.edges}, weights w10..w02 = "
-                   f"{[self.material.w10, self.material.w01, self.material.w20, self.material.w11, self.material.w02]}): "
-                   "some deformation has no energy. Constrain the edges the weights do not "
-                   "reach (e.g. tension only in u needs pinned u0/u1 edges), or add weights")
-        if self.rigid_modes:
-            raise SingularSystemError(message + f" ({self.rigid_modes} deformation(s) without "
-                                      "energy, counted from the weights and the constraints)")
-        try:
-            lu = getattr(self, "_stiffness_factor", None)
-            if lu is None:                     # once constrained K is SPD: a Cholesky,
-                lu = self._stiffness_factor = factorise(self._K)   # kept for further loads
-            d = lu.solve(F)
-        except RuntimeError:
-            raise SingularSystemError(message) from None
-        scale = max(np.linalg.norm(F), 1e-300)
-        residual = np.linalg.norm(self._K @ d - F) / scale
-        if np.all(np.isfinite(d)) and residual <= 1e-8:
-            return d
-        if self.rigid_modes is None or not np.all(np.isfinite(d)):
-            raise SingularSystemError(message)
-        # non-singular by structure, but ill-conditioned: one refinement step estimates
-        # the error of d (the correction's size), accepted up to STATIC_TRUST
-        correction = lu.solve(F - self._K @ d)
-        error = float(np.abs(correction).max() / max(np.abs(d).max(), 1e-300))
-        if np.isfinite(error) and error <= STATIC_TRUST:
-            return d + correction
-        raise SingularSystemError(
-            f"the stiffness matrix is not singular but too ill-conditioned to solve: relative "
-            f"residual {residual:.1g}, estimated relative error {error:.1g} (one refinement "
-            f"step) for weights w10..w02 = {[self.material.w10, self.material.w01, self.material.w20, self.material.w11, self.material.w02]}. "
-            "Raise the smallest weight, or use fewer cells or a lower degree")
+        return solve_stiffness(self, F)
 
     # -- modes -------------------------------------------------------------------------
     @owned
