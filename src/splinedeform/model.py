@@ -126,7 +126,7 @@ class Model:
                                                         mass_matrix == "lumped")
         T = self.constraints.T
         self.K_full, self.M_full = K, M
-        reduced = None if physics == "intrinsic" else reduced_matrices(
+        reduced = None if physics == "intrinsic" or self.gram_u is None else reduced_matrices(
             self.gram_u, self.gram_v, material, mass_matrix == "lumped", M, self.constraints)
         self._K, self._M = reduced or ((T.T @ K @ T).tocsc(), (T.T @ M @ T).tocsc())
         self._finish(start)

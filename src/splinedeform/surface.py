@@ -20,6 +20,7 @@ from .patches import evaluate_patch_point, evaluate_patches, patches_when_worth
 from .spans import scalar_bernstein
 from .errors import InputError
 from .knots import KnotVectorBasis, RationalBasis
+from . import rational
 
 #: the 1-D bases a surface composes: the fast layouts, a general knot vector, a weighted one
 Basis = BSplineBasis | KnotVectorBasis | RationalBasis
@@ -70,6 +71,9 @@ class Surface:
         The bases in the two parameter directions. A general knot vector must start its
         domain at 0 (``t_n = 0``; see :meth:`KnotVectorBasis.shifted`). Two rational bases
         with weights ``a_k`` and ``b_l`` make the NURBS surface with weights ``a_k b_l``.
+    net_weights : array_like, shape ``(n_u, n_v)``, optional
+        General NURBS weights ``w_kl`` on polynomial bases, for weights that are not a
+        product: the basis is ``R_kl = w_kl N_k N_l / Σ w N N`` (:mod:`splinedeform.rational`).
     fit_error : float or None
         Maximum distance to the map the net was fitted to (set by :mod:`splinedeform.shapes`).
     name : str
@@ -81,6 +85,7 @@ class Surface:
     basis_v: Basis
     fit_error: float | None = None
     name: str = "surface"
+    net_weights: NDArray[np.float64] | None = None
     _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -104,6 +109,19 @@ class Surface:
                              f"{tuple(int(i) for i in bad[:2])} is {P[tuple(bad[:2])]}")
         P.setflags(write=False)
         object.__setattr__(self, "control_points", P)
+        if self.net_weights is not None:
+            self._check_net_weights()
+
+    def _check_net_weights(self) -> None:
+        """General weights: one per control point, > 0, on polynomial bases."""
+        if any(isinstance(b, RationalBasis) for b in (self.basis_u, self.basis_v)):
+            raise InputError("give NURBS weights either per direction (rational bases) or "
+                             "per control point (net_weights), not both")
+        if any(getattr(b, "kind", None) == "uniform" for b in (self.basis_u, self.basis_v)):
+            raise InputError("net_weights need open, periodic or general knot vectors: on "
+                             "Höllig's uniform layout the edge conditions would mix weights")
+        object.__setattr__(self, "net_weights", rational.check_weights(self.net_weights,
+                                                                       self.shape))
 
     def __repr__(self) -> str:
         """One line: name, net size, degrees, knot layouts, domain (never the net itself)."""
@@ -127,7 +145,10 @@ class Surface:
 
     @property
     def weights(self) -> NDArray[np.float64]:
-        """NURBS weights ``w_kl = a_k b_l`` of the net (``a``, ``b`` of rational directions, 1 else)."""
+        """NURBS weights of the net: :attr:`net_weights`, else ``w_kl = a_k b_l`` (``a``, ``b``
+        of rational directions, 1 else)."""
+        if self.net_weights is not None:
+            return self.net_weights
         a, b = (np.asarray(basis.weights) if isinstance(basis, RationalBasis)
                 else np.ones(basis.size) for basis in (self.basis_u, self.basis_v))
         return np.outer(a, b)
@@ -143,8 +164,11 @@ class Surface:
         """Sparse ``E`` with ``∂^{du+dv} x / ∂u^du ∂v^dv (u_i, v_i) = (E @ P.reshape(-1, 3))_i``.
 
         ``E_{i, k n_v + l} = D^{du} b_k(u_i) D^{dv} b_l(v_i)``; ``u`` and ``v`` are
-        flattened after broadcasting to a common shape.
+        flattened after broadcasting to a common shape. With :attr:`net_weights`, the
+        rational ``D^(du,dv) R_kl`` (:func:`splinedeform.rational.evaluation_matrix`).
         """
+        if self.net_weights is not None:
+            return rational.evaluation_matrix(self, u, v, du, dv)
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
         u, v = u.ravel(), v.ravel()
         iu, bu = self.basis_u.nonzero(u, du)
@@ -165,8 +189,11 @@ class Surface:
         The surface's own net is evaluated from its Bézier patches (:mod:`splinedeform.patches`,
         computed once it has been asked for as many points as it has cells); until then, and
         for another net, by the sum over the ``(n+1)²`` control points of each parameter's
-        cell, ``Σ_r Σ_s D^du b_r(u) D^dv b_s(v) p_rs``.
+        cell, ``Σ_r Σ_s D^du b_r(u) D^dv b_s(v) p_rs``. With :attr:`net_weights`, in
+        homogeneous coordinates and the quotient rule (:mod:`splinedeform.rational`).
         """
+        if self.net_weights is not None:
+            return rational.derivative(self, u, v, du, dv, control_points)
         Q = None
         own = control_points is None and _order(du) and _order(dv)
         one = type(u) in _SCALARS and type(v) in _SCALARS
@@ -223,7 +250,10 @@ class Surface:
         """Tensor grid evaluation ``X[i, j] = Σ_kl p_kl D^du b_k(u_i) D^dv b_l(v_j)``.
 
         Two sparse products ``B_u P B_vᵀ`` per coordinate; result ``(len(u), len(v), 3)``.
+        With :attr:`net_weights`, the same on the homogeneous net and the quotient rule.
         """
+        if self.net_weights is not None:
+            return rational.evaluate_grid(self, u, v, du, dv, control_points)
         P = self.control_points if control_points is None else np.asarray(control_points, float)
         Bu = _collocation(self.basis_u, u, du)
         Bv = _collocation(self.basis_v, v, dv)

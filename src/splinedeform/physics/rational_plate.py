@@ -22,9 +22,9 @@ on random weights in ``[0.5, 2]`` (a factor 4 between neighbours), the energy of
 field is off by 3e-6 with 12 points, 1e-8 with 16, 1e-13 with 24
 (``tests/test_rational_plate.py``); CAD weights, close to 1, do much better.
 
-Not yet used by :class:`~splinedeform.Model`: a :class:`~splinedeform.Surface` carries
-weights per direction only, and :func:`splinedeform.cad.surface_from_patch` refuses
-weights that do not factor.
+Used by :func:`splinedeform.assembly.patch_matrices` for a surface with
+:attr:`~splinedeform.Surface.net_weights` (the parametric physics of
+:class:`~splinedeform.Model` and of a body).
 """
 
 from __future__ import annotations
@@ -33,10 +33,10 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
-from ..errors import InputError
 from ..knots import KnotVectorBasis
 from ..material import Material
 from ..quadrature import gauss_points
+from ..rational import basis_derivatives, check_weights
 from .metric import assemble
 
 Array = NDArray[np.float64]
@@ -50,27 +50,15 @@ def rational_derivatives(basis_u: KnotVectorBasis, basis_v: KnotVectorBasis,
     """``D^p_u D^q_v R_k`` of the non-zero functions on the grid ``u × v``.
 
     Returns the flat index ``i n_v + j`` of each local function, ``(Qu, Qv, pu pv)``, and
-    ``{(p, q): (Qu, Qv, pu pv)}`` for ``p + q <= 2`` (see the module docstring).
+    ``{(p, q): (Qu, Qv, pu pv)}`` for ``p + q <= 2`` (see the module docstring), from
+    :func:`splinedeform.rational.basis_derivatives`.
     """
-    w = np.asarray(weights, dtype=float)
-    if w.shape != (basis_u.size, basis_v.size) or not np.all(w > 0):
-        raise InputError(f"general NURBS weights must be {basis_u.size} x {basis_v.size} "
-                         f"positive numbers, got shape {w.shape}")
+    w = check_weights(weights, (basis_u.size, basis_v.size), "general NURBS weights")
     iu, Bu = basis_u.nonzero_derivatives(u, 2)                  # (3, Qu, pu)
     iv, Bv = basis_v.nonzero_derivatives(v, 2)
-    local_w = w[iu[:, None, :, None], iv[None, :, None, :]]     # (Qu, Qv, pu, pv)
-    A = {(p, q): Bu[p][:, None, :, None] * Bv[q][None, :, None, :] * local_w
-         for p, q in ORDERS}
-    W = {k: a.sum(axis=(2, 3), keepdims=True) for k, a in A.items()}
-    R = {(0, 0): A[0, 0] / W[0, 0]}
-    for d in ((1, 0), (0, 1)):
-        R[d] = (A[d] - R[0, 0] * W[d]) / W[0, 0]
-    R[2, 0] = (A[2, 0] - 2 * R[1, 0] * W[1, 0] - R[0, 0] * W[2, 0]) / W[0, 0]
-    R[0, 2] = (A[0, 2] - 2 * R[0, 1] * W[0, 1] - R[0, 0] * W[0, 2]) / W[0, 0]
-    R[1, 1] = (A[1, 1] - R[1, 0] * W[0, 1] - R[0, 1] * W[1, 0] - R[0, 0] * W[1, 1]) / W[0, 0]
-    shape = local_w.shape[:2] + (-1,)
-    index = (iu[:, None, :, None] * basis_v.size + iv[None, :, None, :]).reshape(shape)
-    return index, {k: r.reshape(shape) for k, r in R.items()}
+    index, R = basis_derivatives(iu[:, None], Bu[:, :, None], iv[None], Bv[:, None], w,
+                                 ORDERS)
+    return index, {k: R[k] for k in ORDERS}
 
 
 def matrices(basis_u: KnotVectorBasis, basis_v: KnotVectorBasis, weights: Array,

@@ -29,6 +29,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..knots import c0_refusal
+from ..rational import refuse
 from ..surface import Surface
 from . import metric
 from .shell_assembly import Pattern, assemble_cells
@@ -117,6 +118,7 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
     ``D = √g w_q diag(E t/(1−ν²) H, E t³/(12(1−ν²)) H)``, ``M = ρ t ∫ N_k N_l dA ⊗ I₃``;
     cell by cell into a precomputed pattern (:mod:`.shell_assembly`).
     """
+    refuse(surface, "the Kirchhoff–Love shell")
     if min(surface.basis_u.degree, surface.basis_v.degree) < 2:
         raise InputError("the Kirchhoff–Love shell needs degree >= 2 in u and v (curvatures)")
     for name, basis in (("u", surface.basis_u), ("v", surface.basis_v)):
