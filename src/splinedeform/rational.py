@@ -162,6 +162,22 @@ def evaluate_grid(surface: Surface, u: ArrayLike, v: ArrayLike, du: int = 0, dv:
                              du, dv)
 
 
+def grid_nets(surface: Surface, u: ArrayLike, v: ArrayLike, nets: ArrayLike) -> Array:
+    """``Σ_kl R_kl(u_i, v_j) P_kl`` of many nets ``(..., n_u, n_v, c)`` on the grid ``u × v``.
+
+    ``X = B_u P B_vᵀ`` per net and coordinate with the 1-D matrices built once; with general
+    weights ``X = B_u (w P) B_vᵀ / (B_u w B_vᵀ)``. Returns ``(..., len(u), len(v), c)``.
+    """
+    Bu = surface.basis_u.matrix(u).toarray()
+    Bv = surface.basis_v.matrix(v).toarray()
+    P = np.asarray(nets, dtype=float)
+    w = surface.net_weights
+    if w is None:
+        return np.einsum("ik,...klc,jl->...ijc", Bu, P, Bv, optimize=True)
+    X = np.einsum("ik,...klc,jl->...ijc", Bu, P * w[..., None], Bv, optimize=True)
+    return X / (Bu @ w @ Bv.T)[..., None]
+
+
 def weight_field(surface: Surface, U: ArrayLike, V: ArrayLike) -> Array:
     """The denominator ``W(u, v) = Σ w_kl N_k N_l`` at the points ``(U, V)``."""
     w = surface.net_weights
