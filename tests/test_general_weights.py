@@ -196,3 +196,61 @@ def test_bad_general_weights_are_refused():
         sd.Surface(P, bu, bv, net_weights=w)
     with pytest.raises(InputError, match="not both"):
         sd.Surface(P, RationalBasis(bu, np.ones(7)), bv, net_weights=np.ones((7, 6)))
+
+
+def _bump_weights(surface, amplitude=0.4):
+    """``1 + a sin(π s) sin(π t) (s + 1/2) cos t`` at the Greville points ``(s, t)`` of the
+    patch's own parameters scaled to [0, 1]: 1 on its edges, not a product inside."""
+    gu = surface.basis_u.greville() / surface.basis_u.length
+    gv = surface.basis_v.greville() / surface.basis_v.length
+    S, T = np.meshgrid(gu, gv, indexing="ij")
+    return 1.0 + amplitude * np.sin(np.pi * S) * np.sin(np.pi * T) * (S + 0.5) * np.cos(T)
+
+
+def test_a_body_of_reweighted_halves_is_the_same_membrane():
+    """The unit square as two patches (one reversed in u and v, so its normal still points
+    up), each with general weights that are 1 on its edges (so the halves still conform
+    along the shared edge): the intrinsic membrane under pressure gives the load's work of
+    the Fourier series within the discretisation error at this mesh (6 × 12 cells of
+    degree 3 per half; measured -5.9e-7 with unit weights, -8.1e-7 reweighted; tolerance
+    2e-6 as for the single patch)."""
+    from body_patches import flat_patch
+
+    halves = [flat_patch((0, 0.5), (0, 1), (6, 12)),
+              flat_patch((0.5, 1), (0, 1), (6, 12), reverse_u=True, reverse_v=True)]
+    halves = [sd.Surface(h.control_points, h.basis_u, h.basis_v, net_weights=_bump_weights(h))
+              for h in halves]
+    body = sd.BodyModel(sd.Body(halves), sd.Material(w10=1.0, w01=1.0), boundary="pinned")
+    solution = body.static(sd.Pressure(1.0))
+    work = float(np.sum(solution.force_free * solution.d_free))
+    closed_form = _membrane_integral()
+    assert abs(work - closed_form) <= 2e-6 * closed_form
+
+
+def test_meshes_of_frames_and_a_step_round_trip_keep_general_weights(tmp_path):
+    """Meshes of many frames (one pair of 1-D matrices for all) equal each frame's own
+    evaluation (two evaluations of one quotient: 1e-13 of the size); a STEP file written
+    and read back by OpenCASCADE keeps the weights and the surface (OpenCASCADE writes
+    reals with 12 significant digits: 5e-13 of each number, so 1e-12 of the largest
+    weight, and 3e-12 of the size for a point, a weighted mean of such numbers)."""
+    from splinedeform.export.frames import tessellate_frames
+
+    surface = surface_from_patch(_rational_patch())
+    P = surface.control_points
+    nets = np.stack([P, P + 0.1 * np.sin(P[..., ::-1])])
+    vertices, _ = tessellate_frames(surface, nets, 9)
+    size = np.abs(nets).max()
+    for frame in range(2):
+        own = surface.with_control_points(nets[frame]).tessellate(9)[0]
+        assert np.abs(vertices[frame] - own).max() <= 1e-13 * size
+    pytest.importorskip("OCP")
+    from splinedeform.cad_step import read_step, write_step
+
+    written = write_step(tmp_path / "general.step", [patch_from_surface(surface)])
+    back = read_step(written)
+    w = surface.net_weights
+    assert np.abs(np.asarray(back.weights) - w).max() <= 1e-12 * w.max()
+    u, v = np.linspace(0, 1, 9), np.linspace(0, 1, 7)
+    again = surface_from_patch(back)
+    assert np.abs(again.evaluate_grid(u, v) - surface.evaluate_grid(u, v)).max() \
+        <= 3e-12 * np.abs(P).max()
