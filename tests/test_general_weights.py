@@ -194,6 +194,9 @@ def test_bad_general_weights_are_refused():
     w[2, 3] = -1.0
     with pytest.raises(InputError, match=r"net_weights\[2, 3\] is -1"):
         sd.Surface(P, bu, bv, net_weights=w)
+    with pytest.raises(InputError, match="direction u is not"):
+        sd.Surface(np.zeros((7, 6, 3)), sd.BSplineBasis(3, 4, 1.0, "uniform"), bv,
+                   net_weights=np.ones((7, 6)))
     with pytest.raises(InputError, match="not both"):
         sd.Surface(P, RationalBasis(bu, np.ones(7)), bv, net_weights=np.ones((7, 6)))
 
@@ -254,3 +257,13 @@ def test_meshes_of_frames_and_a_step_round_trip_keep_general_weights(tmp_path):
     again = surface_from_patch(back)
     assert np.abs(again.evaluate_grid(u, v) - surface.evaluate_grid(u, v)).max() \
         <= 3e-12 * np.abs(P).max()
+
+
+def test_a_cad_patch_with_general_weights_and_unclamped_knots_is_refused():
+    patch = _rational_patch()
+    knots = np.asarray(KNOTS_U, float)
+    knots[:3] = [-0.3, -0.2, -0.1]                          # unclamped start in u
+    odd = NurbsPatch(patch.degrees, knots, patch.knots_v, patch.points, patch.weights)
+    with pytest.raises(InputError, match="blade.3dm face 2: its weights are not a product "
+                                         "w_ij = a_i b_j and its knot vector in u is not"):
+        surface_from_patch(odd, source="blade.3dm face 2")

@@ -30,7 +30,7 @@ from .cad_units import check_units, rhino_name
 from .errors import InputError, InputWarning
 from .export.atomic import atomic_path
 from .knots import KnotVectorBasis, RationalBasis
-from .rational import product_factors
+from .rational import clamped, product_factors
 from .surface import Basis, Surface
 
 if TYPE_CHECKING:
@@ -133,6 +133,12 @@ def surface_from_patch(patch: NurbsPatch, name: str = "cad surface",
     w = np.asarray(patch.weights, dtype=float)
     factors = weight_factors(w)
     if factors is None:
+        for direction, basis in (("u", bu), ("v", bv)):
+            if not clamped(basis):
+                raise InputError(f"{source}: its weights are not a product w_ij = a_i b_j "
+                                 f"and its knot vector in {direction} is not clamped (end "
+                                 "knots repeated degree + 1 times); general weights need "
+                                 "clamped knots: re-export the surface with clamped knots")
         return Surface(np.asarray(patch.points, dtype=float), bu, bv, name=name,
                        net_weights=w)
     a, b = factors

@@ -66,6 +66,16 @@ def check_weights(w: ArrayLike, shape: tuple[int, int], what: str = "net_weights
     return w
 
 
+def clamped(basis: object) -> bool:
+    """Whether a 1-D basis is periodic or its end knots repeat ``n + 1`` times (so only
+    the end function is non-zero at each end, as the edge conditions of general weights
+    assume)."""
+    if getattr(basis, "periodic", False):
+        return True
+    n, t = basis.degree, np.asarray(basis.knots, dtype=float)      # type: ignore[attr-defined]
+    return bool(np.all(t[:n + 1] == t[n]) and np.all(t[-n - 1:] == t[-n - 1]))
+
+
 def lower_orders(targets: Iterable[Order]) -> list[Order]:
     """Every ``(i, j) <= (p, q)`` of some target, in an order Leibniz' rule can follow."""
     wanted = {(i, j) for p, q in targets for i in range(p + 1) for j in range(q + 1)}

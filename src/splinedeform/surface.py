@@ -117,9 +117,11 @@ class Surface:
         if any(isinstance(b, RationalBasis) for b in (self.basis_u, self.basis_v)):
             raise InputError("give NURBS weights either per direction (rational bases) or "
                              "per control point (net_weights), not both")
-        if any(getattr(b, "kind", None) == "uniform" for b in (self.basis_u, self.basis_v)):
-            raise InputError("net_weights need open, periodic or general knot vectors: on "
-                             "Höllig's uniform layout the edge conditions would mix weights")
+        for name, basis in (("u", self.basis_u), ("v", self.basis_v)):
+            if not rational.clamped(basis):
+                raise InputError(f"net_weights need knot vectors clamped at both ends (or "
+                                 f"periodic); direction {name} is not: on an unclamped end "
+                                 "the edge conditions would mix the weights of several rows")
         object.__setattr__(self, "net_weights", rational.check_weights(self.net_weights,
                                                                        self.shape))
 
@@ -127,6 +129,7 @@ class Surface:
         """One line: name, net size, degrees, knot layouts, domain (never the net itself)."""
         (_, lu), (_, lv) = self.domain
         fit = "" if self.fit_error is None else f", fit_error={self.fit_error:.3g}"
+        fit += "" if self.net_weights is None else ", general weights"
         return (f"Surface({self.name!r}, {self.shape[0]}×{self.shape[1]} control points, "
                 f"degree=({self.basis_u.degree}, {self.basis_v.degree}), "
                 f"knots=({knots_summary(self.basis_u)}, {knots_summary(self.basis_v)}), "

@@ -105,21 +105,19 @@ def grid(surface: Surface, extra_points: int = 2) -> Grid:
         return sp.csr_matrix((values.ravel(), (rows.ravel(), index.ravel())),
                              shape=(index.shape[0], n))
 
+    shapes = None
+    if surface.net_weights is not None:       # the rational basis R_k of general weights
+        _, R = basis_derivatives(iu[:, None], Bu[:, :, None], iv[None], Bv[:, None],
+                                 surface.net_weights, ORDERS)
+        shapes = {k: R[k] for k in ORDERS}
+
     def derivative(p: int, q: int) -> Array:
+        if shapes is not None:      # homogeneous coordinates and the quotient rule
+            return surface.evaluate_grid(xu, xv, p, q)
         # x_{,u^p v^q} = B_u^(p) P B_v^(q)ᵀ per coordinate, two sparse products
         tmp = (collocation(iu, Bu[p], n_u) @ P.reshape(n_u, -1)).reshape(-1, n_v, 3)
         out = collocation(iv, Bv[q], n_v) @ tmp.transpose(1, 0, 2).reshape(n_v, -1)
         return np.asarray(out).reshape(len(xv), len(xu), 3).transpose(1, 0, 2)
-
-    shapes = None
-    if surface.net_weights is not None:       # the rational basis R_k of general weights
-        index, shapes = basis_derivatives(iu[:, None], Bu[:, :, None], iv[None], Bv[:, None],
-                                          surface.net_weights, ORDERS)
-        shapes = {k: shapes[k] for k in ORDERS}
-        local = P.reshape(-1, 3)[index]                           # (Qu, Qv, k, 3)
-
-        def derivative(p: int, q: int) -> Array:               # noqa: F811
-            return np.einsum("abk,abkc->abc", shapes[p, q], local)
 
     a = np.stack([derivative(1, 0), derivative(0, 1)])
     a2 = np.stack([derivative(2, 0), derivative(1, 1), derivative(0, 2)])

@@ -37,11 +37,9 @@ from ..knots import KnotVectorBasis
 from ..material import Material
 from ..quadrature import gauss_points
 from ..rational import basis_derivatives, check_weights
-from .metric import assemble
+from .metric import ORDERS, assemble
 
 Array = NDArray[np.float64]
-#: derivative orders (p, q) of the basis used by the energy
-ORDERS = ((0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2))
 
 
 def rational_derivatives(basis_u: KnotVectorBasis, basis_v: KnotVectorBasis,
