@@ -267,3 +267,31 @@ def test_a_cad_patch_with_general_weights_and_unclamped_knots_is_refused():
     with pytest.raises(InputError, match="blade.3dm face 2: its weights are not a product "
                                          "w_ij = a_i b_j and its knot vector in u is not"):
         surface_from_patch(odd, source="blade.3dm face 2")
+
+
+def test_coupling_traces_of_an_edge_use_the_rational_basis():
+    """A side's traces (values and outward conormal slopes along an edge, used by the
+    coupling of interfaces and C0 lines) on general weights: applied to a smooth field
+    ``d = R · f`` they equal the surface's own evaluation of that field and the conormal
+    slope from its derivatives (two evaluations of one quotient: 1e-12 of the field)."""
+    from splinedeform.physics.coupling_traces import Side
+
+    surface = surface_from_patch(_rational_patch())
+    field = np.sin(3 * surface.control_points)                      # another net, (7, 6, 3)
+    s = np.linspace(0.05, 0.95, 9)
+    for edge, (u, v) in (("u0", (0 * s, s)), ("v1", (s, 0 * s + 1.0))):
+        trace = Side.of_edge(surface, edge).traces(s)
+        flat = field.reshape(-1, 3)
+        want = surface.derivative(u, v, control_points=field)
+        scale = np.abs(want).max()
+        assert np.abs(trace.values @ flat - want).max() <= 1e-12 * scale
+        assert np.abs(trace.points - surface.evaluate(u, v)).max() <= 1e-12
+        x_u, x_v = surface.derivative(u, v, 1, 0), surface.derivative(u, v, 0, 1)
+        d_u = surface.derivative(u, v, 1, 0, control_points=field)
+        d_v = surface.derivative(u, v, 0, 1, control_points=field)
+        x_f, x_r, d_f, d_r = (x_u, x_v, d_u, d_v) if edge[0] == "u" else (x_v, x_u, d_v, d_u)
+        c = np.einsum("qi,qi->q", x_f, x_r) / np.einsum("qi,qi->q", x_r, x_r)
+        outward = -1.0 if edge[1] == "0" else 1.0
+        slope = outward * (d_f - c[:, None] * d_r) / np.linalg.norm(
+            x_f - c[:, None] * x_r, axis=1)[:, None]
+        assert np.abs(trace.slopes @ flat - slope).max() <= 1e-12 * np.abs(slope).max()

@@ -215,6 +215,22 @@ def evaluation_matrix(surface: Surface, u: ArrayLike, v: ArrayLike, du: int = 0,
     return sp.csr_matrix((data, indices, indptr), shape=(u.size, bu.size * bv.size))
 
 
+def rational_operators(V: sp.spmatrix, derivatives: Iterable[sp.spmatrix], weights: Array
+                       ) -> tuple[sp.csr_matrix, list[sp.csr_matrix]]:
+    """First-order rational operators from polynomial ones on the same points.
+
+    ``V`` (values) and each first derivative ``D`` map the flat net to points by the
+    polynomial basis ``N``; with ``A = N diag(w)``, ``W = N w`` and ``W' = D w`` the quotient
+    rule gives ``R = diag(1/W) A`` and ``R' = diag(1/W) (D diag(w) − diag(W') R)``. One-sided
+    polynomial derivatives (at a knot line) give the one-sided rational ones.
+    """
+    w = np.asarray(weights, dtype=float).ravel()
+    scale = sp.diags(w)
+    inverse = sp.diags(1.0 / (V @ w))
+    R = (inverse @ V @ scale).tocsr()
+    return R, [(inverse @ (D @ scale - sp.diags(D @ w) @ R)).tocsr() for D in derivatives]
+
+
 def refuse(surface: Surface, what: str) -> None:
     """InputError where ``what`` cannot take a surface with general (non-product) weights."""
     if getattr(surface, "net_weights", None) is not None:
