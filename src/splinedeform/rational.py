@@ -43,7 +43,7 @@ PRODUCT_TOL = 1e-12
 
 
 def product_factors(w: ArrayLike, tol: float = PRODUCT_TOL) -> tuple[Array, Array] | None:
-    """Factors ``a, b`` with ``w = a bᵀ`` within ``tol · max w`` (one ``b_l`` is 1), else None."""
+    """Factors ``a, b`` with ``w = a bᵀ`` within ``tol · max w`` (one ``b_l`` is 1), or None."""
     w = np.asarray(w, dtype=float)
     j = int(np.argmax(w.max(axis=0)))
     a = w[:, j].copy()

@@ -60,7 +60,8 @@ def tessellate_frames(surface: Surface, nets: ArrayLike, resolution: int = 32
 
     ``X_f = B_u P_f B_vᵀ`` per coordinate with ``(B_u)_ik = b_k(u_i)``, ``(B_v)_jl = b_l(v_j)``
     built once (:func:`splinedeform.rational.grid_nets`, general weights included).
-    ``nets`` has shape ``(..., n_u, n_v, 3)``; returns vertices ``(..., r_u r_v, 3)`` (row-major grid, as :meth:`Surface.tessellate`) and faces.
+    ``nets`` has shape ``(..., n_u, n_v, 3)``; returns vertices ``(..., r_u r_v, 3)``
+    (row-major grid, as :meth:`Surface.tessellate`) and faces.
     """
     if isinstance(resolution, bool) or not isinstance(resolution, (int, np.integer)):
         raise InputError(f"resolution must be an integer >= 2, got {resolution!r}")
