@@ -115,9 +115,14 @@ def basis_derivatives(iu: NDArray[np.int64], Bu: Array, iv: NDArray[np.int64], B
     local_w = weights[iu[..., :, None], iv[..., None, :]]               # S + (pu, pv)
     shape = local_w.shape[:-2] + (-1,)
 
+    numerators: dict[Order, Array] = {}
+
     def A(order: Order) -> Array:
-        p, q = order
-        return (Bu[p][..., :, None] * Bv[q][..., None, :] * local_w).reshape(shape)
+        if order not in numerators:
+            p, q = order
+            numerators[order] = (Bu[p][..., :, None] * Bv[q][..., None, :]
+                                 * local_w).reshape(shape)
+        return numerators[order]
 
     R = quotient(A, lambda o: A(o).sum(axis=-1, keepdims=True), targets)
     index = (iu[..., :, None] * weights.shape[1] + iv[..., None, :]).reshape(shape)

@@ -37,7 +37,9 @@ from ..knots import KnotVectorBasis
 from ..material import Material
 from ..quadrature import gauss_points
 from ..rational import basis_derivatives, check_weights
-from .metric import ORDERS, assemble
+from .metric import ORDERS
+from .shell import by_cell
+from .shell_assembly import Pattern, assemble_cells
 
 Array = NDArray[np.float64]
 
@@ -63,21 +65,48 @@ def matrices(basis_u: KnotVectorBasis, basis_v: KnotVectorBasis, weights: Array,
              material: Material, points_per_cell: int | None = None
              ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
     """Stiffness ``K`` and consistent mass ``M`` (see the module docstring), each
-    ``(n_u n_v)²`` over the flat net ``i n_v + j``, shared by x, y and z."""
+    ``(n_u n_v)²`` over the flat net ``i n_v + j``, shared by x, y and z.
+
+    Cell by cell, a bounded number of cell rows at a time: each cell's block is ``BᵀB`` for
+    the rows ``B = [√(c_t a_q) ∂_t R]`` of its points ``q`` and terms ``t`` stacked (the
+    weights ``c_t >= 0`` of the material), scattered into a precomputed sparse pattern
+    (:mod:`.shell_assembly`), as the intrinsic physics does.
+    """
+    w = check_weights(weights, (basis_u.size, basis_v.size), "general NURBS weights")
     qu = points_per_cell or 2 * basis_u.degree + 10
     qv = points_per_cell or 2 * basis_v.degree + 10
     u, au = gauss_points(basis_u, qu)
     v, av = gauss_points(basis_v, qv)
-    index, R = rational_derivatives(basis_u, basis_v, weights, u, v)
-    dA = au[:, None, None, None] * av[None, :, None, None]
-    terms = [(material.w10, (1, 0)), (material.w01, (0, 1)), (material.w20, (2, 0)),
-             (2 * material.w11, (1, 1)), (material.w02, (0, 2))]
-    blocks = np.zeros(index.shape + index.shape[-1:])
-    for factor, order in terms:
-        if factor:
-            blocks += factor * R[order][..., :, None] * R[order][..., None, :]
-    size = basis_u.size * basis_v.size
-    K = assemble(index, blocks * dA, size)
-    M = assemble(index, material.mass * R[0, 0][..., :, None] * R[0, 0][..., None, :] * dA,
-                 size)
-    return K, M
+    iu, Bu = basis_u.nonzero_derivatives(u, 2)                  # (3, Qu, pu)
+    iv, Bv = basis_v.nonzero_derivatives(v, 2)
+    cells_u, cells_v = iu[::qu], iv[::qv]
+    pattern = Pattern.of(cells_u, cells_v, basis_u.size, basis_v.size, 1)
+    terms = [(factor, order) for factor, order in
+             ((material.w10, (1, 0)), (material.w01, (0, 1)), (material.w20, (2, 0)),
+              (2 * material.w11, (1, 1)), (material.w02, (0, 2))) if factor]
+
+    def shapes(rows: slice, orders: tuple = ORDERS
+               ) -> tuple[dict[tuple[int, int], Array], Array]:
+        p = slice(rows.start * qu, rows.stop * qu)
+        _, R = basis_derivatives(iu[p][:, None], Bu[:, p][:, :, None], iv[None], Bv[:, None],
+                                 w, orders)
+        return R, au[p][:, None] * av[None, :]
+
+    def stiffness(rows: slice) -> Array:
+        R, dA = shapes(rows)
+        k = R[0, 0].shape[-1]
+        if not terms:
+            return np.zeros((rows.stop - rows.start, cells_v.shape[0], k, k))
+        B = np.stack([np.sqrt(factor * dA)[..., None] * R[order] for factor, order in terms],
+                     axis=2)                                            # (Qa, Qv, t, k)
+        B = by_cell(B, (qu, qv))
+        B = B.reshape(B.shape[:2] + (-1, k))
+        return np.swapaxes(B, -1, -2) @ B
+
+    def mass(rows: slice) -> Array:
+        R, dA = shapes(rows, ((0, 0),))
+        N0 = by_cell(R[0, 0], (qu, qv))                                 # (A, B, q, k)
+        return np.swapaxes(N0, -1, -2) @ (by_cell(material.mass * dA, (qu, qv))[..., None] * N0)
+
+    return (assemble_cells(pattern, cells_u, cells_v, stiffness),
+            assemble_cells(pattern, cells_u, cells_v, mass))
