@@ -21,7 +21,7 @@ import scipy.sparse as sp
 
 from .errors import InputError
 from .material import Material
-from .physics import intrinsic
+from .physics import intrinsic, rational_plate
 from .quadrature import gram_matrix
 from .surface import Surface
 
@@ -172,14 +172,26 @@ def gram_matrices(surface: Surface) -> tuple[list[sp.csr_matrix], list[sp.csr_ma
 
 
 def patch_matrices(surface: Surface, material: Material, physics: str, lumped: bool
-                   ) -> tuple[list[sp.csr_matrix], list[sp.csr_matrix], sp.csr_matrix,
-                              sp.csr_matrix]:
+                   ) -> tuple[list[sp.csr_matrix] | None, list[sp.csr_matrix] | None,
+                              sp.csr_matrix, sp.csr_matrix]:
     """One patch's 1-D Gram matrices and full ``(K, M)`` (``n_u n_v`` square).
 
-    ``parametric``: ``K = Σ w G_a^u ⊗ G_b^v``, ``M = μ G_0^u ⊗ G_0^v`` (module docstring);
-    ``intrinsic``: :func:`splinedeform.physics.intrinsic.matrices`. ``lumped`` replaces
-    ``M`` by its row sums on the diagonal. Returns ``(gram_u, gram_v, K, M)``.
+    ``parametric``: ``K = Σ w G_a^u ⊗ G_b^v``, ``M = μ G_0^u ⊗ G_0^v`` (module docstring),
+    or, for general weights (:attr:`~splinedeform.Surface.net_weights`), element by
+    element on the rational basis (:func:`splinedeform.physics.rational_plate.matrices`;
+    no Gram factors: ``None, None``); ``intrinsic``:
+    :func:`splinedeform.physics.intrinsic.matrices`. ``lumped`` replaces ``M`` by its row
+    sums on the diagonal. Returns ``(gram_u, gram_v, K, M)``.
     """
+    if surface.net_weights is not None:
+        if physics == "intrinsic":
+            K, M = intrinsic.matrices(surface, material, lumped)
+        else:
+            K, M = rational_plate.matrices(surface.basis_u, surface.basis_v,
+                                           surface.net_weights, material)
+            if lumped:
+                M = sp.diags(np.asarray(M.sum(axis=1)).ravel(), format="csr")
+        return None, None, K, M
     gram_u, gram_v = gram_matrices(surface)
     if physics == "intrinsic":
         K, M = intrinsic.matrices(surface, material, lumped)

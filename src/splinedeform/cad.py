@@ -30,6 +30,7 @@ from .cad_units import check_units, rhino_name
 from .errors import InputError, InputWarning
 from .export.atomic import atomic_path
 from .knots import KnotVectorBasis, RationalBasis
+from .rational import clamped, product_factors
 from .surface import Basis, Surface
 
 if TYPE_CHECKING:
@@ -119,16 +120,28 @@ def surface_from_patch(patch: NurbsPatch, name: str = "cad surface",
 
     Knots are translated so the parameter domain starts at 0 (their spacing, hence the
     parametrisation, is kept). Equal weights give polynomial :class:`KnotVectorBasis`
-    directions (exact Gram matrices). Otherwise the weights must be a product
-    ``w_ij = a_i b_j`` (surfaces of revolution, extrusions and ruled conics are): then
-    ``R_ij = R_i(u) R_j(v)`` with ``R_i = a_i N_i / Σ a_k N_k``, and the Kronecker
-    structure of the model survives. Other weights are refused.
+    directions (exact Gram matrices). Weights that are a product ``w_ij = a_i b_j``
+    (surfaces of revolution, extrusions and ruled conics) give ``R_ij = R_i(u) R_j(v)``
+    with ``R_i = a_i N_i / Σ a_k N_k``, and the Kronecker structure of the model survives.
+    Other weights are kept per control point (:attr:`Surface.net_weights`; the rational
+    basis element by element, :mod:`splinedeform.rational`).
     """
     bu = KnotVectorBasis(patch.degrees[0], patch.knots_u)
     bv = KnotVectorBasis(patch.degrees[1], patch.knots_v)
     bu, bv = bu.shifted(bu.domain[0]), bv.shifted(bv.domain[0])
     warn_open_seams(patch, source)
-    a, b = weight_factors(np.asarray(patch.weights, dtype=float), source)
+    w = np.asarray(patch.weights, dtype=float)
+    factors = weight_factors(w)
+    if factors is None:
+        for direction, basis in (("u", bu), ("v", bv)):
+            if not clamped(basis):
+                raise InputError(f"{source}: its weights are not a product w_ij = a_i b_j "
+                                 f"and its knot vector in {direction} is not clamped (end "
+                                 "knots repeated degree + 1 times); general weights need "
+                                 "clamped knots: re-export the surface with clamped knots")
+        return Surface(np.asarray(patch.points, dtype=float), bu, bv, name=name,
+                       net_weights=w)
+    a, b = factors
     basis_u: Basis = bu if np.ptp(a) <= WEIGHT_TOL * a.max() else RationalBasis(bu, a)
     basis_v: Basis = bv if np.ptp(b) <= WEIGHT_TOL * b.max() else RationalBasis(bv, b)
     return Surface(np.asarray(patch.points, dtype=float), basis_u, basis_v, name=name)
@@ -154,17 +167,11 @@ def warn_open_seams(patch: NurbsPatch, source: str = "NURBS patch") -> None:
                           stacklevel=3)
 
 
-def weight_factors(w: NDArray[np.float64], source: str = "NURBS patch"
-                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Factors ``a, b`` with ``w = a bᵀ`` (one ``b_j`` is 1); refuse weights of higher rank."""
-    j = int(np.argmax(w.max(axis=0)))
-    a = w[:, j].copy()
-    b = w[int(np.argmax(a))] / a.max()
-    if np.abs(w - np.outer(a, b)).max() > WEIGHT_TOL * w.max():
-        raise InputError(f"{source}: its weights are not a product w_ij = a_i b_j (as for "
-                         "surfaces of revolution and extrusions); a surface with general "
-                         "weights cannot be deformed on the tensor-product model")
-    return a, b
+def weight_factors(w: NDArray[np.float64]
+                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+    """Factors ``a, b`` with ``w = a bᵀ`` within :data:`WEIGHT_TOL` (one ``b_j`` is 1), or
+    None for general weights (:func:`splinedeform.rational.product_factors`)."""
+    return product_factors(w, WEIGHT_TOL)
 
 
 def patch_from_surface(surface: Surface, control_points: NDArray[np.float64] | None = None
@@ -174,20 +181,21 @@ def patch_from_surface(surface: Surface, control_points: NDArray[np.float64] | N
     Open, uniform and general knot vectors are written as they are (Höllig's uniform
     layout is an unclamped knot vector); a periodic direction is unwrapped into the
     uniform layout on the same cells with its first ``n`` control points repeated at
-    the end. Weights are ``a_i b_j`` from rational directions, 1 elsewhere.
+    the end. Weights are the surface's :attr:`~Surface.weights` (general ones as they are,
+    ``a_i b_j`` from rational directions, 1 elsewhere), unwrapped like the points.
     """
     P = surface.control_points if control_points is None else np.asarray(control_points, float)
-    knots, weights = [], []
+    w = surface.weights
+    knots = []
     for axis, basis in enumerate((surface.basis_u, surface.basis_v)):
         if isinstance(basis, BSplineBasis) and basis.periodic:
             n, m = basis.degree, basis.cells
             P = np.take(P, np.mod(np.arange(m + n) - n, m), axis=axis)
+            w = np.take(w, np.mod(np.arange(m + n) - n, m), axis=axis)
             basis = BSplineBasis(n, m, basis.length, "uniform")
         knots.append(np.asarray(basis.knots, dtype=float))
-        weights.append(np.asarray(basis.weights) if isinstance(basis, RationalBasis)
-                       else np.ones(basis.size))
     return NurbsPatch((surface.basis_u.degree, surface.basis_v.degree), knots[0], knots[1],
-                      P, np.outer(*weights))
+                      P, np.array(w))
 
 
 #: CAD file suffixes and what reads them

@@ -103,11 +103,7 @@ def _weights(w: NDArray[np.float64]) -> str:
     """``"1"`` (polynomial), ``"product"`` (``a_i b_j``) or ``"general"``."""
     if np.ptp(w) <= WEIGHT_TOL * w.max():
         return "1"
-    try:
-        weight_factors(w)
-    except InputError:
-        return "general"
-    return "product"
+    return "product" if weight_factors(w) is not None else "general"
 
 
 def degenerate_edges(points: NDArray[np.float64]) -> list[str]:

@@ -22,7 +22,7 @@ import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
 from .assembly import (_largest, check_bending, full_matrices, gram_matrices,
-                       reduced_matrices)
+                       patch_matrices, reduced_matrices)
 from .boundary import Constraints, build_constraints
 from .errors import InputError, SingularSystemError
 from .loads import Load, as_load, static_time
@@ -113,17 +113,19 @@ class Model:
             error.key = "boundary"  # type: ignore[attr-defined]
             raise error
         lumped = mass_matrix == "lumped"
-        self.gram_u, self.gram_v = gram_matrices(surface)
+        general = surface.net_weights is not None         # weights that do not factor
+        self.gram_u, self.gram_v = (None, None) if general else gram_matrices(surface)
         # K and M on the whole net: assembled here only where the constrained matrices are
         # made from them, else when first asked for (K_full, M_full)
         self._full: tuple[sp.csr_matrix, sp.csr_matrix] | None = (
             intrinsic.matrices(surface, material, lumped) if physics == "intrinsic"
-            else (trimmed.stiffness, trimmed.mass) if trimmed else None)
+            else (trimmed.stiffness, trimmed.mass) if trimmed
+            else patch_matrices(surface, material, physics, lumped)[2:] if general else None)
         kinks = c0_coupling(surface, material, self.constraints.edges)
         if kinks is not None:                  # the slopes tied across each C0 line
             K, M = self._full_matrices()
             self._full, self.gram_u, self.gram_v = ((K + kinks).tocsr(), M), None, None
-        reduced = None if physics == "intrinsic" or trimmed or kinks is not None else \
+        reduced = None if physics == "intrinsic" or trimmed or kinks is not None or general else \
             reduced_matrices(self.gram_u, self.gram_v, material, lumped, self.constraints)
         if reduced is None:
             T = self.constraints.T

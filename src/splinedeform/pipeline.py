@@ -319,6 +319,8 @@ def _measure(result: RunResult) -> None:
     """Probe histories, the largest surface displacement and the energies."""
     import numpy as np
 
+    from .rational import grid_nets
+
     scenario, surface = result.scenario, result.built.surface
     D = result.nets - surface.control_points
     probes = scenario.output.probes or (_domain_centre(surface),)
@@ -337,9 +339,7 @@ def _measure(result: RunResult) -> None:
         grid = tessellate_frames(surface, D, scenario.output.resolution)[0]
     else:
         uu, vv = surface.sample_parameters(scenario.output.resolution)
-        Bu = surface.basis_u.matrix(uu).toarray()
-        Bv = surface.basis_v.matrix(vv).toarray()
-        grid = np.einsum("ik,fklc,jl->fijc", Bu, D, Bv, optimize=True)
+        grid = grid_nets(surface, uu, vv, D)
     # |d| per frame, scaled so that the squares of a tiny d do not underflow
     size = float(np.abs(grid).max(initial=0.0))
     scale = size if 0.0 < size < np.inf else 1.0

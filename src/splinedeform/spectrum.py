@@ -39,6 +39,8 @@ NO_FACTORS = ("a body of several patches, or a patch whose C0 lines are coupled,
 
 def kronecker_reason(model: Any) -> str | None:
     """Why the Kronecker factors do not apply to ``model`` (``None`` if they do)."""
+    if getattr(getattr(model, "surface", None), "net_weights", None) is not None:
+        return "the NURBS weights are not a product a_k b_l (no Kronecker factors)"
     if getattr(model, "gram_u", True) is None:
         return NO_FACTORS
     if getattr(model, "physics", "parametric") != "parametric":
@@ -52,6 +54,8 @@ def kronecker_reason(model: Any) -> str | None:
 
 def separable_reason(model: Any) -> str | None:
     """Why the separable fast path does not apply to ``model`` (``None`` if it does)."""
+    if getattr(getattr(model, "surface", None), "net_weights", None) is not None:
+        return "the NURBS weights are not a product a_k b_l (no Kronecker factors)"
     if getattr(model, "gram_u", True) is None:
         return NO_FACTORS
     if getattr(model, "physics", "parametric") != "parametric":

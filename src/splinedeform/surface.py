@@ -22,6 +22,7 @@ from .patches import evaluate_patch_point, evaluate_patches, patches_when_worth
 from .spans import scalar_bernstein
 from .errors import InputError
 from .knots import KnotVectorBasis, RationalBasis
+from . import rational
 
 #: the 1-D bases a surface composes: the fast layouts, a general knot vector, a weighted one
 Basis = BSplineBasis | KnotVectorBasis | RationalBasis
@@ -72,6 +73,9 @@ class Surface:
         The bases in the two parameter directions. A general knot vector must start its
         domain at 0 (``t_n = 0``; see :meth:`KnotVectorBasis.shifted`). Two rational bases
         with weights ``a_k`` and ``b_l`` make the NURBS surface with weights ``a_k b_l``.
+    net_weights : array_like, shape ``(n_u, n_v)``, optional
+        General NURBS weights ``w_kl`` on polynomial bases, for weights that are not a
+        product: the basis is ``R_kl = w_kl N_k N_l / Σ w N N`` (:mod:`splinedeform.rational`).
     fit_error : float or None
         Maximum distance to the map the net was fitted to (set by :mod:`splinedeform.shapes`).
     name : str
@@ -87,6 +91,7 @@ class Surface:
     fit_error: float | None = None
     name: str = "surface"
     trim: Any = None
+    net_weights: NDArray[np.float64] | None = None
     _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -110,11 +115,27 @@ class Surface:
                              f"{tuple(int(i) for i in bad[:2])} is {P[tuple(bad[:2])]}")
         P.setflags(write=False)
         object.__setattr__(self, "control_points", P)
+        if self.net_weights is not None:
+            self._check_net_weights()
+
+    def _check_net_weights(self) -> None:
+        """General weights: one per control point, > 0, on polynomial bases."""
+        if any(isinstance(b, RationalBasis) for b in (self.basis_u, self.basis_v)):
+            raise InputError("give NURBS weights either per direction (rational bases) or "
+                             "per control point (net_weights), not both")
+        for name, basis in (("u", self.basis_u), ("v", self.basis_v)):
+            if not rational.clamped(basis):
+                raise InputError(f"net_weights need knot vectors clamped at both ends (or "
+                                 f"periodic); direction {name} is not: on an unclamped end "
+                                 "the edge conditions would mix the weights of several rows")
+        object.__setattr__(self, "net_weights", rational.check_weights(self.net_weights,
+                                                                       self.shape))
 
     def __repr__(self) -> str:
         """One line: name, net size, degrees, knot layouts, domain (never the net itself)."""
         (_, lu), (_, lv) = self.domain
         fit = "" if self.fit_error is None else f", fit_error={self.fit_error:.3g}"
+        fit += "" if self.net_weights is None else ", general weights"
         return (f"Surface({self.name!r}, {self.shape[0]}×{self.shape[1]} control points, "
                 f"degree=({self.basis_u.degree}, {self.basis_v.degree}), "
                 f"knots=({knots_summary(self.basis_u)}, {knots_summary(self.basis_v)}), "
@@ -133,7 +154,10 @@ class Surface:
 
     @property
     def weights(self) -> NDArray[np.float64]:
-        """NURBS weights ``w_kl = a_k b_l`` of the net (``a``, ``b`` of rational directions, 1 else)."""
+        """NURBS weights of the net: :attr:`net_weights`, else ``w_kl = a_k b_l`` (``a``, ``b``
+        of rational directions, 1 else)."""
+        if self.net_weights is not None:
+            return self.net_weights
         a, b = (np.asarray(basis.weights) if isinstance(basis, RationalBasis)
                 else np.ones(basis.size) for basis in (self.basis_u, self.basis_v))
         return np.outer(a, b)
@@ -156,8 +180,11 @@ class Surface:
         """Sparse ``E`` with ``∂^{du+dv} x / ∂u^du ∂v^dv (u_i, v_i) = (E @ P.reshape(-1, 3))_i``.
 
         ``E_{i, k n_v + l} = D^{du} b_k(u_i) D^{dv} b_l(v_i)``; ``u`` and ``v`` are
-        flattened after broadcasting to a common shape.
+        flattened after broadcasting to a common shape. With :attr:`net_weights`, the
+        rational ``D^(du,dv) R_kl`` (:func:`splinedeform.rational.evaluation_matrix`).
         """
+        if self.net_weights is not None:
+            return rational.evaluation_matrix(self, u, v, du, dv)
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
         u, v = u.ravel(), v.ravel()
         iu, bu = self.basis_u.nonzero(u, du)
@@ -178,8 +205,11 @@ class Surface:
         The surface's own net is evaluated from its Bézier patches (:mod:`splinedeform.patches`,
         computed once it has been asked for as many points as it has cells); until then, and
         for another net, by the sum over the ``(n+1)²`` control points of each parameter's
-        cell, ``Σ_r Σ_s D^du b_r(u) D^dv b_s(v) p_rs``.
+        cell, ``Σ_r Σ_s D^du b_r(u) D^dv b_s(v) p_rs``. With :attr:`net_weights`, in
+        homogeneous coordinates and the quotient rule (:mod:`splinedeform.rational`).
         """
+        if self.net_weights is not None:
+            return rational.derivative(self, u, v, du, dv, control_points)
         Q = None
         own = control_points is None and _order(du) and _order(dv)
         one = type(u) in _SCALARS and type(v) in _SCALARS
@@ -238,7 +268,10 @@ class Surface:
         Two sparse products ``X_c = B_u P_c B_vᵀ`` for all coordinates ``c`` at once, with
         the collocation matrices ``B_u``, ``B_v`` of the two bases (one evaluation where
         both directions share a basis and an order); result ``(len(u), len(v), c)``.
+        With :attr:`net_weights`, the same on the homogeneous net and the quotient rule.
         """
+        if self.net_weights is not None:
+            return rational.evaluate_grid(self, u, v, du, dv, control_points)
         P = self.control_points if control_points is None else np.asarray(control_points, float)
         u = np.atleast_1d(np.asarray(u, dtype=float)).ravel()
         v = np.atleast_1d(np.asarray(v, dtype=float)).ravel()

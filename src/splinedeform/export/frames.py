@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
+from ..rational import grid_nets
 from ..surface import Surface, grid_faces
 
 # -- validation of frames ----------------------------------------------------------
@@ -58,9 +59,10 @@ def tessellate_frames(surface: Surface, nets: ArrayLike, resolution: int = 32
     """Meshes of many control nets on one parameter grid, without re-assembly per frame.
 
     ``X_f = B_u P_f B_vᵀ`` per coordinate with ``(B_u)_ik = b_k(u_i)``, ``(B_v)_jl = b_l(v_j)``
-    built once. ``nets`` has shape ``(..., n_u, n_v, 3)``; returns vertices
-    ``(..., r_u r_v, 3)`` (row-major grid, as :meth:`Surface.tessellate`) and faces. A
-    trimmed surface gives the grid clipped to its trim loops instead
+    built once (:func:`splinedeform.rational.grid_nets`, general weights included).
+    ``nets`` has shape ``(..., n_u, n_v, 3)``; returns vertices ``(..., r_u r_v, 3)``
+    (row-major grid, as :meth:`Surface.tessellate`) and faces. A trimmed surface gives
+    the grid clipped to its trim loops instead
     (:func:`splinedeform.trim.tessellate.clipped_grid`): the vertices inside and those
     on the loops, ``X_f = E P_f`` with the sparse ``E_{q,(k,l)} = b_k(u_q) b_l(v_q)``.
     """
@@ -69,12 +71,10 @@ def tessellate_frames(surface: Surface, nets: ArrayLike, resolution: int = 32
     u, v = surface.sample_parameters(int(resolution))
     if surface.trim is not None:
         return _clipped_frames(surface, nets, u, v)
-    Bu = surface.basis_u.matrix(u).toarray()
-    Bv = surface.basis_v.matrix(v).toarray()
     P = np.asarray(nets, dtype=float)
     if P.shape[-3:] != (*surface.shape, 3):
         raise InputError(f"control nets must end in shape {(*surface.shape, 3)}, got {P.shape}")
-    X = np.einsum("ik,...klc,jl->...ijc", Bu, P, Bv, optimize=True)
+    X = grid_nets(surface, u, v, P)
     return X.reshape(*P.shape[:-3], u.size * v.size, 3), grid_faces(u.size, v.size)
 
 

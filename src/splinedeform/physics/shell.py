@@ -28,6 +28,7 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from ..rational import refuse
 from ..surface import Surface
 from . import metric
 from .shell_assembly import Pattern, assemble_cells
@@ -118,6 +119,7 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
     knot line the cells hold nothing: :class:`~.shell_model.ShellModel` adds its rotation
     penalty (:mod:`.coupling_model`).
     """
+    refuse(surface, "the Kirchhoff–Love shell")
     if min(surface.basis_u.degree, surface.basis_v.degree) < 2:
         raise InputError("the Kirchhoff–Love shell needs degree >= 2 in u and v (curvatures)")
     G = metric.grid(surface, extra_points=1)
