@@ -75,6 +75,12 @@ def solve_group(cases: list[Case], folder: str, case_outputs: bool = False
     return [rows[case.hash] for case in cases]
 
 
+def solve_groups(groups: list[list[Case]], folder: str, case_outputs: bool = False
+                 ) -> list[dict[str, Any]]:
+    """:func:`solve_group` for each of several groups (one task for models of few cases)."""
+    return [row for group in groups for row in solve_group(group, folder, case_outputs)]
+
+
 def _build(case: Case) -> tuple[Built | None, str | None]:
     """The model of a group, or the message of the error that stopped its build."""
     try:
