@@ -132,23 +132,43 @@ class Model:
         top = lambda b: min(2, b.degree)  # noqa: E731
         self.gram_u = [gram_matrix(surface.basis_u, a) for a in range(top(surface.basis_u) + 1)]
         self.gram_v = [gram_matrix(surface.basis_v, a) for a in range(top(surface.basis_v) + 1)]
-        if physics == "intrinsic":
-            K, M = intrinsic.matrices(surface, material, mass_matrix == "lumped")
-        else:
-            K, M = full_matrices(self.gram_u, self.gram_v, material, mass_matrix == "lumped")
-        T = self.constraints.T
-        self.K_full, self.M_full = K, M
+        lumped = mass_matrix == "lumped"
+        # K and M on the whole net: assembled here only where the constrained matrices are
+        # made from them, else when first asked for (K_full, M_full)
+        self._full: tuple[sp.csr_matrix, sp.csr_matrix] | None = (
+            intrinsic.matrices(surface, material, lumped) if physics == "intrinsic" else None)
         reduced = None if physics == "intrinsic" else reduced_matrices(
-            self.gram_u, self.gram_v, material, mass_matrix == "lumped", M, self.constraints)
-        self._K, self._M = reduced or ((T.T @ K @ T).tocsc(), (T.T @ M @ T).tocsc())
+            self.gram_u, self.gram_v, material, lumped, self.constraints)
+        if reduced is None:
+            T = self.constraints.T
+            K, M = self._full_matrices()
+            self._K, self._M = (T.T @ K @ T).tocsc(), (T.T @ M @ T).tocsc()
+            self._C = ((material.damping / material.mass) * self._M
+                       + material.rayleigh * self._K).tocsc()
+        else:
+            self._K, self._M, self._C = reduced
         if self._M.nnz:
             check_scales(material, _largest(self._K), _largest(self._M))
-        self._C = ((material.damping / material.mass) * self._M
-                   + material.rayleigh * self._K).tocsc()
         self._eigen: tuple[Array, Array] | None = None
         self._bases: dict[tuple, modal_basis.ModalBasis] = {}
         self._rigid: tuple[int | None] | None = None
         self.timings: dict[str, float] = {"assembly": time.perf_counter() - start}
+
+    def _full_matrices(self) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        if self._full is None:
+            self._full = full_matrices(self.gram_u, self.gram_v, self.material,
+                                       self.mass_matrix == "lumped")
+        return self._full
+
+    @property
+    def K_full(self) -> sp.csr_matrix:
+        """Stiffness ``K`` of the whole net, before constraints (assembled when first used)."""
+        return self._full_matrices()[0]
+
+    @property
+    def M_full(self) -> sp.csr_matrix:
+        """Mass ``M`` of the whole net, before constraints (assembled when first used)."""
+        return self._full_matrices()[1]
 
     # -- layout --------------------------------------------------------------------
     @property
