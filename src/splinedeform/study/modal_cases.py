@@ -32,6 +32,7 @@ from ..budget import check as check_budget
 from ..load_scale import load_scale
 from ..loads import Harmonic, Profile, as_load
 from ..modal_solve import _bound_applies
+from ..model import Model
 from ..pipeline import _domain_centre
 from ..scenario import Built, Scenario, build_load
 from ..scenario.build import _located, check_parameters
@@ -60,9 +61,9 @@ def prepare(scenario: Scenario, built: Built, case_outputs: bool) -> Prepared | 
     """The case's frame times and load parts when the modal read-out applies, else None
     (also when building its load fails: the ordinary path then reports the error)."""
     solve, model = scenario.solve, built.model
-    if solve.kind != "dynamic" or solve.method != "analytic" or \
-            (case_outputs and scenario.output.formats):
-        return None
+    if not isinstance(model, Model) or solve.kind != "dynamic" or \
+            solve.method != "analytic" or (case_outputs and scenario.output.formats):
+        return None                        # (a shell's modes move x, y and z together)
     try:
         if load_scale(scenario) != 1.0:
             return None
@@ -73,8 +74,8 @@ def prepare(scenario: Scenario, built: Built, case_outputs: bool) -> Prepared | 
         terms = ReducedForcing(model.reduction, load).fixed_terms()
     except Exception:  # noqa: BLE001  (the ordinary path reports it with its key)
         return None
-    if terms is None or not all(p.jumps() is not None or isinstance(p, Harmonic)
-                                for p, _ in terms[1]):
+    if terms is None or not all((p.jumps() is not None or isinstance(p, Harmonic)) and
+                                np.shape(f) == (model.n_free, 3) for p, f in terms[1]):
         return None
     zero = np.zeros((model.n_free, 3))
     harmonics = [p for p, _ in terms[1] if p.jumps() is None]
