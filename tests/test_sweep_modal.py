@@ -72,3 +72,19 @@ def test_modal_read_out_equals_the_pipeline_for_every_case(tmp_path):
     # the harmonic load moves x too: the probes' x differ from 0 in every case
     assert all(abs(row["p1_x"]) > 0 for row in rows)
     assert np.isfinite([row["total_energy_end"] for row in rows]).all()
+
+
+def test_models_of_few_cases_travel_several_to_a_task_in_design_order(tmp_path):
+    from splinedeform.study.run import TASKS_PER_WORKER, tasks
+
+    text = 'scenario = "base.toml"\n[[axis]]\nkey = "material.w10"\nrange = [1.0, 4.0]\n' \
+           'count = 50\n'
+    groups = [[c] for c in plan_cases(load_sweep(write(tmp_path, text)))]
+    packed = tasks(groups, workers=2)
+    size = -(-50 // (TASKS_PER_WORKER * 2))       # ⌈50 / 16⌉ = 4 cases a task
+    assert [len(task) for task in packed] == [size] * (50 // size) + [50 % size]
+    assert [g[0].index for task in packed for g in task] == list(range(1, 51))
+    # a model of many cases is a task of its own, the singles around it packed
+    big = [case for g in groups[:20] for case in g]
+    assert [len(t) for t in tasks([big] + groups[20:], workers=2)] == \
+        [1] + [size] * 7 + [30 - 7 * size]
