@@ -35,7 +35,7 @@ from . import metric
 from .coupling_model import c0_coupling
 from ..body.body import Body
 from .shell import ShellMaterial, matrices
-from .shell_body import body_field, body_system
+from .shell_body import body_field, body_system, free_coordinates, patch_index
 from .shell_edges import EDGES, KINDS, check_edges, constraint_matrix  # noqa: F401
 from .shell_rigid import describe, free_rigid_motions
 from .shell_solve import dissection_ranks, static_displacement, unknown_order
@@ -290,38 +290,18 @@ class ShellModel:
 
     def patch_index(self, patch: int | None) -> int:
         """``patch`` checked as an index of a body's patches."""
-        n = len(self.patches or ())
-        if isinstance(patch, bool) or not isinstance(patch, (int, np.integer)) \
-                or not 0 <= patch < n:
-            raise InputError(f"a shell body's read-out needs its patch: an index in "
-                             f"[0, {n - 1}], got {patch!r}")
-        return int(patch)
+        return patch_index(len(self.patches or ()), patch)
 
     def _to_free(self, net: ArrayLike | None, what: str) -> Array:
         if net is None:
             return np.zeros(self.n_free)
-        shapes = [self.surface.shape] if self.patches is None else [s.shape for s in self.patches]
-        parts = [net] if self.patches is None else net
-        if self.patches is not None and (not isinstance(net, (list, tuple))
-                                         or len(net) != len(shapes)):
-            raise InputError(f"{what} of a shell body is a list of {len(shapes)} nets, one "
-                             "per patch")
-        rows = []
-        for p, (part, shape) in enumerate(zip(parts, shapes)):
-            arr = np.asarray(part, dtype=float)
-            name = what if self.patches is None else f"{what}[{p}]"
-            if arr.shape != shape + (3,):
-                raise InputError(f"{name} must have shape (n_u, n_v, 3) = {shape + (3,)}, "
-                                 f"got {arr.shape}")
-            if not np.all(np.isfinite(arr)):
-                raise InputError(f"{name} must be finite")
-            rows.append(arr.ravel())
-        flat = np.concatenate(rows)
-        free = spla.spsolve((self.T.T @ self.T).tocsc(), self.T.T @ flat)
-        if np.linalg.norm(self.T @ free - flat) > 1e-9 * max(np.linalg.norm(flat), 1e-300):
-            raise InputError(f"{what} moves displacement components that the boundary "
-                             "conditions fix or tie")
-        return np.asarray(free)
+        if self.patches is None:
+            return free_coordinates(self.T, [self.surface.shape], [net], [what])
+        if not isinstance(net, (list, tuple)) or len(net) != len(self.patches):
+            raise InputError(f"{what} of a shell body is a list of {len(self.patches)} nets, "
+                             "one per patch")
+        return free_coordinates(self.T, [s.shape for s in self.patches], net,
+                                [f"{what}[{p}]" for p in range(len(net))])
 
     @owned
     def dynamic(self, load: Load | None, t_end: float, method: str = "analytic",

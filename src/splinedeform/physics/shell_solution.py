@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
+from ..readout import BodyReadout
 from ..solution import Energy, Solution, _check_times
 from ..surface import Surface
 
@@ -94,7 +95,11 @@ class ShellModalSolution(Solution):
     def __init__(self, model: Any, t_end: float, force_free: Callable[[float], Array],
                  timings: dict[str, float], basis: Any, response: Any, truncation: dict,
                  correction: Callable[[Array], Array] | None = None):
-        super().__init__(model, "analytic", t_end, force_free, timings)   # reads .surface
+        # a single shell reads out like a surface (.surface); a body like BodyModel's, on
+        # the per-patch nets of ``_full`` below
+        readout = model if model.patches is None else BodyReadout(
+            model.patches, model.T, *model.matrices()[::2])
+        super().__init__(readout, "analytic", t_end, force_free, timings)
         self.model = model
         self.basis = basis
         self.response = response
