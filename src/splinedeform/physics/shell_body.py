@@ -35,6 +35,7 @@ from ..body.body import Body
 from ..body.constraints import boundary_presets, edge_rows
 from ..body.interface import EDGES
 from ..body.model import BodyReduction
+from ..body.model import _refuse as refuse
 from ..errors import InputError
 from ..surface import Surface
 from .coupling_model import c0_coupling, interface_coupling
@@ -80,16 +81,7 @@ def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
     if not isinstance(body, Body):
         body = Body(body)
     topology = body.topology
-    if topology.non_manifold:
-        group = topology.non_manifold[0]
-        raise InputError("non-manifold edge: " + ", ".join(f"patch {p} edge {e}"
-                                                          for p, e in group)
-                         + " meet on one curve; a body's edge joins at most two patch edges")
-    for i, aligned in zip(topology.interfaces, topology.aligned):
-        if not aligned:
-            raise InputError(f"interface between patch {i.a} edge {i.edge_a} and patch {i.b} "
-                             f"edge {i.edge_b}: their parametrisations along the curve are not "
-                             "an affine map of each other; reparametrise one of the two")
+    refuse(topology)
     presets = boundary_presets(boundary, topology, BODY_KINDS)
     patches = body.patches
     sizes = np.array([s.shape[0] * s.shape[1] for s in patches])
