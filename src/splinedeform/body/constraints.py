@@ -74,13 +74,15 @@ class BodyConstraints:
         return all(preset == "free" for preset in self.edges.values())
 
 
-def boundary_presets(boundary: str | Mapping[Edge, str], topology: Topology
-                     ) -> dict[Edge, str]:
-    """``"clamped"`` for every boundary edge, or ``{(patch, edge): preset}`` (missing: free)."""
+def boundary_presets(boundary: str | Mapping[Edge, str], topology: Topology,
+                     kinds: Sequence[str] = BODY_PRESETS) -> dict[Edge, str]:
+    """``"clamped"`` for every boundary edge, or ``{(patch, edge): preset}`` (missing: free).
+
+    ``kinds`` are the names a preset may take (the shell's edge kinds for a shell body)."""
     edges = list(topology.boundary)
     if isinstance(boundary, str):
-        if boundary not in BODY_PRESETS:
-            raise InputError(f"boundary preset must be one of {BODY_PRESETS}, got {boundary!r}")
+        if boundary not in kinds:
+            raise InputError(f"boundary preset must be one of {tuple(kinds)}, got {boundary!r}")
         return {edge: boundary for edge in edges}
     if not isinstance(boundary, Mapping):
         raise InputError(f"a body's boundary is a preset name or a mapping (patch, edge) -> "
@@ -89,8 +91,8 @@ def boundary_presets(boundary: str | Mapping[Edge, str], topology: Topology
     joined = {(i.a, i.edge_a): (i.b, i.edge_b) for i in topology.interfaces}
     joined.update({(i.b, i.edge_b): (i.a, i.edge_a) for i in topology.interfaces})
     for key, preset in boundary.items():
-        if preset not in BODY_PRESETS:
-            raise InputError(f"boundary[{key!r}] must be one of {BODY_PRESETS}, got {preset!r}")
+        if preset not in kinds:
+            raise InputError(f"boundary[{key!r}] must be one of {tuple(kinds)}, got {preset!r}")
         if key in joined:
             other = joined[key]
             raise InputError(f"boundary[{key!r}]: edge {key[1]} of patch {key[0]} is an "

@@ -16,11 +16,12 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Mapping
+from typing import Mapping, Sequence
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from scipy.sparse.csgraph import reverse_cuthill_mckee
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError, SingularSystemError
@@ -32,7 +33,9 @@ from ..surface import Surface
 from ..threads import owned
 from . import metric
 from .coupling_model import c0_coupling
+from ..body.body import Body
 from .shell import ShellMaterial, matrices
+from .shell_body import body_field, body_system, free_coordinates, patch_index
 from .shell_edges import EDGES, KINDS, check_edges, constraint_matrix  # noqa: F401
 from .shell_rigid import describe, free_rigid_motions
 from .shell_solve import dissection_ranks, static_displacement, unknown_order
@@ -68,42 +71,78 @@ class ShellModel:
 
     Parameters
     ----------
-    surface : Surface
+    surface : Surface, or Body (or list of Surface)
+        One patch, or a body of patches deformed as one shell (:mod:`.shell_body`:
+        conforming interfaces merged, non-conforming ones and every interface's rotation
+        coupled by penalties).
     material : ShellMaterial
     boundary : mapping edge -> kind, optional
-        See the module docstring; missing edges are free.
+        See the module docstring; missing edges are free. For a body one kind for every
+        boundary edge, or ``{(patch, edge): kind}``.
     fixed : bool array ``(n_u, n_v, 3)`` or ``(n_u, n_v)``, optional
-        Individual displacement components (or whole control points) that do not move.
+        Individual displacement components (or whole control points) that do not move
+        (a single surface only).
     """
 
     @owned
-    def __init__(self, surface: Surface, material: ShellMaterial,
-                 boundary: Mapping[str, str] | None = None, fixed: ArrayLike | None = None):
+    def __init__(self, surface: Surface | Body | Sequence[Surface], material: ShellMaterial,
+                 boundary: Mapping | str | None = None, fixed: ArrayLike | None = None):
         start = time.perf_counter()
         if not isinstance(material, ShellMaterial):
             raise InputError("a shell needs a ShellMaterial(E, nu, thickness, density)")
-        if getattr(surface, "trim", None) is not None:
-            raise InputError("the shell is not trimmed yet: a trimmed surface takes the "
-                             "parametric Model (docs/trim.md)")
-        self.surface, self.material = surface, material
-        self.physics = "shell"
-        self.K_full, self.M_full = matrices(surface, material)
-        self.edges = check_edges(surface, dict(boundary or {}))
-        kinks = c0_coupling(surface, material, self.edges)
-        if kinks is not None:                  # the crease kept across each C0 line
-            self.K_full = (self.K_full + kinks).tocsr()
-        self.T = constraint_matrix(surface, self.edges, fixed)
+        self.material, self.physics = material, "shell"
+        if isinstance(surface, (Body, list, tuple)):
+            if fixed is not None:
+                raise InputError("a shell body is held by its boundary edges; fixed "
+                                 "components are for a single surface")
+            system = body_system(surface, material, "free" if boundary is None else boundary)
+            self.body = surface if isinstance(surface, Body) else Body(surface)
+            self.patches: tuple[Surface, ...] | None = self.body.patches
+            self.surface, self.offsets = None, system.offsets
+            self.K_full, self.M_full, self.T, self.edges = (system.K, system.M, system.T,
+                                                            system.edges)
+            points = np.concatenate([s.control_points.reshape(-1, 3) for s in self.patches])
+        else:
+            if getattr(surface, "trim", None) is not None:
+                raise InputError("the shell is not trimmed yet: a trimmed surface takes the "
+                                 "parametric Model (docs/trim.md)")
+            if isinstance(boundary, str):
+                raise InputError("a single surface's shell boundary is a mapping edge -> "
+                                 f"kind, got {boundary!r}")
+            self.surface, self.patches = surface, None
+            self.K_full, self.M_full = matrices(surface, material)
+            self.edges = check_edges(surface, dict(boundary or {}))
+            kinks = c0_coupling(surface, material, self.edges)
+            if kinks is not None:                  # the crease kept across each C0 line
+                self.K_full = (self.K_full + kinks).tocsr()
+            self.T = constraint_matrix(surface, self.edges, fixed)
+            points = surface.control_points
         self._K = (self.T.T @ self.K_full @ self.T).tocsc()
         self._M = (self.T.T @ self.M_full @ self.T).tocsc()
         self._C = (material.damping / (material.density * material.thickness) * self._M
                    + material.rayleigh * self._K).tocsc()
-        motions = free_rigid_motions(self.T, surface.control_points)
+        motions = free_rigid_motions(self.T, points)
         self.rigid = motions.reduced
         #: words for a basis of the free rigid motions (rotation axes, translations)
         self.rigid_motions = describe(motions.twists,
-                                      float(np.ptp(surface.control_points.reshape(-1, 3),
-                                                   axis=0).max()))
+                                      float(np.ptp(points.reshape(-1, 3), axis=0).max()))
         self.timings = {"assembly": time.perf_counter() - start}
+
+    def _field(self, term: Load, t: float = 0.0) -> Array:
+        """Full force of one load term (or a whole load) over the interleaved unknowns."""
+        if self.patches is None:
+            return np.asarray(term.field_vector(self.surface, t)).ravel()
+        return body_field(self.patches, term, t)
+
+    def nets(self, d_free: Array) -> list[Array] | Array:
+        """Displacement nets ``T d_free`` of ``d_free (..., n_free)``: ``(..., n_u, n_v, 3)``,
+        for a body a list of them, one per patch."""
+        lead = d_free.shape[:-1]
+        full = np.asarray(self.T @ d_free.reshape(-1, d_free.shape[-1]).T).T
+        if self.patches is None:
+            return full.reshape(lead + self.surface.shape + (3,))
+        parts = np.split(full, 3 * self.offsets[1:-1], axis=-1)
+        return [part.reshape(lead + s.shape + (3,)) for part, s in zip(parts, self.patches)]
 
     @property
     def n_free(self) -> int:
@@ -119,7 +158,11 @@ class ShellModel:
 
     def load_vector(self, load: Load | None, t: float = 0.0) -> Array:
         """Reduced generalised force ``Tᵀ F(t)`` over the interleaved unknowns."""
-        return np.asarray(self.T.T @ as_load(load).vector(self.surface, t).ravel())
+        load = as_load(load)
+        if self.patches is None:
+            return np.asarray(self.T.T @ load.vector(self.surface, t).ravel())
+        return np.asarray(self.T.T @ sum((term.profile(t) * self._field(term, t)
+                                          for term in load.terms()), np.zeros(self.T.shape[0])))
 
     @owned
     def static(self, load: Load | None, t: float | None = None) -> ShellStaticSolution:
@@ -150,6 +193,9 @@ class ShellModel:
 
     def unknown_order(self) -> NDArray[np.int64]:
         """The reduced unknowns in nested dissection order of their control points."""
+        if getattr(self, "_order", None) is None and self.patches is not None:
+            self._order = np.asarray(reverse_cuthill_mckee(self._K, symmetric_mode=True),
+                                     dtype=np.int64)
         if getattr(self, "_order", None) is None:
             bu, bv = self.surface.basis_u, self.surface.basis_v
             rank = dissection_ranks(bu.size, bv.size, (bu.degree, bv.degree),
@@ -226,34 +272,36 @@ class ShellModel:
     def modes(self, k: int = 6, check_spectrum: bool = True) -> tuple[Array, Array]:
         """Lowest ``k`` frequencies and mode shapes as control net displacements ``(k, n_u, n_v, 3)``."""
         lam, phi = self.eigen(k, check_spectrum)
-        shapes = np.asarray(self.T @ phi).T.reshape((phi.shape[1],) + self.surface.shape + (3,))
-        return np.sqrt(lam), shapes
+        return np.sqrt(lam), self.nets(np.asarray(phi).T)
 
     def stresses(self, displacement: ArrayLike, u: ArrayLike, v: ArrayLike,
-                 at_poles: str = "raise") -> ShellStresses:
+                 at_poles: str = "raise", patch: int | None = None) -> ShellStresses:
         """Stresses of a displacement net ``(n_u, n_v, 3)`` (a solution's, a mode's) at ``u, v``.
 
         See :func:`.shell_stress.stresses`: ``N``, ``M`` in the local frame, ``σ`` at top,
         middle and bottom, principal and von Mises stresses, normal displacement;
-        ``at_poles="nan"`` gives NaN at degenerate points instead of refusing them.
+        ``at_poles="nan"`` gives NaN at degenerate points instead of refusing them. On a
+        body, ``displacement`` is the list of nets and ``patch`` says where ``u, v`` lie.
         """
-        return stresses(self.surface, self.material, displacement, u, v, at_poles)
+        if self.patches is None:
+            return stresses(self.surface, self.material, displacement, u, v, at_poles)
+        p = self.patch_index(patch)
+        return stresses(self.patches[p], self.material, displacement[p], u, v, at_poles)
+
+    def patch_index(self, patch: int | None) -> int:
+        """``patch`` checked as an index of a body's patches."""
+        return patch_index(len(self.patches or ()), patch)
 
     def _to_free(self, net: ArrayLike | None, what: str) -> Array:
         if net is None:
             return np.zeros(self.n_free)
-        arr = np.asarray(net, dtype=float)
-        if arr.shape != self.surface.shape + (3,):
-            raise InputError(f"{what} must have shape (n_u, n_v, 3) = "
-                             f"{self.surface.shape + (3,)}, got {arr.shape}")
-        if not np.all(np.isfinite(arr)):
-            raise InputError(f"{what} must be finite")
-        flat = arr.ravel()
-        free = spla.spsolve((self.T.T @ self.T).tocsc(), self.T.T @ flat)
-        if np.linalg.norm(self.T @ free - flat) > 1e-9 * max(np.linalg.norm(flat), 1e-300):
-            raise InputError(f"{what} moves displacement components that the boundary "
-                             "conditions fix or tie")
-        return np.asarray(free)
+        if self.patches is None:
+            return free_coordinates(self.T, [self.surface.shape], [net], [what])
+        if not isinstance(net, (list, tuple)) or len(net) != len(self.patches):
+            raise InputError(f"{what} of a shell body is a list of {len(self.patches)} nets, "
+                             "one per patch")
+        return free_coordinates(self.T, [s.shape for s in self.patches], net,
+                                [f"{what}[{p}]" for p in range(len(net))])
 
     @owned
     def dynamic(self, load: Load | None, t_end: float, method: str = "analytic",
@@ -327,7 +375,7 @@ class ShellModel:
             if term.time_dependent_field:
                 raise InputError("the shell's dynamic solve takes loads whose spatial field "
                                  "does not change with time")
-            F = np.asarray(self.T.T @ term.field_vector(self.surface).ravel())
+            F = np.asarray(self.T.T @ self._field(term))
             if isinstance(term.profile, Harmonic):
                 harmonics.append((term.profile.omega, term.profile.phase, F))
                 continue

@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
+from ..readout import BodyReadout
 from ..solution import Energy, Solution, _check_times
 from ..surface import Surface
 
@@ -25,16 +26,21 @@ if TYPE_CHECKING:
 Array = NDArray[np.float64]
 
 
-def _full(model: ShellModel, d_free: Array) -> Array:
-    """``p_rest + T d_free`` for ``d_free`` of shape ``(..., n_free)`` → ``(..., n_u, n_v, 3)``."""
-    lead = d_free.shape[:-1]
-    flat = d_free.reshape(-1, d_free.shape[-1]).T
-    full = np.asarray(model.T @ flat).T.reshape(lead + model.surface.shape + (3,))
-    return model.surface.control_points + full
+def _full(model: ShellModel, d_free: Array) -> Array | list[Array]:
+    """``p_rest + T d_free`` for ``d_free`` of shape ``(..., n_free)`` → ``(..., n_u, n_v, 3)``
+    (a body's: a list, one per patch)."""
+    nets = model.nets(d_free)
+    if model.patches is None:
+        return model.surface.control_points + nets
+    return [s.control_points + n for s, n in zip(model.patches, nets)]
 
 
 class ShellStaticSolution:
-    """Equilibrium ``K_r d = Tᵀ F`` of a shell (see :meth:`ShellModel.static`)."""
+    """Equilibrium ``K_r d = Tᵀ F`` of a shell (see :meth:`ShellModel.static`).
+
+    On a body every net and surface is a list, one per patch, and a read-out at ``(u, v)``
+    names its ``patch``.
+    """
 
     def __init__(self, model: ShellModel, d_free: Array, force_free: Array,
                  timings: dict[str, float]):
@@ -43,25 +49,32 @@ class ShellStaticSolution:
         self.force_free = force_free
         self.timings = timings
 
-    def control_points(self) -> Array:
+    def control_points(self) -> Array | list[Array]:
         """Deformed control net ``(n_u, n_v, 3)``."""
         return _full(self.model, self.d_free)
 
-    def net_displacement(self) -> Array:
+    def net_displacement(self) -> Array | list[Array]:
         """Displacement of the control points ``(n_u, n_v, 3)``."""
-        return self.control_points() - self.model.surface.control_points
+        return self.model.nets(self.d_free)
 
-    def surface(self) -> Surface:
+    def surface(self) -> Surface | list[Surface]:
         """The deformed surface."""
-        return self.model.surface.with_control_points(self.control_points(), name="static")
+        if self.model.patches is None:
+            return self.model.surface.with_control_points(self.control_points(), name="static")
+        return [s.with_control_points(p, name="static")
+                for s, p in zip(self.model.patches, self.control_points())]
 
-    def displacement(self, u: ArrayLike, v: ArrayLike) -> Array:
+    def displacement(self, u: ArrayLike, v: ArrayLike, patch: int | None = None) -> Array:
         """Displacement ``d(u, v)`` of surface points, shape ``S + (3,)``."""
-        return self.model.surface.derivative(u, v, control_points=self.net_displacement())
+        if self.model.patches is None:
+            return self.model.surface.derivative(u, v, control_points=self.net_displacement())
+        p = self.model.patch_index(patch)
+        return self.model.patches[p].derivative(u, v,
+                                                control_points=self.net_displacement()[p])
 
-    def stresses(self, u: ArrayLike, v: ArrayLike) -> ShellStresses:
+    def stresses(self, u: ArrayLike, v: ArrayLike, patch: int | None = None) -> ShellStresses:
         """Resultants ``N, M``, stresses and von Mises at ``(u, v)`` (:mod:`.shell_stress`)."""
-        return self.model.stresses(self.net_displacement(), u, v)
+        return self.model.stresses(self.net_displacement(), u, v, patch=patch)
 
     def energy(self) -> Energy:
         """Strain ``½ dᵀ K_r d``, load work ``Fᵀ d`` (total ``−½ Fᵀ d`` at equilibrium)."""
@@ -82,7 +95,11 @@ class ShellModalSolution(Solution):
     def __init__(self, model: Any, t_end: float, force_free: Callable[[float], Array],
                  timings: dict[str, float], basis: Any, response: Any, truncation: dict,
                  correction: Callable[[Array], Array] | None = None):
-        super().__init__(model, "analytic", t_end, force_free, timings)   # reads .surface
+        # a single shell reads out like a surface (.surface); a body like BodyModel's, on
+        # the per-patch nets of ``_full`` below
+        readout = model if model.patches is None else BodyReadout(
+            model.patches, model.T, *model.matrices()[::2])
+        super().__init__(readout, "analytic", t_end, force_free, timings)
         self.model = model
         self.basis = basis
         self.response = response
@@ -101,18 +118,23 @@ class ShellModalSolution(Solution):
             d = d + self.correction(times)[..., 0]
         return d, self.basis.expand(V)[..., 0]
 
-    def stresses(self, t: float, u: ArrayLike, v: ArrayLike) -> ShellStresses:
-        """Resultants, stresses and von Mises at time ``t`` (a number) and ``(u, v)``."""
+    def stresses(self, t: float, u: ArrayLike, v: ArrayLike, patch: int | None = None
+                 ) -> ShellStresses:
+        """Resultants, stresses and von Mises at time ``t`` (a number) and ``(u, v)`` (of
+        ``patch`` on a body)."""
         times, scalar = _check_times(t)
         if not scalar:
             raise InputError(f"stresses are read at one time at a time, got {times.size} times")
-        net = self._full(self.state(times)[0])[0] - self.model.surface.control_points
-        return self.model.stresses(net, u, v)
+        net = self.model.nets(self.state(times)[0])
+        net = net[0] if self.model.patches is None else [n[0] for n in net]
+        return self.model.stresses(net, u, v, patch=patch)
 
     def velocities(self, t: ArrayLike) -> Array:
         """Control point velocities, same shapes as :meth:`control_points`."""
         times, scalar = _check_times(t)
-        vel = self._full(self.state(times)[1]) - self.model.surface.control_points
+        vel = self.model.nets(self.state(times)[1])
+        if self.model.patches is not None:
+            return [n[0] for n in vel] if scalar else vel
         return vel[0] if scalar else vel
 
     def energy(self, t: ArrayLike) -> Energy:
