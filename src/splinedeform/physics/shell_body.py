@@ -116,9 +116,13 @@ def merge_columns(Tb: sp.csr_matrix, pairs: NDArray[np.int64]) -> sp.csr_matrix:
     """``S`` (columns of ``Tb`` → classes) with ``(Tb S)[r_a] = (Tb S)[r_b]`` for each pair.
 
     A pair of unit rows joins their columns; a zero row holds the other's column (its class
-    is dropped). A row of ``Tb`` that combines several columns cannot be merged: refused.
+    is dropped). A pair whose two rows are already equal asks nothing (the two control
+    points of one pole, where a seam meets it, move as that one point). A row of ``Tb``
+    that combines several columns otherwise cannot be merged: refused.
     """
     n = Tb.shape[1]
+    apart = abs(Tb[pairs[:, 0]] - Tb[pairs[:, 1]]).max(axis=1).toarray().ravel()
+    pairs = pairs[apart > 1e-14]             # T_b's entries are 0, 1 or O(1) null vectors
     count = Tb.getnnz(axis=1)
     first = np.zeros(Tb.shape[0], dtype=np.int64)
     first[count > 0] = Tb.indices[Tb.indptr[:-1][count > 0]]
