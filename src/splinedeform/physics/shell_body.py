@@ -16,8 +16,10 @@ identifies. A merged pair of dofs ``(r_a, r_b)`` (the same component of the ``k`
 points of the two edges) asks ``d_{r_a} = d_{r_b}``: where both rows of ``T_b`` are unit rows
 ``e_{j_a}``, ``e_{j_b}`` this is ``x_{j_a} = x_{j_b}`` (the columns are joined into one
 class, the classes being the connected components of that graph); where one row is zero
-(the component is held) the other's column is held too. So merged control points share all
-three displacements exactly.
+(the component is held) the other's column is held too. Where a row combines several
+columns (the points of a pole, tied to one point by a null-space basis of ``T_p``) the pair
+is imposed instead, ``T = T_b S N`` with ``range N = null((T_b S)[r_a] − (T_b S)[r_b])``.
+So merged control points share all three displacements exactly.
 """
 
 from __future__ import annotations
@@ -41,6 +43,7 @@ from ..surface import Surface
 from .coupling_model import c0_coupling, interface_coupling
 from .shell import ShellMaterial, matrices
 from .shell_edges import KINDS, check_edges, constraint_matrix
+from .shell_edges import _impose as impose
 
 Array = NDArray[np.float64]
 BODY_KINDS = tuple(k for k in KINDS if k != "pole")
@@ -105,24 +108,30 @@ def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
         rb = offsets[i.b] + edge_rows(patches[i.b], i.edge_b)
         points = np.stack([ra, rb[::-1] if i.reversed else rb], axis=1)
         pairs.append((3 * points[:, None, :] + np.arange(3)[None, :, None]).reshape(-1, 2))
-    T = (Tb @ merge_columns(Tb, np.concatenate(pairs))).tocsr()
+    pairs = np.concatenate(pairs)
+    S, rest = merge_columns(Tb, pairs)
+    T = (Tb @ S).tocsr()
+    if len(rest):                     # rows combining columns (poles): d_ra = d_rb imposed
+        T = impose(T, T[rest[:, 0]] - T[rest[:, 1]])
     if T.shape[1] == 0:
         raise InputError("no free displacement: the boundary holds every control point of "
                          f"the {len(patches)} patches")
     return ShellBodySystem(K, M, T, presets, offsets)
 
 
-def merge_columns(Tb: sp.csr_matrix, pairs: NDArray[np.int64]) -> sp.csr_matrix:
-    """``S`` (columns of ``Tb`` → classes) with ``(Tb S)[r_a] = (Tb S)[r_b]`` for each pair.
+def merge_columns(Tb: sp.csr_matrix, pairs: NDArray[np.int64]
+                  ) -> tuple[sp.csr_matrix, NDArray[np.int64]]:
+    """``S`` (columns of ``Tb`` → classes) with ``(Tb S)[r_a] = (Tb S)[r_b]`` for each pair
+    of unit or zero rows, and the other pairs.
 
     A pair of unit rows joins their columns; a zero row holds the other's column (its class
-    is dropped). A pair whose two rows are already equal asks nothing (the two control
-    points of one pole, where a seam meets it, move as that one point). A row of ``Tb``
-    that combines several columns otherwise cannot be merged: refused.
+    is dropped). A row of ``Tb`` that combines several columns (a pole's points, tied to
+    one point by a null-space basis; a plane not along an axis) cannot be merged: its pairs
+    are returned, for ``(Tb S)[r_a] − (Tb S)[r_b] = 0`` to be imposed on the reduced
+    coordinates (:func:`.shell_edges._impose`; a pair of equal rows, the two ends of a
+    seam at a pole, asks nothing).
     """
     n = Tb.shape[1]
-    apart = abs(Tb[pairs[:, 0]] - Tb[pairs[:, 1]]).max(axis=1).toarray().ravel()
-    pairs = pairs[apart > 1e-14]             # T_b's entries are 0, 1 or O(1) null vectors
     count = Tb.getnnz(axis=1)
     first = np.zeros(Tb.shape[0], dtype=np.int64)
     first[count > 0] = Tb.indices[Tb.indptr[:-1][count > 0]]
@@ -131,12 +140,10 @@ def merge_columns(Tb: sp.csr_matrix, pairs: NDArray[np.int64]) -> sp.csr_matrix:
     unit = (count == 1) & np.isclose(value, 1.0, rtol=0, atol=1e-14)
     zero = count == 0
     bad = ~(unit | zero)[pairs].all(axis=1)
-    if np.any(bad):
-        point = int(pairs[np.flatnonzero(bad)[0], 0]) // 3
-        raise InputError(f"control point {point} of the body lies on a conforming interface "
-                         "but its edge condition couples it to other control points "
-                         "(uniform knots, a plane not along an axis): use open knots and "
-                         "axis-aligned conditions at edges that meet")
+    rest, pairs = pairs[bad], pairs[~bad]
+    if len(rest):                     # equal rows up to round-off: nothing to impose
+        apart = abs(Tb[rest[:, 0]] - Tb[rest[:, 1]]).max(axis=1).toarray().ravel()
+        rest = rest[apart > 1e-12]    # entries of Tb are O(1): 0, 1 or null vectors
     both = unit[pairs].all(axis=1)
     links = first[pairs[both]]
     graph = sp.coo_matrix((np.ones(len(links)), (links[:, 0], links[:, 1])), shape=(n, n))
@@ -148,7 +155,7 @@ def merge_columns(Tb: sp.csr_matrix, pairs: NDArray[np.int64]) -> sp.csr_matrix:
     keep = ~held[label]
     _, new = np.unique(label[keep], return_inverse=True)
     return sp.csr_matrix((np.ones(new.size), (np.flatnonzero(keep), new)),
-                         shape=(n, int(new.max(initial=-1)) + 1))
+                         shape=(n, int(new.max(initial=-1)) + 1)), rest
 
 
 def body_field(patches: Sequence[Surface], term: object, t: float = 0.0) -> Array:
