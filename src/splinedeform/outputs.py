@@ -15,7 +15,9 @@ from typing import TYPE_CHECKING, Any, Protocol
 import numpy as np
 
 from .mode_outputs import animated_modes, mode_file_names, mode_frames
+from .outputs_body import body_outputs, write_body_files
 from .scenario import scenario_to_toml
+from .scenario.body import is_body
 
 if TYPE_CHECKING:
     from .pipeline import RunResult
@@ -49,6 +51,8 @@ def planned_outputs(result: RunResult) -> list[str]:
     from .export import frame_file_names
 
     s = result.scenario
+    if is_body(result.built.surface):
+        return body_outputs(result)
     formats, name = s.output.formats, s.name
     names = [f"{name}.{ext}" for ext in ("obj", "stl", "ply") if ext in formats]
     if "vtu" in formats:
@@ -81,7 +85,10 @@ def write_outputs(result: RunResult, folder: Path, stages: Stages) -> None:
                          frame_pattern=re.escape(name) + r"_\d{4,}\.vtu")
     try:
         result.removed, result.kept = claim.removed, claim.kept
-        _write_files(result, folder, stages)
+        if is_body(result.built.surface):
+            write_body_files(result, folder, stages)
+        else:
+            _write_files(result, folder, stages)
         with stages.stage("manifest"):
             result.outputs.append(("manifest", claim.finish()))
     finally:
@@ -307,6 +314,10 @@ def _write_mode_files(result: RunResult, folder: Path, stages: Stages) -> None:
 
 def make_report(result: RunResult) -> dict[str, Any]:
     """The content of ``report.json`` / ``report.md``: inputs, solver, timings, energies, probes."""
+    if is_body(result.built.surface):
+        from .outputs_body import body_report
+
+        return body_report(result)
     s, surface = result.scenario, result.built.surface
     report: dict[str, Any] = {
         "inputs": {"source": s.source, **tomllib.loads(scenario_to_toml(s))},
@@ -357,9 +368,12 @@ def _solution_timings(result: RunResult) -> dict[str, float]:
 def summary_rows(result: RunResult) -> list[tuple[str, str]]:
     """(label, value) rows of the closing summary: sizes, times per stage, outputs."""
     s, surface = result.scenario, result.built.surface
+    net = (f"{len(surface)} faces, {sum(p.shape[0] * p.shape[1] for p in surface)} points"
+           if is_body(surface) else
+           f"{surface.shape[0]} x {surface.shape[1]} ({surface.shape[0] * surface.shape[1]} "
+           "points)")
     rows = [("scenario", s.title or s.name),
-            ("control net", f"{surface.shape[0]} x {surface.shape[1]} "
-                            f"({surface.shape[0] * surface.shape[1]} points)"),
+            ("control net", net),
             (_unknowns(result.built.model), str(result.n_free)),
             ("solve", s.solve.kind + (f" ({s.solve.method})" if s.solve.kind == "dynamic"
                                       else "")),

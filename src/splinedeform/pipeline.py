@@ -19,6 +19,8 @@ from .errors import InputError
 from .outputs import make_report, planned_outputs, summary_rows, write_outputs
 from .load_scale import ScaledSolution, load_scale
 from .scenario import Built, Scenario, SolveSpec, _located, build, build_load
+from .pipeline_body import solve_body
+from .scenario.body import is_body
 
 #: ``progress(stage, done, total)``, called as each stage advances
 ProgressCallback = Callable[[str, int, int], None]
@@ -70,6 +72,9 @@ class RunResult:
 
     @property
     def rest_net(self) -> Any:
+        """The rest control net (a body's: a list, one per patch)."""
+        if is_body(self.built.surface):
+            return [s.control_points for s in self.built.surface.patches]
         return self.built.surface.control_points
 
 
@@ -124,7 +129,11 @@ def run(scenario: Scenario, outdir: str | Path | None = None,
         with stages.stage("build"):
             built = build(scenario)
             check_budget(scenario, built.model, budget)
-        result = _solve(scenario, built, stages)
+        if is_body(built.surface):
+            result = solve_body(scenario, built, stages)
+            _require_finite(result)
+        else:
+            result = _solve(scenario, built, stages)
         result.timings = stages.timings
         if folder is not None:
             write_outputs(result, folder, stages)
@@ -233,7 +242,8 @@ def _require_finite(result: RunResult) -> None:
     """Refuse a solution, energy or probe that overflowed to NaN or inf before anything is written."""
     import numpy as np
 
-    arrays = [result.nets, result.max_displacement, *result.probes.values(),
+    nets = result.nets if isinstance(result.nets, list) else [result.nets]
+    arrays = [*nets, result.max_displacement, *result.probes.values(),
               *(result.energy or {}).values()]
     if result.omegas is not None:
         arrays.append(result.omegas)
