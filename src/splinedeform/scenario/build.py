@@ -111,7 +111,8 @@ def _surface_from_cad(scenario: Scenario) -> tuple[Any, str | None]:
     path = scenario.surface.path
     assert path is not None
     face = scenario.surface.parameters["face"]
-    if "face" not in scenario.raw.get("surface", {}):      # faces = "all" unless told
+    raw = scenario.raw.get("surface", {})
+    if "face" not in raw or "faces" in raw:          # faces = "all" unless face is given
         from .body import body_from_cad
 
         body, face, units = body_from_cad(scenario)
