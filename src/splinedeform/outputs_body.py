@@ -63,7 +63,6 @@ def peak_frame(result: RunResult) -> int:
 
 def write_body_files(result: RunResult, folder: Path, stages: Stages) -> None:
     """Every requested format of a body (module docstring)."""
-    from . import export
     from .export import body as body_files
 
     s = result.scenario
@@ -92,10 +91,9 @@ def write_body_files(result: RunResult, folder: Path, stages: Stages) -> None:
     if "images" in formats:
         _write_images(result, folder, stages)
     if "report" in formats:
-        with stages.stage("report"):
-            result.report = body_report(result)
-            paths = export.write_report(folder, result.report)
-            result.outputs += [("report .json", paths[0]), ("report .md", paths[1])]
+        from .outputs import write_report
+
+        write_report(result, folder, stages)
 
 
 def _write_images(result: RunResult, folder: Path, stages: Stages) -> None:
@@ -134,7 +132,7 @@ def _warp(result: RunResult) -> float:
 def body_report(result: RunResult) -> dict[str, Any]:
     """The content of ``report.json`` / ``report.md`` of a body: inputs, the body (unit,
     faces, topology counts, nets), solver, timings, energies, modes and the faces' centres."""
-    from .outputs import _solution_timings
+    from .run_report import solution_timings, add_energies_and_probes, mode_table, solver_section
     from .scenario import scenario_to_toml
 
     s, body = result.scenario, result.built.surface
@@ -148,23 +146,10 @@ def body_report(result: RunResult) -> dict[str, Any]:
                  "nets": [f"{p.shape[0]} x {p.shape[1]}" for p in body],
                  "degrees": [[p.basis_u.degree, p.basis_v.degree] for p in body],
                  "free control points": result.n_free},
-        "solver": {"kind": s.solve.kind,
-                   "method": s.solve.method if s.solve.kind == "dynamic" else "direct",
-                   "t_end": s.solve.t_end if s.solve.kind == "dynamic" else None,
-                   "frames": len(result.times),
-                   "max displacement": result.max_displacement},
-        "timings": {**_solution_timings(result), **result.timings},
+        "solver": solver_section(result),
+        "timings": {**solution_timings(result), **result.timings},
     }
     if result.omegas is not None:
-        report["modes"] = {"mode": list(range(1, len(result.omegas) + 1)),
-                           "omega": result.omegas,
-                           "frequency (omega / 2 pi)": np.asarray(result.omegas) / (2 * np.pi)}
-    if result.energy is not None:
-        report["energies"] = result.energy
-    frame_label = {"dynamic": "time", "static": "load factor", "modes": "phase"}[s.solve.kind]
-    probes: dict[str, Any] = {frame_label: result.times}
-    for name, d in result.probes.items():
-        probes.update({f"{name} d{c}": d[:, i] for i, c in enumerate("xyz")})
-        probes[f"{name} magnitude"] = np.linalg.norm(d, axis=1)
-    report["probes"] = probes
+        report["modes"] = mode_table(result.omegas)
+    add_energies_and_probes(report, result)
     return report

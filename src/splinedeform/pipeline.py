@@ -184,23 +184,9 @@ def _prepare_outdir(scenario: Scenario, outdir: str | Path | None) -> Path:
 def _solve(scenario: Scenario, built: Built, stages: _Stages) -> RunResult:
     import numpy as np
 
-    solve, model = scenario.solve, built.model
-    solution, omegas, shapes = None, None, None
-    times = np.asarray(solve.frame_times() if solve.kind == "dynamic"
-                       else np.linspace(0.0, 1.0, solve.frames))
-    scale = load_scale(scenario)           # extreme loads solved at order one, then scaled
-    with stages.stage("solve"), _located(scenario, "solve"), stages.simulated("solve"):
-        load = built.load if scale == 1.0 else build_load(scenario, scale)
-        if solve.kind == "static":
-            solution = model.static(load)
-        elif solve.kind == "dynamic":
-            solution = model.dynamic(load, solve.t_end, method=solve.method,
-                                     **_method_options(solve, times, scenario.output.time))
-        if solution is not None and scale != 1.0:
-            solution = ScaledSolution(solution, scale)
-    if solve.modes > 0 and solve.kind != "static":
-        with stages.stage("modes"), _located(scenario, "solve.modes"):
-            omegas, shapes = model.modes(min(solve.modes, model.n_free))
+    times = np.asarray(scenario.solve.frame_times() if scenario.solve.kind == "dynamic"
+                       else np.linspace(0.0, 1.0, scenario.solve.frames))
+    solution, omegas, shapes = solve_and_modes(scenario, built, stages, times)
     mode_nets = None if shapes is None else mode_displacements(built.surface, shapes)
     with stages.stage("frames"), _located(scenario, "solve"):
         nets = _frames(scenario, built, solution, times, mode_nets)
@@ -215,6 +201,30 @@ def _solve(scenario: Scenario, built: Built, stages: _Stages) -> RunResult:
         _measure(result)
     _require_finite(result)
     return result
+
+
+def solve_and_modes(scenario: Scenario, built: Built, stages: _Stages, times: Any,
+                    static: Callable[[Any, Any], Any] | None = None) -> tuple[Any, Any, Any]:
+    """``(solution, omegas, shapes)``: the static or dynamic solution at ``times`` (None
+    for modes) and the modes when asked for; ``static(model, load)`` solves a static one
+    (default ``model.static(load)``)."""
+    solve, model = scenario.solve, built.model
+    solution, omegas, shapes = None, None, None
+    scale = load_scale(scenario)           # extreme loads solved at order one, then scaled
+    with stages.stage("solve"), _located(scenario, "solve"), stages.simulated("solve"):
+        load = built.load if scale == 1.0 else build_load(
+            scenario, scale, built.surface if is_body(built.surface) else None)
+        if solve.kind == "static":
+            solution = (static or (lambda m, f: m.static(f)))(model, load)
+        elif solve.kind == "dynamic":
+            solution = model.dynamic(load, solve.t_end, method=solve.method,
+                                     **_method_options(solve, times, scenario.output.time))
+        if solution is not None and scale != 1.0:
+            solution = ScaledSolution(solution, scale)
+    if solve.modes > 0 and solve.kind != "static":
+        with stages.stage("modes"), _located(scenario, "solve.modes"):
+            omegas, shapes = model.modes(min(solve.modes, model.n_free))
+    return solution, omegas, shapes
 
 
 def _extreme_inputs(scenario: Scenario) -> list[tuple[str, float]]:
@@ -341,25 +351,40 @@ def _measure(result: RunResult) -> None:
         name = f"p{i} ({u:g}, {v:g})"
         result.probes[name] = histories[i - 1]
         result.probe_points[name] = (float(u), float(v))
-    uu, vv = surface.sample_parameters(scenario.output.resolution)
+    per_frame = displacement_per_frame(surface, D, scenario.output.resolution)
+    result.displacement_per_frame = per_frame
+    result.max_displacement = float(per_frame.max(initial=0.0))
+    result.energy = energies(result)
+
+
+def displacement_per_frame(surface: Any, D: Any, resolution: int) -> Any:
+    """``max_(u,v) |d_f(u, v)|`` per frame on the output grid of ``surface``, for net
+    displacements ``D (F, n_u, n_v, 3)``: ``d_f = B_u D_f B_vᵀ``."""
+    import numpy as np
+
+    uu, vv = surface.sample_parameters(resolution)
     Bu = surface.basis_u.matrix(uu).toarray()
     Bv = surface.basis_v.matrix(vv).toarray()
     grid = np.einsum("ik,fklc,jl->fijc", Bu, D, Bv, optimize=True)
     # |d| per frame, scaled so that the squares of a tiny d do not underflow
     size = float(np.abs(grid).max(initial=0.0))
     scale = size if 0.0 < size < np.inf else 1.0
-    per_frame = scale * np.linalg.norm(grid / scale, axis=-1).reshape(len(grid), -1).max(axis=1)
-    result.displacement_per_frame = per_frame
-    result.max_displacement = float(per_frame.max(initial=0.0))
-    solution = result.solution
-    if scenario.solve.kind == "dynamic":
+    return scale * np.linalg.norm(grid / scale, axis=-1).reshape(len(grid), -1).max(axis=1)
+
+
+def energies(result: RunResult) -> dict[str, Any] | None:
+    """The energies of a run: per frame for a dynamic solve, of the equilibrium for a
+    static one, None for modes."""
+    solution, kind = result.solution, result.scenario.solve.kind
+    if kind == "dynamic":
         energy = solution.energy(result.times)
-        result.energy = {"time": result.times, "kinetic": energy.kinetic,
-                         "strain": energy.strain, "work": energy.work, "total": energy.total}
-    elif scenario.solve.kind == "static":
+        return {"time": result.times, "kinetic": energy.kinetic, "strain": energy.strain,
+                "work": energy.work, "total": energy.total}
+    if kind == "static":
         energy = solution.energy()
-        result.energy = {"strain": float(energy.strain), "work": float(energy.work),
-                         "total": float(energy.total)}
+        return {"strain": float(energy.strain), "work": float(energy.work),
+                "total": float(energy.total)}
+    return None
 
 
 def _domain_centre(surface: Any) -> tuple[float, float]:

@@ -18,8 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from .load_scale import ScaledSolution, load_scale
-from .scenario import Built, Scenario, _located, build_load
+from .scenario import Built, Scenario, _located
 
 
 def body_static(model: Any, load: Any) -> Any:
@@ -43,25 +42,12 @@ def body_static(model: Any, load: Any) -> Any:
 
 def solve_body(scenario: Scenario, built: Built, stages: Any) -> Any:
     """The :class:`~splinedeform.pipeline.RunResult` of a body scenario (module docstring)."""
-    from .pipeline import RunResult, _method_options
+    from .pipeline import RunResult, solve_and_modes
 
-    solve, model = scenario.solve, built.model
-    solution, omegas, shapes = None, None, None
+    solve = scenario.solve
     times = np.asarray(solve.frame_times() if solve.kind == "dynamic"
                        else np.linspace(0.0, 1.0, solve.frames))
-    scale = load_scale(scenario)
-    with stages.stage("solve"), _located(scenario, "solve"), stages.simulated("solve"):
-        load = built.load if scale == 1.0 else build_load(scenario, scale, built.surface)
-        if solve.kind == "static":
-            solution = body_static(model, load)
-        elif solve.kind == "dynamic":
-            solution = model.dynamic(load, solve.t_end, method=solve.method,
-                                     **_method_options(solve, times, scenario.output.time))
-        if solution is not None and scale != 1.0:
-            solution = ScaledSolution(solution, scale)
-    if solve.modes > 0 and solve.kind != "static":
-        with stages.stage("modes"), _located(scenario, "solve.modes"):
-            omegas, shapes = model.modes(min(solve.modes, model.n_free))
+    solution, omegas, shapes = solve_and_modes(scenario, built, stages, times, body_static)
     patches = built.surface.patches
     mode_nets = None if shapes is None else body_mode_displacements(patches, shapes)
     with stages.stage("frames"), _located(scenario, "solve"):
@@ -101,6 +87,8 @@ def _frames(scenario: Scenario, patches: Any, solution: Any, times: Any, mode_ne
 def _measure(result: Any) -> None:
     """Each face's centre displacement per frame (the probes), the largest displacement on
     the patches' output grids per frame, and the energies."""
+    from .pipeline import displacement_per_frame, energies
+
     scenario, body = result.scenario, result.built.surface
     F = len(result.times)
     per_frame = np.zeros(F)
@@ -113,19 +101,8 @@ def _measure(result: Any) -> None:
         result.probes[name] = np.asarray(E @ np.moveaxis(D.reshape(F, -1, 3), 0, 1)
                                          .reshape(E.shape[1], F * 3)).reshape(F, 3)
         result.probe_points[name] = (0.5 * lu, 0.5 * lv)
-        uu, vv = surface.sample_parameters(scenario.output.resolution)
-        Bu, Bv = surface.basis_u.matrix(uu).toarray(), surface.basis_v.matrix(vv).toarray()
-        grid = np.einsum("ik,fklc,jl->fijc", Bu, D, Bv, optimize=True)
-        per_frame = np.maximum(per_frame, np.linalg.norm(grid, axis=-1).reshape(F, -1)
-                               .max(axis=1))
+        per_frame = np.maximum(per_frame, displacement_per_frame(
+            surface, D, scenario.output.resolution))
     result.displacement_per_frame = per_frame
     result.max_displacement = float(per_frame.max(initial=0.0))
-    solution = result.solution
-    if scenario.solve.kind == "dynamic":
-        energy = solution.energy(result.times)
-        result.energy = {"time": result.times, "kinetic": energy.kinetic,
-                         "strain": energy.strain, "work": energy.work, "total": energy.total}
-    elif scenario.solve.kind == "static":
-        energy = solution.energy()
-        result.energy = {"strain": float(energy.strain), "work": float(energy.work),
-                         "total": float(energy.total)}
+    result.energy = energies(result)
