@@ -226,3 +226,18 @@ def test_a_single_face_file_runs_as_one_surface(tmp_path):
     # the same face read by the same reader twice: the same numbers
     np.testing.assert_array_equal(default.surface.control_points, one.surface.control_points)
     assert default.model.n_free == one.model.n_free
+
+
+def test_a_body_scenario_is_written_back_as_it_runs(box_3dm, tmp_path):
+    """The scenario written into a report reads back as the same body: every face (no
+    `face = 0`) and each load's face."""
+    from splinedeform.scenario import parse_scenario, scenario_to_toml
+
+    push = '[[load]]\nkind = "point"\nat = [0.5, 0.5]\nface = 2\nforce = [0, 0, 1.0]\n'
+    path = write_scenario(tmp_path, box_3dm, formats='["report"]', loads=push)
+    scenario = parse_scenario(path.read_text(), directory=tmp_path)
+    text = scenario_to_toml(scenario)
+    assert "face = 2" in text and "face = 0" not in text
+    again = parse_scenario(text, directory=tmp_path)
+    assert again.loads == scenario.loads and again.surface == scenario.surface
+    assert "face" not in again.raw["surface"]
