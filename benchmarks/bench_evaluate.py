@@ -2,8 +2,9 @@
 
 A cubic net of 64 × 64 cells (open knots, 67 × 67 control points) is evaluated
 
-* on a 200 × 200 parameter grid: ``Surface.evaluate_grid`` against the same products
-  ``B_u P B_vᵀ`` with the collocation matrices of ``scipy.interpolate.BSpline.design_matrix``;
+* on parameter grids of 20 × 20, 200 × 200 and 1000 × 1000 (:data:`GRID_SAMPLES`):
+  ``Surface.evaluate_grid`` against the same products ``B_u P B_vᵀ`` with the collocation
+  matrices of ``scipy.interpolate.BSpline.design_matrix``;
 * at the 40 000 flattened grid points and at 1 000 random points: ``Surface.evaluate``
   against ``scipy.interpolate.NdBSpline`` on the same points (and ``∂x/∂u`` by
   ``Surface.derivative(u, v, 1, 0)`` against ``NdBSpline(..., nu=(1, 0))``);
@@ -39,6 +40,7 @@ from splinedeform.surface import Surface
 CELLS = 64
 DEGREE = 3
 SAMPLES = 200
+GRID_SAMPLES = (20, 200, 1000)
 TOLERANCE = 1e-12
 
 
@@ -98,8 +100,11 @@ def run(quick: bool = False) -> list[dict]:
     su, sv = scattered[:, 0].copy(), scattered[:, 1].copy()
     label = f"{CELLS}x{CELLS}-cell cubic"
     cases: list[tuple[str, Callable[[], Any], Callable[[], Any], int]] = [
-        (f"evaluate_grid ({SAMPLES}x{SAMPLES} samples, {label}) vs design_matrix products",
-         lambda: surface.evaluate_grid(u, v), lambda: reference_grid(surface, u, v), repeats),
+        (f"evaluate_grid ({n}x{n} samples, {label}) vs design_matrix products",
+         lambda x=x: surface.evaluate_grid(x, x), lambda x=x: reference_grid(surface, x, x),
+         max(repeats, repeats * SAMPLES // n))
+        for n, x in ((n, np.linspace(0.0, 1.0, n)) for n in GRID_SAMPLES)]
+    cases += [
         (f"evaluate pointwise ({SAMPLES * SAMPLES} grid points, {label}) vs NdBSpline",
          lambda: surface.evaluate(U, V).reshape(-1, 3), lambda: spline(grid_points), repeats),
         (f"evaluate pointwise (1000 random points, {label}) vs NdBSpline",

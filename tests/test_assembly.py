@@ -40,8 +40,10 @@ def test_reduced_matrices_equal_the_reduction_of_the_full_ones(boundary, lumped)
     np.testing.assert_allclose(K.toarray(), K_kron.toarray(), rtol=0,
                                atol=1e-12 * abs(K_kron).max())
     T = model.constraints.T
-    K_r, M_r = reduced_matrices(model.gram_u, model.gram_v, PLATE, lumped, M, model.constraints)
-    for got, full in ((K_r, K_kron), (M_r, M)):
+    K_r, M_r, C_r = reduced_matrices(model.gram_u, model.gram_v, PLATE, lumped,
+                                     model.constraints)
+    C = (PLATE.damping / PLATE.mass) * M + PLATE.rayleigh * K_kron
+    for got, full in ((K_r, K_kron), (M_r, M), (C_r, C)):
         expected = (T.T @ full @ T).toarray()
         np.testing.assert_allclose(got.toarray(), expected, rtol=0,
                                    atol=1e-12 * np.abs(expected).max())
@@ -52,9 +54,25 @@ def test_fixed_points_off_the_tensor_structure_take_the_general_reduction():
     fixed[3, 4] = True
     model = sd.Model(sd.shapes.plane(cells=(7, 5)), PLATE, boundary="clamped", fixed=fixed)
     assert model.constraints.T_u is None
-    assert reduced_matrices(model.gram_u, model.gram_v, PLATE, False, model.M_full,
+    assert reduced_matrices(model.gram_u, model.gram_v, PLATE, False,
                             model.constraints) is None
     T = model.constraints.T
     expected = (T.T @ model.K_full @ T).toarray()
     np.testing.assert_allclose(model.matrices()[2].toarray(), expected, rtol=0,
                                atol=1e-12 * np.abs(expected).max())
+
+
+def test_the_whole_net_matrices_wait_until_asked_for_and_equal_the_kronecker_sums():
+    """A tensor-product constraint needs only the reduced matrices; K_full and M_full are
+    assembled when first read, the same as assembling them directly (to the last bit is not
+    asked: 1e-15 of the largest entry, a few roundings of sums of O(1) products)."""
+    model = sd.Model(sd.shapes.plane(cells=(7, 5)), PLATE, boundary="clamped")
+    assert model._full is None
+    K, M = full_matrices(model.gram_u, model.gram_v, PLATE)
+    for got, expected in ((model.K_full, K), (model.M_full, M)):
+        np.testing.assert_allclose(got.toarray(), expected.toarray(), rtol=0,
+                                   atol=1e-15 * abs(expected).max())
+    M_r, C_r, K_r = model.matrices()
+    expected = (PLATE.damping / PLATE.mass) * M_r + PLATE.rayleigh * K_r
+    np.testing.assert_allclose(C_r.toarray(), expected.toarray(), rtol=0,
+                               atol=1e-15 * abs(expected).max())

@@ -79,7 +79,8 @@ def test_same_curve_another_parametrisation_matches_but_does_not_conform() -> No
     assert topology.aligned == (False,)
     body = sd.Body([left, bent])
     assert body.conforming().summary()["non_conforming"] == 1     # no knot makes it conform
-    with pytest.raises(sd.InputError, match="non-conforming interface"):
+    with pytest.raises(sd.InputError, match="patch 0 edge u1 and patch 1 edge u0: the edges "
+                                            "meet, but their parametrisations"):
         sd.BodyModel(body, sd.Material(w10=1.0, w01=1.0))
 
 

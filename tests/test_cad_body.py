@@ -260,14 +260,17 @@ def test_a_face_that_cannot_be_deformed_is_skipped_and_said_why(tmp_path):
     from splinedeform.cad import NurbsPatch, write_3dm
 
     knots = np.array([0, 0, 0, 1, 1, 1.0])
+    unclamped = np.array([-0.2, -0.1, 0, 1, 1.1, 1.2])
     x, y = np.meshgrid([0, 0.5, 1], [0, 0.5, 1], indexing="ij")
     flat = np.stack([x, y, 0 * x], -1)
-    general = NurbsPatch((2, 2), knots, knots, flat, 1 + 0.5 * np.eye(3))   # rank-3 weights
+    # rank-3 weights on knots that are not clamped: general weights need clamped knots
+    general = NurbsPatch((2, 2), unclamped, knots, flat, 1 + 0.5 * np.eye(3))
     path = write_3dm(tmp_path / "two.3dm", [general, NurbsPatch((2, 2), knots, knots, flat,
                                                                 np.ones((3, 3)))])
     surfaces, topology, info = read_body(path)
     assert len(surfaces) == 1 and info["faces"] == [1] and list(info["skipped"]) == [0]
     assert "weights are not a product" in info["skipped"][0]
+    assert "not clamped" in info["skipped"][0]
     assert topology.counts == dict.fromkeys(topology.counts, 0)   # plain surfaces: no edges
     with pytest.raises(InputError, match="none of the faces chosen can be deformed: face 0: "):
         read_body(path, [0])

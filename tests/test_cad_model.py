@@ -70,13 +70,17 @@ def test_patch_knots_are_shifted_to_start_at_zero():
     _close(surf.evaluate(0.5, 1.0), surface_from_patch(base).evaluate(0.5, 0.5), 1e-14)
 
 
-def test_weights_that_are_not_a_product_are_refused():
+def test_weights_that_are_not_a_product_are_kept_per_control_point():
+    """The patch's own formula (homogeneous sums) and the surface agree to 1e-14 of the
+    size: two evaluations of one quotient (round-off)."""
     patch = quarter_cylinder()
     w = patch.weights.copy()
     w[1, 1] = 2.0
-    with pytest.raises(InputError, match="not a product"):
-        surface_from_patch(NurbsPatch(patch.degrees, patch.knots_u, patch.knots_v,
-                                      patch.points, w), source="odd.3dm face 0")
+    odd = NurbsPatch(patch.degrees, patch.knots_u, patch.knots_v, patch.points, w)
+    surf = surface_from_patch(odd, source="odd.3dm face 0")
+    assert np.array_equal(surf.net_weights, w)        # the same numbers, copied
+    u, v = np.linspace(0, 1, 7), np.linspace(0, 1, 5)
+    _close(surf.evaluate_grid(u, v), odd.evaluate(u, v), 1e-14)
 
 
 def _centre_and_frequency(surf):
@@ -104,7 +108,7 @@ def test_rational_model_converges_to_the_polynomial_approximation():
     assert gaps[-1].max() <= 2e-3, gaps
 
 
-def test_bending_on_a_c0_knot_vector_is_refused():
+def test_bending_on_a_c0_knot_vector_is_coupled():
     # two quarter arcs joined by a double knot: C0 in u at 0.5
     ring = np.array([[1.0, 0, 0], [1, 1, 0], [0, 1, 0], [-1, 1, 0], [-1, 0, 0]])
     points = np.stack([ring, ring + [0, 0, 1.0], ring + [0, 0, 2.0]], axis=1)
@@ -113,6 +117,13 @@ def test_bending_on_a_c0_knot_vector_is_refused():
                        np.outer([1, S, 1, S, 1], [1, 1, 1]))
     surf = surface_from_patch(patch)
     assert surf.basis_u.continuity == 0 and surf.basis_v.continuity == 2
-    with pytest.raises(InputError, match="w20 needs a C1 basis in u"):
-        sd.Model(surf, sd.Material(w10=1, w01=1, w20=1), boundary={"u0": "clamped"})
+    model = sd.Model(surf, sd.Material(w10=1, w01=1, w20=1), boundary={"u0": "clamped"})
+    net = model.static(sd.Uniform((0.0, 0.0, -1.0))).control_points() - surf.control_points
+    v, x = np.linspace(0, 1, 21), np.linspace(0, 1, 41)
+    jump = surf.derivative(0.5, v, 1, 0, net) - surf.derivative(0.5 - 1e-12, v, 1, 0, net)
+    largest = np.abs(surf.derivative(x[:, None], x[None, :], 1, 0, net)).max()
+    # the rotation penalty ties the slopes across u = 0.5 (the arcs meet G1 there, with the
+    # same parametric speed): the jump against the largest slope is the penalty's error on
+    # two spans a side, 5.4e-5 measured, held to 1e-4
+    assert np.abs(jump).max() <= 1e-4 * largest
     sd.Model(surf, sd.Material(w10=1, w01=1, w02=1), boundary={"u0": "clamped"})   # v is C2

@@ -139,3 +139,35 @@ def test_one_point_on_a_new_periodic_surface_equals_the_array_path():
         fresh = s.with_control_points(s.control_points)
         np.testing.assert_allclose(fresh.derivative(1.3, 2.9, du, dv), by_sum, rtol=0,
                                    atol=1e-13 * max(np.abs(by_sum).max(), 1.0))
+
+
+@pytest.mark.parametrize("samples", [(4, 3), (200, 150)])
+@pytest.mark.parametrize("shared", [True, False])
+def test_grid_evaluation_equals_ndbspline_by_gather_and_by_sparse_product(samples, shared):
+    """``evaluate_grid`` against NdBSpline on the grid's points, for small grids (the rows
+    gathered and contracted) and larger ones (scipy's sparse product), with one basis
+    shared by both directions (evaluated once) and with two bases.
+
+    Both paths and scipy sum the same ``(n+1)²`` products in other orders: 1e-13 relative
+    to the largest value of the order, as for the pointwise evaluation.
+    """
+    from splinedeform import collocation
+    basis = BSplineBasis(3, 9, 1.0, "open")
+    other = basis if shared else BSplineBasis(2, 7, 1.0, "open")
+    s = surface_on(basis, other, seed=4)
+    u, v = np.linspace(0.0, 1.0, samples[0]), np.linspace(0.0, 1.0, samples[1])
+    # the numbers each product would gather: N_u (n+1) n_v 3, then N_v (n+1) N_u 3
+    sizes = (samples[0] * 4 * other.size * 3, samples[1] * (other.degree + 1) * samples[0] * 3)
+    small = samples == (4, 3)
+    assert all((size <= collocation.GATHER_LIMIT) == small for size in sizes)
+    U, V = np.meshgrid(u, v, indexing="ij")
+    points = np.stack([U.ravel(), V.ravel()], axis=-1)
+    for du, dv in [(0, 0), (1, 0), (0, 2), (1, 1)]:
+        expected = reference(s)(points, nu=(du, dv)).reshape(U.shape + (3,))
+        grid = s.evaluate_grid(u, v, du, dv)
+        scale = float(np.abs(expected).max())
+        np.testing.assert_allclose(grid, expected, rtol=0, atol=1e-13 * scale)
+    # a scalar field on the net: records of one number
+    field = s.control_points[..., :1]
+    np.testing.assert_allclose(s.evaluate_grid(u, v, control_points=field)[..., 0],
+                               s.evaluate_grid(u, v)[..., 0], rtol=0, atol=1e-15 * scale)

@@ -140,13 +140,26 @@ def test_bad_weights_are_refused(written, tmp_path):
     doc = json.loads((folder / "nets.json").read_text())
     doc["weights"] = doc["weights"][:-1]
     (tmp_path / "short.json").write_text(json.dumps(doc))
-    with pytest.raises(InputError, match="short.json: a rational net needs weights"):
+    with pytest.raises(InputError, match="short.json: NURBS weights must be > 0 of shape"):
         read_control_net(tmp_path / "short.json")
+
+
+def test_weights_on_polynomial_directions_are_general_weights(written, tmp_path):
+    """Differing weights on directions not marked rational are read per control point:
+    the same surface (the product weights given as general ones)."""
+    surface, nets, folder = written
     doc = json.loads((folder / "nets.json").read_text())
     doc["basis"]["u"]["kind"] = "general"
-    (tmp_path / "dropped.json").write_text(json.dumps(doc))
-    with pytest.raises(InputError, match="dropped.json: weights differ but no direction"):
-        read_control_net(tmp_path / "dropped.json")
+    doc["basis"]["v"]["kind"] = "general"
+    (tmp_path / "general.json").write_text(json.dumps(doc))
+    back = read_control_net(tmp_path / "general.json")
+    assert back.net_weights is not None
+    u, v = np.linspace(0, surface.domain[0][1], 7), np.linspace(0, surface.domain[1][1], 5)
+    # the same rational function by two evaluations (per direction, homogeneous): to 1e-13
+    # of the net's size (a few roundings of a degree-3 quotient)
+    size = np.abs(nets[-1]).max()
+    assert np.abs(back.evaluate_grid(u, v) - surface.evaluate_grid(
+        u, v, control_points=nets[-1])).max() <= 1e-13 * size
 
 
 def test_polynomial_nets_state_unit_weights(tmp_path):

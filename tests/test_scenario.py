@@ -16,6 +16,7 @@ from splinedeform.scenario import (SHAPE_PARAMETERS, Scenario, build, build_load
                                    parse_scenario, scenario_to_toml, with_overrides)
 
 from tiny_scenario import BASE
+from trim_scenario import TRIMMED
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "scenario.md"
@@ -159,7 +160,7 @@ ANALYTIC = (BASE
 PAINTED = STATIC.replace('v1 = "pinned"\n', 'v1 = "pinned"\nfree_points = [[1, 1], [2, 2], [3, 3]]\n')
 
 COVERAGE = {"plane": PLANE, "newmark": NEWMARK, "modes": MODES, "static": STATIC,
-            "analytic": ANALYTIC, "painted": PAINTED}
+            "analytic": ANALYTIC, "painted": PAINTED, "trimmed": TRIMMED}
 
 
 def shape_scenario(shape: str, params: dict[str, object]) -> str:

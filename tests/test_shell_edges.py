@@ -109,16 +109,19 @@ def test_the_pole_of_a_half_sphere_is_one_point():
         ShellModel(sphere, MATERIAL, {"v0": "pole"})
 
 
-def test_a_c0_knot_line_is_refused_as_for_the_plate():
-    bu = KnotVectorBasis(2, [0, 0, 0, 0.5, 0.5, 1, 1, 1])
-    bv = BSplineBasis(2, 4, 1.0, "open")
-    grid = np.stack(np.meshgrid(np.linspace(0, 1, bu.size), np.linspace(0, 1, bv.size),
-                                indexing="ij"), -1)
-    net = np.concatenate([grid, np.zeros(grid.shape[:2] + (1,))], -1)
-    plate = Surface(net, bu, bv)
-    with pytest.raises(InputError, match="needs a C1 basis in u, but its knot vector repeats "
-                                         "an interior knot 2 times"):
-        ShellModel(plate, MATERIAL, {e: "pinned" for e in ALL})
+def test_a_c0_knot_line_is_coupled_as_for_the_plate():
+    deflections = []
+    for knots in ([0, 0, 0, 0.5, 0.5, 1, 1, 1], [0, 0, 0, 0.5, 1, 1, 1]):
+        bu = KnotVectorBasis(2, knots)
+        bv = BSplineBasis(2, 4, 1.0, "open")
+        grid = np.stack(np.meshgrid(bu.greville(), bv.greville(), indexing="ij"), -1)
+        net = np.concatenate([grid, np.zeros(grid.shape[:2] + (1,))], -1)
+        model = ShellModel(Surface(net, bu, bv), MATERIAL, {e: "pinned" for e in ALL})
+        deflections.append(model.static(sd.Uniform((0.0, 0.0, 1.0))).displacement(0.5, 0.5)[2])
+    # the double knot's C0 space with the slopes tied across u = 1/2 tends to the C1 space
+    # of the single knot (all a quadratic can be there): the penalty's error, 4.6e-6
+    # measured, held to 1e-5
+    assert deflections[0] == pytest.approx(deflections[1], rel=1e-5)
 
 
 def quarter_hemisphere(cells: int, oblique: float) -> Surface:

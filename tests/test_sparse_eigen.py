@@ -11,7 +11,7 @@ import pytest
 import scipy.linalg as sla
 
 import splinedeform as sd
-from splinedeform.solvers import sparse_eigen
+from splinedeform.solvers import block_cholesky, sparse_eigen
 
 PLATE = sd.Material(mass=1.0, damping=0.8, rayleigh=5e-4, w10=10.0, w01=10.0, w20=1.0,
                     w11=1.0, w02=1.0)
@@ -34,13 +34,20 @@ def models():
     return _models()
 
 
+@pytest.mark.parametrize("factor", ["banded", "block"])
 @pytest.mark.parametrize("name", list(_models()))
-def test_lowest_eigenpairs_match_dense_eigh(models, name):
+def test_lowest_eigenpairs_match_dense_eigh(models, name, factor, monkeypatch):
+    """Both factorisations of K: the band solve of these small nets, and the block one
+    (solvers/block_cholesky.py, with its wider Lanczos blocks) that large nets use."""
+    if factor == "block":
+        monkeypatch.setattr(block_cholesky, "CACHED_BAND", 0)
     model = models[name]
     M, _, K = model.matrices()
     lam_ref, phi_ref = sla.eigh(K.toarray(), M.toarray())
     k = 24
-    modes = sparse_eigen.lowest_modes(K, M, k)
+    krylov = sparse_eigen.BlockLanczos(K, M)
+    assert getattr(krylov.lu, "method", "superlu") == factor or name.startswith("fixed")
+    modes = krylov.lowest(k)
     assert modes.lam.size in (k + 1, model.n_free)      # all when the space fills R^n
     lam, phi = modes.lam[:k + 1], modes.phi[:, :k + 1]
     assert np.max(np.abs(lam - lam_ref[:k + 1]) / lam_ref[:k + 1]) <= 1e-9

@@ -20,9 +20,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from .errors import InputError
-from .knots import c0_refusal
 from .material import Material
-from .physics import intrinsic
+from .physics import intrinsic, rational_plate
 from .quadrature import gram_matrix
 from .surface import Surface
 
@@ -53,12 +52,14 @@ def mass(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], density: float,
 
 
 def reduced_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix],
-                     material: Material, lumped: bool, M_full: sp.spmatrix, constraints: Any
-                     ) -> tuple[sp.csc_matrix, sp.csc_matrix] | None:
-    """``(K_r, M_r) = (Tᵀ K T, Tᵀ M T)`` from the reduced 1-D factors, in CSC.
+                     material: Material, lumped: bool, constraints: Any
+                     ) -> tuple[sp.csc_matrix, sp.csc_matrix, sp.csc_matrix] | None:
+    """``(K_r, M_r, C_r) = (Tᵀ K T, Tᵀ M T, Tᵀ C T)`` from the reduced 1-D factors, in CSC.
 
-    ``None`` unless the constraints are of tensor-product form (``T_u``, ``T_v`` known).
-    A lumped (diagonal) mass ``M_full`` is reduced as it is.
+    ``C = (γ/μ) M + β K`` (viscous and Rayleigh damping). ``None`` unless the constraints
+    are of tensor-product form (``T_u``, ``T_v`` known). A lumped (diagonal) mass is
+    reduced as it is, ``Tᵀ M T``. The consistent ``K_r``, ``M_r`` and ``C_r`` share one
+    compressed layout: three sums of Kronecker products of the same 1-D factors.
     """
     T_u, T_v = constraints.T_u, constraints.T_v
     if T_u is None or T_v is None:
@@ -67,11 +68,17 @@ def reduced_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix],
     reduced_v = [(T_v.T @ G @ T_v).tocsr() for G in gram_v]
     shape = (T_u.shape[1] * T_v.shape[1],) * 2
     stiff = stiffness_terms(reduced_u, reduced_v, material)
+    viscous = material.damping / material.mass
     if lumped:
         T = constraints.T
-        return kronecker_sum(stiff, shape, "csc"), (T.T @ M_full @ T).tocsc()
-    K, M = kronecker_sums([stiff, [(material.mass, reduced_u[0], reduced_v[0])]], shape, "csc")
-    return K, M
+        K = kronecker_sum(stiff, shape, "csc")
+        M = (T.T @ mass(gram_u, gram_v, material.mass, True) @ T).tocsc()
+        return K, M, (viscous * M + material.rayleigh * K).tocsc()
+    mass_term = [(material.mass, reduced_u[0], reduced_v[0])]
+    damping = [(viscous * material.mass, reduced_u[0], reduced_v[0])] + [
+        (material.rayleigh * w, A, B) for w, A, B in stiff]
+    K, M, C = kronecker_sums([stiff, mass_term, damping], shape, "csc")
+    return K, M, C
 
 
 def full_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], material: Material,
@@ -119,6 +126,11 @@ def kronecker_sums(sums: Sequence[Sequence[tuple[float, sp.spmatrix, sp.spmatrix
     np.cumsum(np.outer(np.diff(PA.indptr), np.diff(PB.indptr)).ravel(), out=indptr[1:])
     width_b = PB.shape[1] if format == "csr" else PB.shape[0]
     indices = (other_a[:, None, :, None] * width_b + other_b[None, :, None, :])[stored]
+    la, ca = other_a.shape
+    lb, cb = other_b.shape
+    # where each stored (i, k, e, f) sits in the product's (i e, k f) layout
+    i, k, e, f = np.nonzero(stored)
+    positions = ((i * ca + e) * lb + k) * cb + f
     full_shape = (PA.shape[0] * PB.shape[0], PA.shape[1] * PB.shape[1])
     out = []
     for terms in sums:
@@ -126,12 +138,10 @@ def kronecker_sums(sums: Sequence[Sequence[tuple[float, sp.spmatrix, sp.spmatrix
             weights = np.array([w for w, _, _ in terms], dtype=float)
             values_a = np.stack([_table(PA, _values_on(A, PA))[0] for _, A, _ in terms])
             values_b = np.stack([_table(PB, _values_on(B, PB))[0] for _, _, B in terms])
-            la, ca = values_a.shape[1:]
-            lb, cb = values_b.shape[1:]
             with np.errstate(over="ignore", invalid="ignore"):   # scales are checked later
                 product = ((values_a * weights[:, None, None]).reshape(len(terms), -1).T
                            @ values_b.reshape(len(terms), -1))          # (i e, k f)
-            data = product.reshape(la, ca, lb, cb).transpose(0, 2, 1, 3)[stored]
+            data = np.take(product.ravel(), positions)
         else:
             data = np.zeros(indices.size)
         matrix = cls((data, indices, indptr), shape=full_shape if shape is None else shape)
@@ -143,34 +153,46 @@ def kronecker_sums(sums: Sequence[Sequence[tuple[float, sp.spmatrix, sp.spmatrix
 def check_bending(surface: Surface, material: Material) -> None:
     """Refuse bending weights that a patch's bases cannot carry.
 
-    ``w20`` (``w02``) needs degree ``>= 2`` in ``u`` (``v``) and a ``C^1`` basis there: at a
-    ``C^0`` knot line the surface may kink and ``d_uu`` is not square integrable.
+    ``w20`` (``w02``) needs degree ``>= 2`` in ``u`` (``v``) (second derivatives). A
+    ``C^0`` knot line is integrated span by span, and the model couples the rotation
+    across it (:mod:`splinedeform.physics.coupling_model`).
     """
     for name, basis, weight in (("u", surface.basis_u, material.w20),
                                 ("v", surface.basis_v, material.w02)):
         if weight and basis.degree < 2:
             raise InputError(f"bending weight w{'20' if name == 'u' else '02'} needs degree "
                              f">= 2 in {name} (second derivatives), got {basis.degree}")
-        if weight and getattr(basis, "continuity", basis.degree - 1) < 1:
-            key = f"w{'20' if name == 'u' else '02'}"
-            error = InputError(c0_refusal(basis, name, f"bending weight {key}")
-                               + "; or use tension weights only (w10, w01)")
-            error.key = f"material.{key}"  # type: ignore[attr-defined]
-            raise error
+
+
+def gram_matrices(surface: Surface) -> tuple[list[sp.csr_matrix], list[sp.csr_matrix]]:
+    """The 1-D Gram matrices ``G_a = ∫ N^(a) N^(a)ᵀ`` of both directions, ``a ≤ min(2, n)``."""
+    top = lambda b: min(2, b.degree)  # noqa: E731
+    return ([gram_matrix(surface.basis_u, a) for a in range(top(surface.basis_u) + 1)],
+            [gram_matrix(surface.basis_v, a) for a in range(top(surface.basis_v) + 1)])
 
 
 def patch_matrices(surface: Surface, material: Material, physics: str, lumped: bool
-                   ) -> tuple[list[sp.csr_matrix], list[sp.csr_matrix], sp.csr_matrix,
-                              sp.csr_matrix]:
+                   ) -> tuple[list[sp.csr_matrix] | None, list[sp.csr_matrix] | None,
+                              sp.csr_matrix, sp.csr_matrix]:
     """One patch's 1-D Gram matrices and full ``(K, M)`` (``n_u n_v`` square).
 
-    ``parametric``: ``K = Σ w G_a^u ⊗ G_b^v``, ``M = μ G_0^u ⊗ G_0^v`` (module docstring);
-    ``intrinsic``: :func:`splinedeform.physics.intrinsic.matrices`. ``lumped`` replaces
-    ``M`` by its row sums on the diagonal. Returns ``(gram_u, gram_v, K, M)``.
+    ``parametric``: ``K = Σ w G_a^u ⊗ G_b^v``, ``M = μ G_0^u ⊗ G_0^v`` (module docstring),
+    or, for general weights (:attr:`~splinedeform.Surface.net_weights`), element by
+    element on the rational basis (:func:`splinedeform.physics.rational_plate.matrices`;
+    no Gram factors: ``None, None``); ``intrinsic``:
+    :func:`splinedeform.physics.intrinsic.matrices`. ``lumped`` replaces ``M`` by its row
+    sums on the diagonal. Returns ``(gram_u, gram_v, K, M)``.
     """
-    top = lambda b: min(2, b.degree)  # noqa: E731
-    gram_u = [gram_matrix(surface.basis_u, a) for a in range(top(surface.basis_u) + 1)]
-    gram_v = [gram_matrix(surface.basis_v, a) for a in range(top(surface.basis_v) + 1)]
+    if surface.net_weights is not None:
+        if physics == "intrinsic":
+            K, M = intrinsic.matrices(surface, material, lumped)
+        else:
+            K, M = rational_plate.matrices(surface.basis_u, surface.basis_v,
+                                           surface.net_weights, material)
+            if lumped:
+                M = sp.diags(np.asarray(M.sum(axis=1)).ravel(), format="csr")
+        return None, None, K, M
+    gram_u, gram_v = gram_matrices(surface)
     if physics == "intrinsic":
         K, M = intrinsic.matrices(surface, material, lumped)
     else:

@@ -83,6 +83,50 @@ def edge_conditions(boundary: str | Mapping[str, str]) -> dict[str, str]:
     return out
 
 
+LOOP_PRESETS = ("free", "pinned", "clamped")
+
+
+def trim_conditions(boundary: str | Mapping[str, str], loops: tuple[str, ...],
+                    rectangle: bool = False) -> tuple[dict[str, str], dict[str, str]]:
+    """Presets of the rectangle's edges and of the trim loops of a trimmed surface.
+
+    A preset name holds every trim loop; a mapping names edges (``u0`` …) and loops
+    (``outer``, ``hole1`` …), missing ones free. The rectangle's edges bound the region
+    only when the outer loop is the rectangle itself (``rectangle``): then they take the
+    presets (a preset name holds them too) and the loop ``outer`` is theirs; otherwise
+    they lie outside the region and any preset but ``free`` there is refused.
+    """
+    if isinstance(boundary, str):
+        if boundary not in LOOP_PRESETS:
+            raise InputError(f"a trim loop's preset must be one of {LOOP_PRESETS}, got "
+                             f"{boundary!r}")
+        presets = {name: boundary for name in loops}
+        if rectangle:
+            presets["outer"] = "free"
+        return {e: boundary if rectangle else "free" for e in EDGES}, presets
+    if not isinstance(boundary, Mapping):
+        raise InputError(f"boundary must be a preset name or a mapping edge/loop -> preset, "
+                         f"got {type(boundary).__name__}")
+    unknown = set(boundary) - set(EDGES) - set(loops)
+    if unknown:
+        raise InputError(f"unknown boundary edge(s) or loop(s) {sorted(unknown)} of a trimmed "
+                         f"surface; its loops are {loops}, its edges {EDGES}")
+    edges = {e: boundary.get(e, "free") for e in EDGES}
+    presets = {name: boundary.get(name, "free") for name in loops}
+    for name, preset in {**edges, **presets}.items():
+        if preset not in LOOP_PRESETS:
+            raise InputError(f"boundary.{name} must be one of {LOOP_PRESETS}, got {preset!r}")
+    held = [e for e, preset in edges.items() if preset != "free"]
+    if held and not rectangle:
+        raise InputError(f"boundary.{held[0]} = {edges[held[0]]!r}: the trimmed region is "
+                         f"bounded by its trim loops {loops}, not by the rectangle's edges "
+                         "(make the outer loop the rectangle itself to hold them)")
+    if rectangle and presets["outer"] != "free":
+        raise InputError(f"boundary.outer = {presets['outer']!r}: the outer loop is the "
+                         f"rectangle itself; hold its edges {EDGES} instead")
+    return edges, presets
+
+
 def end_constraints(basis: BSplineBasis, end: int, preset: str) -> sp.csr_matrix:
     """Rows ``D^j b(x_e)``, ``j < r``, with ``r = 0, 1, 2`` for free, pinned, clamped."""
     order = {"free": 0, "pole": 0, "pinned": 1, "clamped": 2}[preset]

@@ -18,6 +18,7 @@ import os
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -29,7 +30,11 @@ from .cad_units import check_units, rhino_name
 from .errors import InputError, InputWarning
 from .export.atomic import atomic_path
 from .knots import KnotVectorBasis, RationalBasis
+from .rational import clamped, product_factors
 from .surface import Basis, Surface
+
+if TYPE_CHECKING:
+    from .trim.loops import TrimDomain
 
 #: relative tolerance for weights to count as a product ``a_i b_j`` (or as all equal)
 WEIGHT_TOL = 1e-12
@@ -115,16 +120,28 @@ def surface_from_patch(patch: NurbsPatch, name: str = "cad surface",
 
     Knots are translated so the parameter domain starts at 0 (their spacing, hence the
     parametrisation, is kept). Equal weights give polynomial :class:`KnotVectorBasis`
-    directions (exact Gram matrices). Otherwise the weights must be a product
-    ``w_ij = a_i b_j`` (surfaces of revolution, extrusions and ruled conics are): then
-    ``R_ij = R_i(u) R_j(v)`` with ``R_i = a_i N_i / Σ a_k N_k``, and the Kronecker
-    structure of the model survives. Other weights are refused.
+    directions (exact Gram matrices). Weights that are a product ``w_ij = a_i b_j``
+    (surfaces of revolution, extrusions and ruled conics) give ``R_ij = R_i(u) R_j(v)``
+    with ``R_i = a_i N_i / Σ a_k N_k``, and the Kronecker structure of the model survives.
+    Other weights are kept per control point (:attr:`Surface.net_weights`; the rational
+    basis element by element, :mod:`splinedeform.rational`).
     """
     bu = KnotVectorBasis(patch.degrees[0], patch.knots_u)
     bv = KnotVectorBasis(patch.degrees[1], patch.knots_v)
     bu, bv = bu.shifted(bu.domain[0]), bv.shifted(bv.domain[0])
     warn_open_seams(patch, source)
-    a, b = weight_factors(np.asarray(patch.weights, dtype=float), source)
+    w = np.asarray(patch.weights, dtype=float)
+    factors = weight_factors(w)
+    if factors is None:
+        for direction, basis in (("u", bu), ("v", bv)):
+            if not clamped(basis):
+                raise InputError(f"{source}: its weights are not a product w_ij = a_i b_j "
+                                 f"and its knot vector in {direction} is not clamped (end "
+                                 "knots repeated degree + 1 times); general weights need "
+                                 "clamped knots: re-export the surface with clamped knots")
+        return Surface(np.asarray(patch.points, dtype=float), bu, bv, name=name,
+                       net_weights=w)
+    a, b = factors
     basis_u: Basis = bu if np.ptp(a) <= WEIGHT_TOL * a.max() else RationalBasis(bu, a)
     basis_v: Basis = bv if np.ptp(b) <= WEIGHT_TOL * b.max() else RationalBasis(bv, b)
     return Surface(np.asarray(patch.points, dtype=float), basis_u, basis_v, name=name)
@@ -150,17 +167,11 @@ def warn_open_seams(patch: NurbsPatch, source: str = "NURBS patch") -> None:
                           stacklevel=3)
 
 
-def weight_factors(w: NDArray[np.float64], source: str = "NURBS patch"
-                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Factors ``a, b`` with ``w = a bᵀ`` (one ``b_j`` is 1); refuse weights of higher rank."""
-    j = int(np.argmax(w.max(axis=0)))
-    a = w[:, j].copy()
-    b = w[int(np.argmax(a))] / a.max()
-    if np.abs(w - np.outer(a, b)).max() > WEIGHT_TOL * w.max():
-        raise InputError(f"{source}: its weights are not a product w_ij = a_i b_j (as for "
-                         "surfaces of revolution and extrusions); a surface with general "
-                         "weights cannot be deformed on the tensor-product model")
-    return a, b
+def weight_factors(w: NDArray[np.float64]
+                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+    """Factors ``a, b`` with ``w = a bᵀ`` within :data:`WEIGHT_TOL` (one ``b_j`` is 1), or
+    None for general weights (:func:`splinedeform.rational.product_factors`)."""
+    return product_factors(w, WEIGHT_TOL)
 
 
 def patch_from_surface(surface: Surface, control_points: NDArray[np.float64] | None = None
@@ -170,20 +181,21 @@ def patch_from_surface(surface: Surface, control_points: NDArray[np.float64] | N
     Open, uniform and general knot vectors are written as they are (Höllig's uniform
     layout is an unclamped knot vector); a periodic direction is unwrapped into the
     uniform layout on the same cells with its first ``n`` control points repeated at
-    the end. Weights are ``a_i b_j`` from rational directions, 1 elsewhere.
+    the end. Weights are the surface's :attr:`~Surface.weights` (general ones as they are,
+    ``a_i b_j`` from rational directions, 1 elsewhere), unwrapped like the points.
     """
     P = surface.control_points if control_points is None else np.asarray(control_points, float)
-    knots, weights = [], []
+    w = surface.weights
+    knots = []
     for axis, basis in enumerate((surface.basis_u, surface.basis_v)):
         if isinstance(basis, BSplineBasis) and basis.periodic:
             n, m = basis.degree, basis.cells
             P = np.take(P, np.mod(np.arange(m + n) - n, m), axis=axis)
+            w = np.take(w, np.mod(np.arange(m + n) - n, m), axis=axis)
             basis = BSplineBasis(n, m, basis.length, "uniform")
         knots.append(np.asarray(basis.knots, dtype=float))
-        weights.append(np.asarray(basis.weights) if isinstance(basis, RationalBasis)
-                       else np.ones(basis.size))
     return NurbsPatch((surface.basis_u.degree, surface.basis_v.degree), knots[0], knots[1],
-                      P, np.outer(*weights))
+                      P, np.array(w))
 
 
 #: CAD file suffixes and what reads them
@@ -191,13 +203,20 @@ CAD_SUFFIXES = {".3dm": "openNURBS", ".igs": "IGES", ".iges": "IGES", ".stp": "S
                 ".step": "STEP"}
 
 
-def read_cad(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
-    """Surface number ``face`` of a CAD file, chosen by its suffix (see :data:`CAD_SUFFIXES`)."""
-    path = Path(path)
+def cad_kind(path: Path) -> str:
+    """The format of a CAD file by its suffix (a value of :data:`CAD_SUFFIXES`); an
+    ``InputError`` for any other suffix."""
     kind = CAD_SUFFIXES.get(path.suffix.lower())
     if kind is None:
         raise InputError(f"{path}: not a CAD file (expected one of "
                          f"{', '.join(CAD_SUFFIXES)}), got suffix {path.suffix or 'none'!r}")
+    return kind
+
+
+def read_cad(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
+    """Surface number ``face`` of a CAD file, chosen by its suffix (see :data:`CAD_SUFFIXES`)."""
+    path = Path(path)
+    kind = cad_kind(path)
     if kind == "openNURBS":
         return read_3dm(path, face)
     from .cad_step import read_step   # STEP and IGES: OpenCASCADE, the 'cad-step' extra
@@ -206,17 +225,22 @@ def read_cad(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
 
 
 def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch],
-              names: list[str] | None = None, units: str | None = None) -> Path:
+              names: list[str] | None = None, units: str | None = None,
+              trims: list[TrimDomain | None] | None = None) -> Path:
     """Write ``patches`` as NURBS surfaces to a ``.3dm`` file (atomically); return its path.
 
     ``names`` label the objects (openNURBS object names), one per patch. ``units`` (a key
     of :data:`splinedeform.cad_units.UNITS`; default: the first patch's) is the file's
     ``ModelUnitSystem``; ``None`` when not known (openNURBS ``UnitSystem.None``).
+    ``trims`` (one per patch, None for an untrimmed one) are written beside their surface
+    as curves in its ``(u, v)`` (:func:`splinedeform.cad_trims_3dm.add_trim_curves`).
     """
     r3 = _rhino3dm()
     path = Path(path)
     if names is not None and len(names) != len(patches):
         raise InputError(f"{len(names)} object names for {len(patches)} surfaces")
+    if trims is not None and len(trims) != len(patches):
+        raise InputError(f"{len(trims)} trims for {len(patches)} surfaces")
     if units is None and patches:
         units = patches[0].units
     model = r3.File3dm()
@@ -236,6 +260,11 @@ def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch],
         if names is not None:
             attributes.Name = names[index]
         model.Objects.AddSurface(srf, attributes)
+        if trims is not None and trims[index] is not None:
+            from .cad_trims_3dm import add_trim_curves
+
+            add_trim_curves(model, r3, trims[index], len(model.Objects) - 1,
+                            names[index] if names is not None else f"surface {index}")
     with atomic_path(path) as tmp:
         if not model.Write(str(tmp), 7):
             raise InputError(f"{path}: openNURBS could not write the file")
@@ -262,11 +291,13 @@ def frame_patches(surface: Surface, times: NDArray[np.float64], nets: NDArray[np
 
 def write_frames_3dm(path: str | os.PathLike, surface: Surface, times: NDArray[np.float64],
                      nets: NDArray[np.float64], label: str = "t",
-                     units: str | None = None) -> Path:
+                     units: str | None = None, trim: TrimDomain | None = None) -> Path:
     """The initial surface and every frame as named NURBS surfaces in one ``.3dm`` file
     (object ``k + 1`` is frame ``k``; see :func:`frame_patches`), in ``units`` (see
-    :func:`write_3dm`). Written atomically."""
-    return write_3dm(path, *frame_patches(surface, times, nets, label), units=units)
+    :func:`write_3dm`), each with the trim loops ``trim`` when given. Written atomically."""
+    patches, names = frame_patches(surface, times, nets, label)
+    return write_3dm(path, patches, names, units=units,
+                     trims=None if trim is None else [trim] * len(patches))
 
 
 def read_3dm(path: str | os.PathLike, face: int = 0) -> NurbsPatch:

@@ -102,6 +102,12 @@ def list_3dm_arrays(path: Path) -> dict[str, Any]:
                 entry["closed"] = (bool(surface.IsClosed(0)), bool(surface.IsClosed(1)))
                 entry["periodic"] = (bool(surface.IsPeriodic(0)), bool(surface.IsPeriodic(1)))
                 entry.update(_patch_from_rhino(surface.ToNurbsSurface(), f"{path} object {index}"))
+                from .cad_trims import listed
+                from .cad_trims_3dm import member_trims
+
+                entry.update(listed(lambda: member_trims(
+                    model, r3, index if kind == "surface" else geometry, member,
+                    f"{path} face {len(faces)}")))
             except InputError as exc:
                 entry["error"] = str(exc)
             faces.append(entry)

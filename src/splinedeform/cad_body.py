@@ -7,8 +7,8 @@ face numbers as ``splinedeform faces`` lists them, or object names and layers), 
 each a deformable :class:`~splinedeform.surface.Surface`
 (:func:`splinedeform.cad.surface_from_patch`) and finds the interfaces between them from
 the file's edges (:func:`splinedeform.cad_topology.body_topology`). A face that cannot
-be deformed (unreadable, general weights) is skipped, and ``info`` says why; a trimmed
-face is taken untrimmed, with one warning line naming it.
+be deformed (unreadable, general weights on unclamped knots) is skipped, and ``info``
+says why; a trimmed face is taken untrimmed, with one warning line naming it.
 """
 
 from __future__ import annotations

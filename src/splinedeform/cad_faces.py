@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .cad import SEAM_TOL, WEIGHT_TOL, weight_factors
+from .cad_trims import trim_summary
 from .errors import InputError
 from .knots import KnotVectorBasis
 from .quadrature import gauss_points
@@ -71,13 +72,17 @@ def _describe(number: int, entry: dict[str, Any]) -> dict[str, Any]:
     points, w = np.asarray(entry["points"], float), np.asarray(entry["weights"], float)
     whole = area(bases, points, w)
     inside = entry.get("trimmed_area")
-    trimmed = is_trimmed(entry, whole)
+    loops = trim_summary(entry, f"face {number}")
+    fraction = loops["trimmed_fraction"]
+    trimmed = is_trimmed(entry, whole) or (fraction is not None
+                                           and fraction < 1 - TRIM_AREA_TOL)
     return {**out, "degrees": list(degrees), "net": list(w.shape), "weights": _weights(w),
             "trimmed": trimmed, "closed": [bool(c) for c in entry["closed"]],
             "periodic": [bool(c) for c in entry["periodic"]],
             "c0_knots": {d: [float(x) for x in b.c0_knots] for d, b in zip("uv", bases)},
             "degenerate": degenerate_edges(points), "area": whole,
-            "trimmed_area": None if inside is None else abs(float(inside))}
+            "trimmed_area": None if inside is None else abs(float(inside)),
+            **loops}
 
 
 def is_trimmed(entry: dict[str, Any], whole: float | None = None) -> bool:
@@ -98,11 +103,7 @@ def _weights(w: NDArray[np.float64]) -> str:
     """``"1"`` (polynomial), ``"product"`` (``a_i b_j``) or ``"general"``."""
     if np.ptp(w) <= WEIGHT_TOL * w.max():
         return "1"
-    try:
-        weight_factors(w)
-    except InputError:
-        return "general"
-    return "product"
+    return "product" if weight_factors(w) is not None else "general"
 
 
 def degenerate_edges(points: NDArray[np.float64]) -> list[str]:
@@ -131,7 +132,7 @@ def area(bases: list[KnotVectorBasis], points: NDArray[np.float64],
 def faces_text(listing: dict[str, Any]) -> str:
     """The listing as a table, one line per face."""
     head = ("face", "object", "name", "layer", "kind", "degree", "net", "weights", "trimmed",
-            "closed", "periodic", "C0 knots", "poles", "area")
+            "closed", "periodic", "C0 knots", "poles", "area", "loops", "inside")
     rows = []
     for f in listing["faces"]:
         if "error" in f:
@@ -144,7 +145,7 @@ def faces_text(listing: dict[str, Any]) -> str:
                      f["kind"], "x".join(map(str, f["degrees"])), "x".join(map(str, f["net"])),
                      f["weights"], "yes" if f["trimmed"] else "no", uv(f["closed"]),
                      uv(f["periodic"]), c0, ",".join(f["degenerate"]) or "-",
-                     f"{f['area']:.6g}"))
+                     f"{f['area']:.6g}", *_loops_text(f)))
     widths = [max([len(head[k])] + [len(r[k]) for r in rows if len(r) > k])
               for k in range(len(head))]
     widths[5] = max([len(head[5])] + [len(r[5]) for r in rows if len(r) > 6])
@@ -166,6 +167,17 @@ def topology_line(topology: dict[str, Any]) -> str:
     if topology["off_sides"]:
         line += f", {topology['off_sides']} on trimming loops (not joined)"
     return (line + f"; {len(topology['interfaces'])} interface(s), {conforming} conforming")
+
+
+def _loops_text(face: dict[str, Any]) -> tuple[str, str]:
+    """``("1+2", "87.2%")``: outer + inner loops and the part of the parameter box inside
+    them; ``("unread", "-")`` where the loops cannot be read, ``("-", "-")`` where there
+    are none."""
+    if face.get("trim_error"):
+        return "unread", "-"
+    if face["loops"] is None:
+        return "-", "-"
+    return f"{face['loops'][0]}+{face['loops'][1]}", f"{100 * face['trimmed_fraction']:.4g}%"
 
 
 def faces_json(listing: dict[str, Any]) -> str:

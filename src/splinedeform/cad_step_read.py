@@ -242,6 +242,20 @@ def _refuse_bad_weights(reader: Any, face: Any, bad: dict[int, tuple[tuple[int, 
 def face_arrays(face: Any, source: str) -> dict[str, Any]:
     """One face's surface as open B-spline arrays (in millimetres), with whether it was
     ``periodic`` and ``closed`` in u and v before it was opened (warns if trimmed)."""
+    spline, periodic, closed = open_spline(face, source)
+    try:
+        arrays = _arrays(spline, source)
+    except InputError:
+        raise
+    except Exception as exc:  # Standard_OutOfRange and kin: a degenerate conversion
+        raise _conversion_error(face, source, exc) from None
+    arrays["periodic"], arrays["closed"] = periodic, closed
+    return arrays
+
+
+def open_spline(face: Any, source: str) -> tuple[Any, tuple[bool, bool], tuple[bool, bool]]:
+    """``(spline, periodic, closed)``: the face's surface as an open ``Geom_BSplineSurface``
+    and whether it was periodic and closed in u and v before it was opened."""
     from OCP.BRep import BRep_Tool
     from OCP.BRepTools import BRepTools
     from OCP.GeomConvert import GeomConvert
@@ -267,14 +281,17 @@ def face_arrays(face: Any, source: str) -> dict[str, Any]:
             spline.SetUNotPeriodic()
         if spline.IsVPeriodic():
             spline.SetVNotPeriodic()
-        arrays = _arrays(spline, source)
-    except InputError:
-        raise
     except Exception as exc:  # Standard_OutOfRange and kin: a degenerate conversion
-        raise InputError(f"{source}: OpenCASCADE could not convert its surface ({kind}) to an "
-                         f"open B-spline surface ({type(exc).__name__}: {exc})") from None
-    arrays["periodic"], arrays["closed"] = periodic, closed
-    return arrays
+        raise _conversion_error(face, source, exc) from None
+    return spline, periodic, closed
+
+
+def _conversion_error(face: Any, source: str, exc: Exception) -> InputError:
+    from OCP.BRep import BRep_Tool
+
+    kind = BRep_Tool.Surface_s(face).DynamicType().Name()
+    return InputError(f"{source}: OpenCASCADE could not convert its surface ({kind}) to an "
+                      f"open B-spline surface ({type(exc).__name__}: {exc})")
 
 
 def list_step_arrays(path: Path) -> dict[str, Any]:
@@ -332,6 +349,10 @@ def faces_listing(path: Path, reader: Any, faces: list[Any], units: str | None
             arrays["points"] /= millimetres(units)
             arrays["trimmed_area"] = _area(face) / millimetres(units) ** 2
             entry.update(arrays)
+            from .cad_trims import listed
+            from .cad_trims_step import face_trim_arrays
+
+            entry.update(listed(lambda: face_trim_arrays(face, source)))
             entry["trimmed"] = _wires(face) > 1 or any("trimmed" in str(w.message)
                                                          for w in caught)
         except InputError as exc:

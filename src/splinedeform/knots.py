@@ -213,21 +213,6 @@ class KnotVectorBasis:
         return self.matrix(x, derivative).toarray()
 
 
-def c0_refusal(basis: KnotVectorBasis | RationalBasis, direction: str, needs: str) -> str:
-    """The message refusing bending energy on a basis with ``C^0`` knots: where the lines
-    are (``direction`` = value) and what to do."""
-    knots = basis.c0_knots
-    lines = ", ".join(f"{direction} = {x:.12g}" for x in knots)
-    line = "that line" if knots.size == 1 else "those lines"
-    return (f"{needs} needs a C1 basis in {direction}, but its knot vector repeats an "
-            f"interior knot {basis.degree} times (degree {basis.degree}) at {lines}: the "
-            f"surface is only C0 along {line} and may kink there, where bending energy is "
-            "undefined. A C0 line inside a face is to become an interface between two "
-            f"patches; for now split the face along {line} into separate surfaces "
-            "(surface.elevate does not help: it raises a knot's multiplicity with the "
-            "degree, so the line stays C0)")
-
-
 @dataclass(frozen=True)
 class RationalBasis:
     """Weighted (NURBS) basis ``R_k = w_k N_k / W`` with ``W = Σ_j w_j N_j``.

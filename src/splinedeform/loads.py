@@ -23,7 +23,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from .errors import InputError
 from .quadrature import gauss_points, integrals
+from .rational import weight_field
 from .surface import Surface
+from .trim.surface_trim import region_contains
 
 
 def _finite(value: float, what: str) -> float:
@@ -230,6 +232,9 @@ class Point(Load):
             if not basis.periodic and not 0.0 <= value <= basis.length:
                 raise InputError(f"point load at {name}={value:g} is outside the parameter "
                                  f"domain [0, {basis.length:g}]")
+        if surface.trim is not None and not region_contains(surface, [self.u, self.v]):
+            raise InputError(f"point load at (u, v) = ({self.u:g}, {self.v:g}) is outside the "
+                             "trimmed region of the surface")
         E = surface.evaluation_matrix(np.array([self.u]), np.array([self.v]))
         return np.asarray(E.T.toarray()) * self.force[None, :]
 
@@ -246,8 +251,17 @@ class Uniform(Load):
         object.__setattr__(self, "profile", _profile(self.profile))
 
     def field_vector(self, surface: Surface, t: float = 0.0) -> NDArray[np.float64]:
+        if surface.trim is not None:
+            return project(surface, lambda U, V: np.broadcast_to(self.force, U.shape + (3,)))
+        if surface.net_weights is not None:         # ∫∫ R_kl: no tensor product (project)
+            return project(surface, lambda U, V: np.broadcast_to(self.force, U.shape + (3,)),
+                           RATIONAL_POINTS)
         weights = np.outer(integrals(surface.basis_u), integrals(surface.basis_v)).ravel()
         return weights[:, None] * self.force[None, :]
+
+
+#: extra Gauss points per cell of a load on general weights (as the rational plate's ``n + 10``)
+RATIONAL_POINTS = 9
 
 
 def project(surface: Surface, values: Callable[[NDArray, NDArray], NDArray],
@@ -256,8 +270,22 @@ def project(surface: Surface, values: Callable[[NDArray, NDArray], NDArray],
 
     ``values(U, V)`` gets 2-D parameter grids ``(Q_u, Q_v)`` and returns ``(Q_u, Q_v, 3)``.
     With ``n + 1 + extra_points`` points per cell and direction; computed as
-    ``B_uᵀ W_u f W_v B_v`` (two sparse products per coordinate).
+    ``B_uᵀ W_u f W_v B_v`` (two sparse products per coordinate). A trimmed surface
+    integrates over its trimmed region (:func:`splinedeform.trim.model_matrices.project`,
+    ``values`` then gets the points' parameter arrays ``(Q,)``).
+
+    With general weights (:attr:`~splinedeform.Surface.net_weights`) the basis is
+    ``R_kl = w_kl b_k b_l / W``, so ``∫∫ f R_kl = w_kl ∫∫ (f / W) b_k b_l``: the same
+    products on ``f / W``, with at least :data:`RATIONAL_POINTS` more points (``1 / W``
+    is not a polynomial).
     """
+    if surface.trim is not None:
+        from .trim.model_matrices import project as project_trimmed
+
+        return project_trimmed(surface, values)
+    rational_weights = surface.net_weights
+    if rational_weights is not None:
+        extra_points = max(extra_points, RATIONAL_POINTS)
     bu, bv = surface.basis_u, surface.basis_v
     xu, wu = gauss_points(bu, bu.degree + 1 + extra_points)
     xv, wv = gauss_points(bv, bv.degree + 1 + extra_points)
@@ -269,10 +297,13 @@ def project(surface: Surface, values: Callable[[NDArray, NDArray], NDArray],
     if not np.all(np.isfinite(f)):
         raise InputError("a load function returned non-finite values")
     f = f * (wu[:, None] * wv[None, :])[..., None]
+    if rational_weights is not None:
+        f = f / weight_field(surface, U, V)[..., None]
     Bu, Bv = bu.matrix(xu), bv.matrix(xv)
     tmp = (Bu.T @ f.reshape(xu.size, -1)).reshape(bu.size, xv.size, 3)
     out = Bv.T @ tmp.transpose(1, 0, 2).reshape(xv.size, -1)
-    return np.asarray(out).reshape(bv.size, bu.size, 3).transpose(1, 0, 2).reshape(-1, 3)
+    out = np.asarray(out).reshape(bv.size, bu.size, 3).transpose(1, 0, 2).reshape(-1, 3)
+    return out if rational_weights is None else out * rational_weights.reshape(-1, 1)
 
 
 @dataclass(frozen=True)

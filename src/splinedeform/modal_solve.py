@@ -243,7 +243,7 @@ def _largest_below(basis: Any, correction: Any, report: dict[str, Any], jumps: l
     response = ModalResponse(lam, gamma + beta * lam, zero, zero,
                              [(t_j, basis.project(merged[t_j])) for t_j in order], [])
     row = basis.phi[p]                          # a DenseBasis (automatic_basis)
-    d = response(times)[0][:, :, c] @ row + correction(times)[:, p, c]
+    d = response(times)[0][:, :, c] @ row + correction.coordinate(times, p, c)
     error = report["estimate"].relative(times) * report["scale"]
     return float(np.max(np.abs(d) - error))
 
@@ -256,7 +256,8 @@ def pointwise_factor(model: Model) -> float:
         M = model.matrices()[0]
         inverse = None
         if (model.physics == "parametric" and model.mass_matrix == "consistent"
-                and model.gram_u is not None):          # one patch: M = μ G0u⊗G0v
+                and model.gram_u is not None                # one patch: M = μ G0u⊗G0v
+                and getattr(model.surface, "trim", None) is None):
             gu, gv = (np.diag(np.linalg.inv(g[0].toarray())) for g in (model.gram_u,
                                                                        model.gram_v))
             inverse = np.kron(gu, gv) / model.material.mass

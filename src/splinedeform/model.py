@@ -21,47 +21,30 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
-from .assembly import (_largest, check_bending, full_matrices, mass,  # noqa: F401
-                       patch_matrices, reduced_matrices, stiffness)
+from .assembly import (_largest, check_bending, full_matrices, gram_matrices,
+                       patch_matrices, reduced_matrices)
 from .boundary import Constraints, build_constraints
 from .errors import InputError, SingularSystemError
 from .loads import Load, as_load, static_time
 from .material import Material, check_scales
-from .physics import PHYSICS
+from .physics import intrinsic
+from .physics.coupling_model import c0_coupling
 from . import modal_solve
 from .modal_solve import check_count as _check_count
 from .solution import ModalSolution, Readout, SampledSolution, StaticSolution
 from . import spectrum
 from .solvers import modal_basis, numeric
-from .solvers.factor import factorise
 from .solvers.forcing import ReducedForcing
 from .solvers.system import KroneckerFactors, Reduction
 from .surface import Surface
 from .threads import owned
+from .static_solve import check_options, solve_stiffness  # noqa: F401
+from .trim.model_matrices import trimmed_system
 
 Array = NDArray[np.float64]
 METHODS = ("analytic", "newmark", "radau3", "radau5", "radau7", "genalpha", "rk45", "dop853",
            "radau", "bdf")
-STATIC_TRUST = 1e-6
-"""Largest estimated relative error accepted from an ill-conditioned static solve."""
 STEP_METHODS = ("newmark", "radau3", "radau5", "radau7", "genalpha")   # take a step dt
-
-
-def check_options(material: Material, mass_matrix: str, rest: str, physics: str) -> None:
-    """Refuse a material that is not one, and unknown mass, rest or physics options."""
-    if not isinstance(material, Material):
-        raise InputError(f"material must be a splinedeform.Material, got "
-                         f"{type(material).__name__}")
-    if mass_matrix not in ("consistent", "lumped"):
-        raise InputError(f"mass_matrix must be 'consistent' or 'lumped', got {mass_matrix!r}")
-    if rest not in ("initial", "none"):
-        raise InputError(f"rest must be 'initial' or 'none', got {rest!r}")
-    if physics == "shell":
-        raise InputError("physics 'shell' couples x, y and z and has its own material: use "
-                         "splinedeform.ShellModel(surface, ShellMaterial(E, nu, thickness, "
-                         "density), boundary)")
-    if physics not in PHYSICS:
-        raise InputError(f"physics must be one of {PHYSICS}, got {physics!r}")
 
 
 class Model:
@@ -86,6 +69,11 @@ class Model:
         ``parametric``: the paper's energy per unit parameter area (Kronecker matrices);
         ``intrinsic``: the same plate under tension measured on the initial surface
         (:mod:`splinedeform.physics.intrinsic`), independent of the parametrisation.
+        A trimmed surface (``surface.trim``) takes ``parametric`` over its trimmed region
+        (:mod:`splinedeform.trim.model_matrices`), with ``boundary`` naming its loops
+        (``{"outer": "clamped", "hole1": "free"}``). With bending weights, the rotation
+        across each C0 knot line is tied by a penalty
+        (:mod:`splinedeform.physics.coupling_model`), which leaves no Kronecker factors.
 
     Examples
     --------
@@ -110,7 +98,9 @@ class Model:
         self.mass_matrix = mass_matrix
         self.rest = rest
         self.physics = physics
-        self.constraints: Constraints = build_constraints(
+        trimmed = None if surface.trim is None else trimmed_system(
+            surface, material, boundary, mass_matrix == "lumped", physics, fixed, rest)
+        self.constraints: Constraints = trimmed.constraints if trimmed else build_constraints(
             surface.basis_u, surface.basis_v, boundary,
             None if fixed is None else np.asarray(fixed), surface.control_points)
         if self.constraints.n_free == 0:
@@ -122,26 +112,61 @@ class Model:
                 "(surface.cells; a CAD or control net surface: insert knots with surface.refine)")
             error.key = "boundary"  # type: ignore[attr-defined]
             raise error
-        self.gram_u, self.gram_v, K, M = patch_matrices(surface, material, physics,
-                                                        mass_matrix == "lumped")
-        T = self.constraints.T
-        self.K_full, self.M_full = K, M
-        reduced = None if physics == "intrinsic" else reduced_matrices(
-            self.gram_u, self.gram_v, material, mass_matrix == "lumped", M, self.constraints)
-        self._K, self._M = reduced or ((T.T @ K @ T).tocsc(), (T.T @ M @ T).tocsc())
+        lumped = mass_matrix == "lumped"
+        general = surface.net_weights is not None         # weights that do not factor
+        self.gram_u, self.gram_v = (None, None) if general else gram_matrices(surface)
+        # K and M on the whole net: assembled here only where the constrained matrices are
+        # made from them, else when first asked for (K_full, M_full)
+        self._full: tuple[sp.csr_matrix, sp.csr_matrix] | None = (
+            intrinsic.matrices(surface, material, lumped) if physics == "intrinsic"
+            else (trimmed.stiffness, trimmed.mass) if trimmed
+            else patch_matrices(surface, material, physics, lumped)[2:] if general else None)
+        kinks = c0_coupling(surface, material, self.constraints.edges)
+        if kinks is not None:                  # the slopes tied across each C0 line
+            K, M = self._full_matrices()
+            self._full, self.gram_u, self.gram_v = ((K + kinks).tocsr(), M), None, None
+        reduced = None if physics == "intrinsic" or trimmed or kinks is not None or general else \
+            reduced_matrices(self.gram_u, self.gram_v, material, lumped, self.constraints)
+        if reduced is None:
+            T = self.constraints.T
+            K, M = self._full_matrices()
+            self._K, self._M = (T.T @ K @ T).tocsc(), (T.T @ M @ T).tocsc()
+            self._C: sp.csc_matrix | None = None
+        else:
+            self._K, self._M, self._C = reduced
         self._finish(start)
+        if trimmed:
+            self._rigid = (trimmed.rigid_modes,)
 
     def _finish(self, start: float) -> None:
-        """Damping ``C_r = (γ/μ) M_r + β K_r``, the checks of scale and the caches."""
+        """Damping ``C_r = (γ/μ) M_r + β K_r`` (unless made with K_r), the checks of scale
+        and the caches."""
         material = self.material
+        if getattr(self, "_C", None) is None:
+            self._C = ((material.damping / material.mass) * self._M
+                       + material.rayleigh * self._K).tocsc()
         if self._M.nnz:
             check_scales(material, _largest(self._K), _largest(self._M))
-        self._C = ((material.damping / material.mass) * self._M
-                   + material.rayleigh * self._K).tocsc()
         self._eigen: tuple[Array, Array] | None = None
         self._bases: dict[tuple, modal_basis.ModalBasis] = {}
         self._rigid: tuple[int | None] | None = None
         self.timings: dict[str, float] = {"assembly": time.perf_counter() - start}
+
+    def _full_matrices(self) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        if self._full is None:
+            self._full = full_matrices(self.gram_u, self.gram_v, self.material,
+                                       self.mass_matrix == "lumped")
+        return self._full
+
+    @property
+    def K_full(self) -> sp.csr_matrix:
+        """Stiffness ``K`` of the whole net, before constraints (assembled when first used)."""
+        return self._full_matrices()[0]
+
+    @property
+    def M_full(self) -> sp.csr_matrix:
+        """Mass ``M`` of the whole net, before constraints (assembled when first used)."""
+        return self._full_matrices()[1]
 
     # -- layout --------------------------------------------------------------------
     @property
@@ -215,38 +240,7 @@ class Model:
         return StaticSolution(self.readout, d, F, {"static": time.perf_counter() - start})
 
     def _solve_stiffness(self, F: Array) -> Array:
-        message = ("the stiffness matrix is singular for these boundary conditions and weights "
-                   f"(edges {self.constraints.edges}, weights w10..w02 = "
-                   f"{[self.material.w10, self.material.w01, self.material.w20, self.material.w11, self.material.w02]}): "
-                   "some deformation has no energy. Constrain the edges the weights do not "
-                   "reach (e.g. tension only in u needs pinned u0/u1 edges), or add weights")
-        if self.rigid_modes:
-            raise SingularSystemError(message + f" ({self.rigid_modes} deformation(s) without "
-                                      "energy, counted from the weights and the constraints)")
-        try:
-            lu = getattr(self, "_stiffness_factor", None)
-            if lu is None:                     # once constrained K is SPD: a Cholesky,
-                lu = self._stiffness_factor = factorise(self._K)   # kept for further loads
-            d = lu.solve(F)
-        except RuntimeError:
-            raise SingularSystemError(message) from None
-        scale = max(np.linalg.norm(F), 1e-300)
-        residual = np.linalg.norm(self._K @ d - F) / scale
-        if np.all(np.isfinite(d)) and residual <= 1e-8:
-            return d
-        if self.rigid_modes is None or not np.all(np.isfinite(d)):
-            raise SingularSystemError(message)
-        # non-singular by structure, but ill-conditioned: one refinement step estimates
-        # the error of d (the correction's size), accepted up to STATIC_TRUST
-        correction = lu.solve(F - self._K @ d)
-        error = float(np.abs(correction).max() / max(np.abs(d).max(), 1e-300))
-        if np.isfinite(error) and error <= STATIC_TRUST:
-            return d + correction
-        raise SingularSystemError(
-            f"the stiffness matrix is not singular but too ill-conditioned to solve: relative "
-            f"residual {residual:.1g}, estimated relative error {error:.1g} (one refinement "
-            f"step) for weights w10..w02 = {[self.material.w10, self.material.w01, self.material.w20, self.material.w11, self.material.w02]}. "
-            "Raise the smallest weight, or use fewer cells or a lower degree")
+        return solve_stiffness(self, F)
 
     # -- modes -------------------------------------------------------------------------
     @owned

@@ -146,7 +146,7 @@ def _write_files(result: RunResult, folder: Path, stages: Stages) -> None:
                      "modes": "phase"}[scenario.solve.kind]
             result.outputs.append(("NURBS surfaces .3dm", write_frames_3dm(
                 folder / f"{name}.3dm", surface, times, nets, label,
-                units=result.built.units)))
+                units=result.built.units, trim=getattr(surface, "trim", None))))
     for ext, suffix in STEP_FILES.items():
         if ext in formats:
             from .cad_step import write_frames_step

@@ -20,6 +20,7 @@ from .outputs import make_report, planned_outputs, summary_rows, write_outputs
 from .load_scale import ScaledSolution, load_scale
 from .scenario import Built, Scenario, SolveSpec, _located, build, build_load
 from .pipeline_body import solve_body
+from .run_measures import displacement_per_frame, energies
 from .scenario.body import is_body
 
 #: ``progress(stage, done, total)``, called as each stage advances
@@ -357,39 +358,24 @@ def _measure(result: RunResult) -> None:
     result.energy = energies(result)
 
 
-def displacement_per_frame(surface: Any, D: Any, resolution: int) -> Any:
-    """``max_(u,v) |d_f(u, v)|`` per frame on the output grid of ``surface``, for net
-    displacements ``D (F, n_u, n_v, 3)``: ``d_f = B_u D_f B_vᵀ``."""
+def _domain_centre(surface: Any) -> tuple[float, float]:
+    """The rectangle's centre; on a trimmed surface whose region misses it, the Gauss
+    point of a whole cell inside the region nearest to it."""
     import numpy as np
 
-    uu, vv = surface.sample_parameters(resolution)
-    Bu = surface.basis_u.matrix(uu).toarray()
-    Bv = surface.basis_v.matrix(vv).toarray()
-    grid = np.einsum("ik,fklc,jl->fijc", Bu, D, Bv, optimize=True)
-    # |d| per frame, scaled so that the squares of a tiny d do not underflow
-    size = float(np.abs(grid).max(initial=0.0))
-    scale = size if 0.0 < size < np.inf else 1.0
-    return scale * np.linalg.norm(grid / scale, axis=-1).reshape(len(grid), -1).max(axis=1)
-
-
-def energies(result: RunResult) -> dict[str, Any] | None:
-    """The energies of a run: per frame for a dynamic solve, of the equilibrium for a
-    static one, None for modes."""
-    solution, kind = result.solution, result.scenario.solve.kind
-    if kind == "dynamic":
-        energy = solution.energy(result.times)
-        return {"time": result.times, "kinetic": energy.kinetic, "strain": energy.strain,
-                "work": energy.work, "total": energy.total}
-    if kind == "static":
-        energy = solution.energy()
-        return {"strain": float(energy.strain), "work": float(energy.work),
-                "total": float(energy.total)}
-    return None
-
-
-def _domain_centre(surface: Any) -> tuple[float, float]:
     (_, lu), (_, lv) = surface.domain
-    return (0.5 * lu, 0.5 * lv)
+    centre = (0.5 * lu, 0.5 * lv)
+    from .trim.surface_trim import region_contains
+
+    if surface.trim is None or region_contains(surface, centre):
+        return centre
+    from .trim import INSIDE
+    from .trim.model_matrices import quadrature_of
+
+    quad = quadrature_of(surface)
+    points = quad.points[quad.classes[quad.cell[:, 0], quad.cell[:, 1]] == INSIDE]
+    best = points[np.argmin(np.hypot(points[:, 0] - centre[0], points[:, 1] - centre[1]))]
+    return (float(best[0]), float(best[1]))
 
 
 __all__ = ["ProgressCallback", "RunResult", "make_report", "planned_outputs", "run",

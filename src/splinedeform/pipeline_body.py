@@ -87,7 +87,7 @@ def _frames(scenario: Scenario, patches: Any, solution: Any, times: Any, mode_ne
 def _measure(result: Any) -> None:
     """Each face's centre displacement per frame (the probes), the largest displacement on
     the patches' output grids per frame, and the energies."""
-    from .pipeline import displacement_per_frame, energies
+    from .run_measures import displacement_per_frame, energies
 
     scenario, body = result.scenario, result.built.surface
     F = len(result.times)

@@ -162,6 +162,9 @@ def refine_surface(surface: Surface, elevate: tuple[int, int] = (0, 0),
     direction; see the module docstring); the geometry is unchanged up to round-off.
     """
     P = np.asarray(surface.control_points, dtype=float)
+    if surface.net_weights is not None:     # general weights: the homogeneous net (w P, w)
+        P = np.concatenate([P * surface.net_weights[..., None],
+                            surface.net_weights[..., None]], axis=-1)
     bases = []
     for axis, (name, basis) in enumerate((("u", surface.basis_u), ("v", surface.basis_v))):
         new, T, weights = refine_basis(basis, elevate[axis], insert[axis], name)
@@ -172,4 +175,7 @@ def refine_surface(surface: Surface, elevate: tuple[int, int] = (0, 0),
                             0, axis)
         P = moved / (np.ones(new.size) if weights is None else weights).reshape(shape)
         bases.append(new)
+    if surface.net_weights is not None:
+        return Surface(P[..., :3] / P[..., 3:], bases[0], bases[1], name=surface.name,
+                       net_weights=P[..., 3])
     return Surface(P, bases[0], bases[1], name=surface.name)

@@ -33,10 +33,16 @@ if TYPE_CHECKING:
 Array = NDArray[np.float64]
 
 
+NO_FACTORS = ("a body of several patches, or a patch whose C0 lines are coupled, has no "
+              "Kronecker factors")
+
+
 def kronecker_reason(model: Any) -> str | None:
     """Why the Kronecker factors do not apply to ``model`` (``None`` if they do)."""
+    if getattr(getattr(model, "surface", None), "net_weights", None) is not None:
+        return "the NURBS weights are not a product a_k b_l (no Kronecker factors)"
     if getattr(model, "gram_u", True) is None:
-        return "a body of several patches has no Kronecker factors"
+        return NO_FACTORS
     if getattr(model, "physics", "parametric") != "parametric":
         return "the surface metric varies over the parameters (no Kronecker factors)"
     if model.mass_matrix != "consistent":
@@ -48,8 +54,10 @@ def kronecker_reason(model: Any) -> str | None:
 
 def separable_reason(model: Any) -> str | None:
     """Why the separable fast path does not apply to ``model`` (``None`` if it does)."""
+    if getattr(getattr(model, "surface", None), "net_weights", None) is not None:
+        return "the NURBS weights are not a product a_k b_l (no Kronecker factors)"
     if getattr(model, "gram_u", True) is None:
-        return "a body of several patches has no Kronecker factors"
+        return NO_FACTORS
     if getattr(model, "physics", "parametric") != "parametric":
         return "the surface metric varies over the parameters (no Kronecker factors)"
     if model.material.w11 != 0:
@@ -83,8 +91,13 @@ def kronecker_factors(model: Model) -> KroneckerFactors:
 def rigid_count(model: Model) -> int | None:
     """Dimension of ``null K_r`` (:func:`splinedeform.solvers.rigid.rigid_count`)."""
     if model.physics == "intrinsic":
-        # T |∇_S d|²: zero on constants only; without tension no structure is known
-        terms = None if model.material.w10 == 0 else [(1, 0), (0, 1)]
+        # T |∇_S d|²: zero on constants only. Without tension D (Δ_S d)² vanishes on
+        # harmonic fields, which a clamped edge's zero value and slope make zero (unique
+        # continuation, span to span); otherwise no structure is known
+        if model.material.w10 == 0:
+            clamped = model.material.w20 > 0 and "clamped" in model.constraints.edges.values()
+            return 0 if clamped else None
+        terms = [(1, 0), (0, 1)]
     else:
         terms = rigid.parametric_terms(model.material)
     return rigid.rigid_count(terms, model.surface.basis_u, model.surface.basis_v,

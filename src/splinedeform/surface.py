@@ -9,17 +9,20 @@ tensor-product operator on the flattened net is ``A_u ⊗ A_v``.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
 from .basis import BSplineBasis
+from .collocation import collocate
 from .deboor import BLOCK
 from .patches import evaluate_patch_point, evaluate_patches, patches_when_worth
 from .spans import scalar_bernstein
 from .errors import InputError
 from .knots import KnotVectorBasis, RationalBasis
+from . import rational
 
 #: the 1-D bases a surface composes: the fast layouts, a general knot vector, a weighted one
 Basis = BSplineBasis | KnotVectorBasis | RationalBasis
@@ -70,10 +73,16 @@ class Surface:
         The bases in the two parameter directions. A general knot vector must start its
         domain at 0 (``t_n = 0``; see :meth:`KnotVectorBasis.shifted`). Two rational bases
         with weights ``a_k`` and ``b_l`` make the NURBS surface with weights ``a_k b_l``.
+    net_weights : array_like, shape ``(n_u, n_v)``, optional
+        General NURBS weights ``w_kl`` on polynomial bases, for weights that are not a
+        product: the basis is ``R_kl = w_kl N_k N_l / Σ w N N`` (:mod:`splinedeform.rational`).
     fit_error : float or None
         Maximum distance to the map the net was fitted to (set by :mod:`splinedeform.shapes`).
     name : str
         A label used in reports.
+    trim : TrimDomain or None
+        The trimmed region in ``(u, v)`` (:mod:`splinedeform.trim`); ``None``: the whole
+        rectangle. Set by :meth:`with_trim`.
     """
 
     control_points: NDArray[np.float64]
@@ -81,6 +90,8 @@ class Surface:
     basis_v: Basis
     fit_error: float | None = None
     name: str = "surface"
+    trim: Any = None
+    net_weights: NDArray[np.float64] | None = None
     _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -104,11 +115,27 @@ class Surface:
                              f"{tuple(int(i) for i in bad[:2])} is {P[tuple(bad[:2])]}")
         P.setflags(write=False)
         object.__setattr__(self, "control_points", P)
+        if self.net_weights is not None:
+            self._check_net_weights()
+
+    def _check_net_weights(self) -> None:
+        """General weights: one per control point, > 0, on polynomial bases."""
+        if any(isinstance(b, RationalBasis) for b in (self.basis_u, self.basis_v)):
+            raise InputError("give NURBS weights either per direction (rational bases) or "
+                             "per control point (net_weights), not both")
+        for name, basis in (("u", self.basis_u), ("v", self.basis_v)):
+            if not rational.clamped(basis):
+                raise InputError(f"net_weights need knot vectors clamped at both ends (or "
+                                 f"periodic); direction {name} is not: on an unclamped end "
+                                 "the edge conditions would mix the weights of several rows")
+        object.__setattr__(self, "net_weights", rational.check_weights(self.net_weights,
+                                                                       self.shape))
 
     def __repr__(self) -> str:
         """One line: name, net size, degrees, knot layouts, domain (never the net itself)."""
         (_, lu), (_, lv) = self.domain
         fit = "" if self.fit_error is None else f", fit_error={self.fit_error:.3g}"
+        fit += "" if self.net_weights is None else ", general weights"
         return (f"Surface({self.name!r}, {self.shape[0]}×{self.shape[1]} control points, "
                 f"degree=({self.basis_u.degree}, {self.basis_v.degree}), "
                 f"knots=({knots_summary(self.basis_u)}, {knots_summary(self.basis_v)}), "
@@ -127,7 +154,10 @@ class Surface:
 
     @property
     def weights(self) -> NDArray[np.float64]:
-        """NURBS weights ``w_kl = a_k b_l`` of the net (``a``, ``b`` of rational directions, 1 else)."""
+        """NURBS weights of the net: :attr:`net_weights`, else ``w_kl = a_k b_l`` (``a``, ``b``
+        of rational directions, 1 else)."""
+        if self.net_weights is not None:
+            return self.net_weights
         a, b = (np.asarray(basis.weights) if isinstance(basis, RationalBasis)
                 else np.ones(basis.size) for basis in (self.basis_u, self.basis_v))
         return np.outer(a, b)
@@ -137,14 +167,24 @@ class Surface:
         return replace(self, control_points=control_points, fit_error=None,
                        name=self.name if name is None else name)
 
+    def with_trim(self, domain: Any) -> Surface:
+        """The same surface trimmed to ``domain`` (a :class:`~splinedeform.trim.TrimDomain`
+        inside the parameter rectangle), or untrimmed for ``None``."""
+        from .trim.surface_trim import checked_trim
+
+        return replace(self, trim=None if domain is None else checked_trim(self, domain))
+
     # -- evaluation -------------------------------------------------------------
     def evaluation_matrix(self, u: ArrayLike, v: ArrayLike, du: int = 0, dv: int = 0
                           ) -> sp.csr_matrix:
         """Sparse ``E`` with ``∂^{du+dv} x / ∂u^du ∂v^dv (u_i, v_i) = (E @ P.reshape(-1, 3))_i``.
 
         ``E_{i, k n_v + l} = D^{du} b_k(u_i) D^{dv} b_l(v_i)``; ``u`` and ``v`` are
-        flattened after broadcasting to a common shape.
+        flattened after broadcasting to a common shape. With :attr:`net_weights`, the
+        rational ``D^(du,dv) R_kl`` (:func:`splinedeform.rational.evaluation_matrix`).
         """
+        if self.net_weights is not None:
+            return rational.evaluation_matrix(self, u, v, du, dv)
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
         u, v = u.ravel(), v.ravel()
         iu, bu = self.basis_u.nonzero(u, du)
@@ -165,8 +205,11 @@ class Surface:
         The surface's own net is evaluated from its Bézier patches (:mod:`splinedeform.patches`,
         computed once it has been asked for as many points as it has cells); until then, and
         for another net, by the sum over the ``(n+1)²`` control points of each parameter's
-        cell, ``Σ_r Σ_s D^du b_r(u) D^dv b_s(v) p_rs``.
+        cell, ``Σ_r Σ_s D^du b_r(u) D^dv b_s(v) p_rs``. With :attr:`net_weights`, in
+        homogeneous coordinates and the quotient rule (:mod:`splinedeform.rational`).
         """
+        if self.net_weights is not None:
+            return rational.derivative(self, u, v, du, dv, control_points)
         Q = None
         own = control_points is None and _order(du) and _order(dv)
         one = type(u) in _SCALARS and type(v) in _SCALARS
@@ -222,15 +265,31 @@ class Surface:
                       control_points: ArrayLike | None = None) -> NDArray[np.float64]:
         """Tensor grid evaluation ``X[i, j] = Σ_kl p_kl D^du b_k(u_i) D^dv b_l(v_j)``.
 
-        Two sparse products ``B_u P B_vᵀ`` per coordinate; result ``(len(u), len(v), 3)``.
+        Two sparse products ``X_c = B_u P_c B_vᵀ`` for all coordinates ``c`` at once, with
+        the collocation matrices ``B_u``, ``B_v`` of the two bases (one evaluation where
+        both directions share a basis and an order); result ``(len(u), len(v), c)``.
+        With :attr:`net_weights`, the same on the homogeneous net and the quotient rule.
         """
+        if self.net_weights is not None:
+            return rational.evaluate_grid(self, u, v, du, dv, control_points)
         P = self.control_points if control_points is None else np.asarray(control_points, float)
-        Bu = _collocation(self.basis_u, u, du)
-        Bv = _collocation(self.basis_v, v, dv)
-        n_u, n_v = self.shape
-        tmp = (Bu @ P.reshape(n_u, -1)).reshape(Bu.shape[0], n_v, -1)   # (Nu, n_v, c)
-        out = Bv @ tmp.transpose(1, 0, 2).reshape(n_v, -1)               # (Nv, Nu*c)
-        return np.asarray(out).reshape(Bv.shape[0], Bu.shape[0], -1).transpose(1, 0, 2)
+        u = np.atleast_1d(np.asarray(u, dtype=float)).ravel()
+        v = np.atleast_1d(np.asarray(v, dtype=float)).ravel()
+        if du == dv and self.basis_u is self.basis_v:     # one evaluation for both
+            index, values = self.basis_u.nonzero(np.concatenate([u, v]), du)
+            Bu = index[:u.size], values[:u.size]
+            Bv = index[u.size:], values[u.size:]
+        else:
+            Bu, Bv = self.basis_u.nonzero(u, du), self.basis_v.nonzero(v, dv)
+        n_u, n_v = P.shape[:2]
+        along_u = collocate(*Bu, P.reshape(n_u, -1))            # (N_u, n_v · c), C order
+        width = along_u.shape[1] // n_v
+        # (N_u, n_v, c) -> (n_v, N_u, c): the rows moved as records of c numbers, which
+        # numpy copies faster than the strided three-number blocks of a float transpose
+        record = np.dtype((np.void, width * along_u.itemsize))
+        rows = np.ascontiguousarray(along_u.view(record).reshape(u.size, n_v).T)
+        out = collocate(*Bv, rows.view(np.float64).reshape(n_v, -1))   # (N_v, N_u · c)
+        return out.reshape(v.size, u.size, width).transpose(1, 0, 2)
 
     def normal(self, u: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
         """Unit normal ``n = x_u × x_v / |x_u × x_v|``; raises where the surface is degenerate."""
@@ -266,19 +325,6 @@ class Surface:
         u, v = self.sample_parameters(resolution)
         vertices = self.evaluate_grid(u, v, control_points=control_points).reshape(-1, 3)
         return vertices, grid_faces(u.size, v.size)
-
-
-def _collocation(basis: Basis, x: ArrayLike, derivative: int) -> sp.csr_array:
-    """``A_{ij} = D^derivative b_j(x_i)`` as a sparse array built from its CSR arrays.
-
-    The same matrix as ``basis.matrix``; ``csr_array`` skips the ``np.matrix`` layer of
-    ``csr_matrix``, whose construction costs more than these products on small grids.
-    """
-    x = np.atleast_1d(np.asarray(x, dtype=float)).ravel()
-    index, values = basis.nonzero(x, derivative)
-    width = index.shape[-1]
-    indptr = np.arange(0, x.size * width + 1, width)
-    return sp.csr_array((values.ravel(), index.ravel(), indptr), shape=(x.size, basis.size))
 
 
 def knots_summary(basis: Basis) -> str:

@@ -79,16 +79,19 @@ def _truncation(solution: Any) -> dict[str, Any]:
     return dict(getattr(solution, "truncation", None) or {})
 
 
-def automatic(case: Case, target: float, repeats: int = 3) -> Row:
+def automatic(case: Case, target: float, repeats: int = 3, times_given: bool = False) -> Row:
     """The README's call as it ships: ``Model.dynamic(load, t_end)``, then
     ``solution.control_points(frames)``, with the library's own thread setting.
 
-    No ``times=``, no ``tolerance=``: the library chooses its modes for its default accuracy
-    (:data:`splinedeform.modal_solve.DEFAULT_TOLERANCE`, any time in ``[0, t_end]``), so the
-    row reports the error measured against the reference next to ``target``, the modes the
-    default chose and its bound; nothing is retried.
+    No ``tolerance=``: the library chooses its modes for its default accuracy
+    (:data:`splinedeform.modal_solve.DEFAULT_TOLERANCE`), so the row reports the error
+    measured against the reference next to ``target``, the modes the default chose and its
+    bound; nothing is retried. The modes are chosen for any time in ``[0, t_end]``, or with
+    ``times_given`` for the case's times, passed as ``dynamic(..., times=...)`` (the call for
+    one state, docs/cost.md).
     """
-    solution, nets, setup, frames = _solve(case)
+    options = {"times": case.times} if times_given else {}
+    solution, nets, setup, frames = _solve(case, **options)
     error = relative_error(nets, case)
     report = _truncation(solution)
     modes = int(solution.basis.size)
@@ -97,11 +100,11 @@ def automatic(case: Case, target: float, repeats: int = 3) -> Row:
     row = Row(case.family, case.cells, case.model.n_free, "analytic",
               "ok" if error <= target else "not reached", error=error, modes=modes,
               bound=bound, runs=1)
-    row.setting = "default call, " + automatic_label(tolerance, modes, bound,
-                                                     case.model.n_free)
+    row.setting = ("default call, times given, " if times_given else "default call, ") + \
+        automatic_label(tolerance, modes, bound, case.model.n_free)
     runs = [(setup + frames, setup, frames)]
     while runs[0][0] < 3.0 and len(runs) < repeats:
-        _, _, s, f = _solve(case)
+        _, _, s, f = _solve(case, **options)
         runs.append((s + f, s, f))
     row.seconds, row.setup, frames = sorted(runs)[len(runs) // 2]
     row.per_frame = frames / case.times.size

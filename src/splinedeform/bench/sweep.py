@@ -8,7 +8,8 @@ budget on a smaller net or its forecast exceeds four budgets (:mod:`.bookkeeping
 forecast), with its own budget (``Study.large_budget``), and its search does not try the
 setting that missed the target more than ten times on the previous net. The
 reference is the all-modes solution, checked against DOP853 at ``rtol = 1e-12`` on the
-smallest nets; where all modes are out of reach, the automatic solution at a tolerance ten
+smallest nets (at most ``YARDSTICK_CELLS`` cells per direction: beyond, that check alone
+outlasts the budget four times over); where all modes are out of reach, the automatic solution at a tolerance ten
 times tighter, cross-checked against Radau IIA-7 with twice its passing steps over the first
 tenth of the horizon.
 """
@@ -21,7 +22,7 @@ from collections.abc import Callable
 from . import analytic
 from .bookkeeping import Row, numerical_row, predicted_seconds, skip_row
 from .cases import make_case
-from .config import Study
+from .config import YARDSTICK_CELLS, Study
 from .search import START_LEVEL, search, setting_label, substeps
 from .timing import assembly_seconds, attempt
 
@@ -56,7 +57,7 @@ def study_family(family: str, study: Study, say: Callable[[str], None]) -> list[
         if case.model.n_free <= analytic.DENSE_LIMIT:
             full = analytic.all_modes(case)
             dense.append(full)
-            if index < study.yardstick_sizes:
+            if index < study.yardstick_sizes and cells <= YARDSTICK_CELLS:
                 yardstick(case, full, budget)
             reference = None
         else:

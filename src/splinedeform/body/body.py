@@ -193,15 +193,19 @@ def insert_knots_at(surface: Surface, direction: str, values: Sequence[float]) -
                          f"direction {direction} of {surface.name!r} is {poly.kind!r}")
     a = np.ones(poly.size) if weights is None else np.asarray(weights)
     P = np.moveaxis(np.asarray(surface.control_points), axis, 0)       # (n, m, 3)
-    coefficients = np.concatenate([P * a[:, None, None], np.broadcast_to(
-        a[:, None, None], P.shape[:2] + (1,))], axis=2)
+    w = np.broadcast_to(a[:, None, None], P.shape[:2] + (1,)) if surface.net_weights is None \
+        else np.moveaxis(surface.net_weights, axis, 0)[..., None]      # general weights
+    coefficients = np.concatenate([P * w, w], axis=2)
     knots = np.asarray(poly.knots, dtype=float)
     for x in sorted(values):
         knots, coefficients = boehm_insert(knots, poly.degree, float(x), coefficients)
     new_weights = coefficients[:, 0, 3]
     new_points = coefficients[..., :3] / coefficients[..., 3:]
+    net_weights = None if surface.net_weights is None \
+        else np.moveaxis(coefficients[..., 3], 0, axis)
     new: object = KnotVectorBasis(poly.degree, knots)
     if weights is not None:
         new = RationalBasis(new, new_weights)  # type: ignore[arg-type]
     bases = (new, surface.basis_v) if axis == 0 else (surface.basis_u, new)
-    return Surface(np.moveaxis(new_points, 0, axis), bases[0], bases[1], name=surface.name)
+    return Surface(np.moveaxis(new_points, 0, axis), bases[0], bases[1], name=surface.name,
+                   net_weights=net_weights)

@@ -9,6 +9,8 @@ each), ``N = Σ n_u n_v``. The map ``d = T d_free`` is built in two steps:
 2. **Merging.** Points that must move as one are joined into classes: along a conforming
    interface the ``k``-th control point of edge ``a`` with the ``k``-th (``reversed``: the
    ``k``-th from the end) of edge ``b``; on a pole all control points of the degenerate edge.
+   A non-conforming interface merges nothing: its penalty couples it
+   (:mod:`splinedeform.physics.coupling_model`).
    The classes are the connected components of that graph (union-find, by
    :func:`scipy.sparse.csgraph.connected_components`), so a corner shared by three or more
    patches, a seam and a pole come out as one class each. With ``S`` mapping the columns
@@ -112,7 +114,7 @@ def edge_rows(surface: Surface, edge: str) -> NDArray[np.int64]:
 
 def build_body_constraints(patches: Sequence[Surface], topology: Topology,
                            presets: dict[Edge, str]) -> BodyConstraints:
-    """``T = T_b S`` (module docstring) for conforming interfaces and the given presets."""
+    """``T = T_b S`` (module docstring): conforming interfaces merged, the given presets."""
     sizes = np.array([s.shape[0] * s.shape[1] for s in patches])
     offsets = np.concatenate([[0], np.cumsum(sizes)])
     maps, columns = [], []
@@ -124,7 +126,7 @@ def build_body_constraints(patches: Sequence[Surface], topology: Topology,
     Tb = sp.block_diag(maps, format="csr")
     column_point = np.concatenate(columns)
     pairs = [np.zeros((0, 2), dtype=np.int64)]
-    for i in topology.interfaces:
+    for i in (i for i in topology.interfaces if i.conforming):
         ra = offsets[i.a] + edge_rows(patches[i.a], i.edge_a)
         rb = offsets[i.b] + edge_rows(patches[i.b], i.edge_b)
         pairs.append(np.stack([ra, rb[::-1] if i.reversed else rb], axis=1))

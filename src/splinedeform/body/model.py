@@ -5,8 +5,10 @@ are those of a single surface (:func:`splinedeform.assembly.patch_matrices`), so
 
 .. math:: K = \\operatorname{diag}(K_1, …, K_P), \\qquad M = \\operatorname{diag}(M_1, …, M_P),
 
-and the constraint map ``d = T d_free`` of :mod:`.constraints` merges the control points
-of conforming interfaces and poles and applies the edge conditions of boundary edges:
+plus the penalties coupling non-conforming interfaces and, with bending, the rotation
+across every interface and C0 line (:mod:`splinedeform.physics.coupling_model`); the
+constraint map ``d = T d_free`` of :mod:`.constraints` merges the control points of
+conforming interfaces and poles and applies the edge conditions of boundary edges:
 ``K_r = Tᵀ K T``, ``M_r = Tᵀ M T``, ``F_r = Tᵀ F``. Everything a solver or a solution needs
 (static, modes, the closed-form and numerical dynamics) is the single-surface model's
 (:class:`splinedeform.Model`), on these matrices.
@@ -30,8 +32,10 @@ from ..model import Model, check_options
 from ..readout import BodyReadout
 from ..solvers.system import Reduction
 from ..surface import Surface
+from ..physics.coupling_model import c0_coupling, interface_coupling
 from .body import Body
 from .constraints import boundary_presets, build_body_constraints
+from .interface import EDGES
 from .loads import OnPatch
 
 Array = NDArray[np.float64]
@@ -66,7 +70,7 @@ class BodyModel(Model):
     boundary : str or mapping, default "free"
         ``"free" | "pinned" | "clamped"`` for every boundary edge (an edge no other edge
         meets), or ``{(patch, edge): preset}`` (missing boundary edges are free). Interface
-        and pole edges have no preset: their control points are merged.
+        and pole edges have no preset: they are merged or coupled (Notes).
     mass_matrix : {"consistent", "lumped"}
     rest : {"initial", "none"}
     physics : {"intrinsic", "parametric"}, default "intrinsic"
@@ -80,8 +84,17 @@ class BodyModel(Model):
     Raises
     ------
     InputError
-        For a non-manifold edge (three or more patches on one edge), a non-conforming
-        interface, or bending weights across an interface (the surface is only C0 there).
+        For a non-manifold edge (three or more patches on one edge), or an interface whose
+        two edges are parametrised differently along the curve (not an affine map).
+
+    Notes
+    -----
+    Conforming interfaces, seams and poles are merged by the constraint map; a
+    non-conforming interface is coupled by a displacement penalty projected onto the finer
+    edge's splines (a penalised mortar condition); with bending weights, every interface
+    and C0 knot line also by a penalty on the slope jump across it. The factors come from
+    the material and the mesh (:mod:`splinedeform.physics.coupling_model`); the mass is
+    the patches' own.
 
     Examples
     --------
@@ -103,7 +116,7 @@ class BodyModel(Model):
             body = Body(body)
         check_options(material, mass_matrix, rest, physics)
         topology = body.topology
-        _refuse(topology, material)
+        _refuse(topology)
         self.body = body
         self.patches: tuple[Surface, ...] = body.patches
         self.surface = None            # no single surface: the read-out has the patches
@@ -121,11 +134,22 @@ class BodyModel(Model):
             raise error
         blocks = [patch_matrices(s, material, physics, mass_matrix == "lumped")[2:]
                   for s in self.patches]
-        self.K_full = sp.block_diag([k for k, _ in blocks], format="csr")
-        self.M_full = sp.block_diag([m for _, m in blocks], format="csr")
+        K = sp.block_diag([k for k, _ in blocks], format="csr")
+        M = sp.block_diag([m for _, m in blocks], format="csr")
+        offsets = self.constraints.offsets
+        size = int(offsets[-1])
+        couplings = [interface_coupling(self.patches, topology.interfaces, material,
+                                        self.constraints.edges, offsets[:-1])]
+        couplings += [c0_coupling(s, material, {e: self.constraints.edges.get((p, e), "free")
+                                                for e in EDGES}, int(offsets[p]), size)
+                      for p, s in enumerate(self.patches)]
+        for penalty in (c for c in couplings if c is not None):
+            K = (K + penalty).tocsr()
+        self._full = (K, M)
         T = self.constraints.T
-        self._K = (T.T @ self.K_full @ T).tocsc()
-        self._M = (T.T @ self.M_full @ T).tocsc()
+        self._K = (T.T @ K @ T).tocsc()
+        self._M = (T.T @ M @ T).tocsc()
+        self._C = None
         self._finish(start)
 
     # -- layout ------------------------------------------------------------------------
@@ -180,9 +204,18 @@ class BodyModel(Model):
     def rigid_modes(self) -> int | None:
         """Dimension of ``null K_r``: with tension in both directions the energy vanishes on
         constant displacements only, one per connected part of the body that no pinned or
-        clamped edge holds; ``None`` (unknown) without tension."""
+        clamped edge holds. Without tension but with bending in both directions
+        (``w20, w02 > 0``) it is 0 where a clamped edge holds every part: a field without
+        energy is a polynomial with ``d_uu = d_vv = 0`` (``Δ d = 0`` intrinsic) on each span,
+        which vanishes with its value and slope on a segment (unique continuation), and the
+        merged points and the penalties carry value and slope across every span border and
+        interface. ``None`` (unknown) otherwise."""
         m = self.material
-        if not (m.w10 > 0 and m.w01 > 0):
+        if m.w10 > 0 and m.w01 > 0:
+            holds = ("pinned", "clamped")
+        elif m.w20 > 0 and m.w02 > 0:
+            holds = ("clamped",)
+        else:
             return None
         n = len(self.patches)
         links = [(i.a, i.b) for i in self.body.topology.interfaces] or [(0, 0)]
@@ -190,32 +223,22 @@ class BodyModel(Model):
         parts, label = connected_components(graph, directed=False)
         held = np.zeros(parts, dtype=bool)
         for (p, _), preset in self.constraints.edges.items():
-            held[label[p]] |= preset != "free"
+            held[label[p]] |= preset in holds
+        if holds == ("clamped",):
+            return 0 if held.all() else None
         return int(np.sum(~held))
 
 
-def _refuse(topology: Any, material: Material) -> None:
-    """Refuse what the merged constraint map cannot couple (see :class:`BodyModel`)."""
+def _refuse(topology: Any) -> None:
+    """Refuse what neither the constraint map nor a penalty couples (see :class:`BodyModel`)."""
     if topology.non_manifold:
         group = topology.non_manifold[0]
         names = ", ".join(f"patch {p} edge {e}" for p, e in group)
         raise InputError(f"non-manifold edge: {len(group)} patch edges meet on one curve "
                          f"({names}); a body's edge joins at most two patch edges")
-    bad = [i for i in topology.interfaces if not i.conforming]
-    if bad:
-        i = bad[0]
-        raise InputError(f"non-conforming interface between patch {i.a} edge {i.edge_a} and "
-                         f"patch {i.b} edge {i.edge_b} (different knots, degrees or control "
-                         "points along the edge): refine to conforming (Body.conforming() "
-                         "inserts the missing knots where the degrees match) or wait for "
-                         "penalty coupling")
-    bending = [k for k in ("w20", "w11", "w02") if getattr(material, k)]
-    if bending and topology.interfaces:
-        i = topology.interfaces[0]
-        raise InputError(
-            f"bending weight {bending[0]} needs a C1 surface, but the patches meet at "
-            f"{len(topology.interfaces)} interface(s) (e.g. patch {i.a} edge {i.edge_a} with "
-            f"patch {i.b} edge {i.edge_b}) where merged control points make it only C0: the "
-            "surface may kink there, where bending energy is undefined, and would bend like "
-            "a hinge. The rotation across an interface is not coupled yet; use tension "
-            "weights only (w10, w01), or one patch")
+    for i, aligned in zip(topology.interfaces, topology.aligned):
+        if not aligned:
+            raise InputError(f"interface between patch {i.a} edge {i.edge_a} and patch {i.b} "
+                             f"edge {i.edge_b}: the edges meet, but their parametrisations "
+                             "along the curve are not an affine map of each other, which the "
+                             "coupling follows; reparametrise one of the two patches")

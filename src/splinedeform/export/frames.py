@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
+from ..rational import grid_nets
 from ..surface import Surface, grid_faces
 
 # -- validation of frames ----------------------------------------------------------
@@ -58,17 +59,37 @@ def tessellate_frames(surface: Surface, nets: ArrayLike, resolution: int = 32
     """Meshes of many control nets on one parameter grid, without re-assembly per frame.
 
     ``X_f = B_u P_f B_vᵀ`` per coordinate with ``(B_u)_ik = b_k(u_i)``, ``(B_v)_jl = b_l(v_j)``
-    built once. ``nets`` has shape ``(..., n_u, n_v, 3)``; returns vertices
-    ``(..., r_u r_v, 3)`` (row-major grid, as :meth:`Surface.tessellate`) and faces.
+    built once (:func:`splinedeform.rational.grid_nets`, general weights included).
+    ``nets`` has shape ``(..., n_u, n_v, 3)``; returns vertices ``(..., r_u r_v, 3)``
+    (row-major grid, as :meth:`Surface.tessellate`) and faces. A trimmed surface gives
+    the grid clipped to its trim loops instead
+    (:func:`splinedeform.trim.tessellate.clipped_grid`): the vertices inside and those
+    on the loops, ``X_f = E P_f`` with the sparse ``E_{q,(k,l)} = b_k(u_q) b_l(v_q)``.
     """
     if isinstance(resolution, bool) or not isinstance(resolution, (int, np.integer)):
         raise InputError(f"resolution must be an integer >= 2, got {resolution!r}")
     u, v = surface.sample_parameters(int(resolution))
-    Bu = surface.basis_u.matrix(u).toarray()
-    Bv = surface.basis_v.matrix(v).toarray()
+    if surface.trim is not None:
+        return _clipped_frames(surface, nets, u, v)
     P = np.asarray(nets, dtype=float)
     if P.shape[-3:] != (*surface.shape, 3):
         raise InputError(f"control nets must end in shape {(*surface.shape, 3)}, got {P.shape}")
-    X = np.einsum("ik,...klc,jl->...ijc", Bu, P, Bv, optimize=True)
+    X = grid_nets(surface, u, v, P)
     return X.reshape(*P.shape[:-3], u.size * v.size, 3), grid_faces(u.size, v.size)
 
+
+
+def _clipped_frames(surface: Surface, nets: ArrayLike, u: NDArray[np.float64],
+                    v: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """:func:`tessellate_frames` of a trimmed surface: one sparse product for all frames."""
+    from ..trim.tessellate import surface_grid
+
+    P = np.asarray(nets, dtype=float)
+    if P.shape[-3:] != (*surface.shape, 3):
+        raise InputError(f"control nets must end in shape {(*surface.shape, 3)}, got {P.shape}")
+    uv, faces = surface_grid(surface, u, v)
+    E = surface.evaluation_matrix(uv[:, 0], uv[:, 1])
+    lead = P.shape[:-3]
+    flat = np.moveaxis(P.reshape(-1, E.shape[1], 3), 0, 1).reshape(E.shape[1], -1)
+    X = np.moveaxis(np.asarray(E @ flat).reshape(len(uv), -1, 3), 1, 0)
+    return X.reshape(*lead, len(uv), 3), faces

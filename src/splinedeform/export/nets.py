@@ -256,24 +256,28 @@ def _general_basis(desc: Mapping[str, Any], size: int, where: str) -> KnotVector
 
 
 def _with_weights(basis_u: Basis, basis_v: Basis, kinds: tuple[Any, Any], weights: Any,
-                  source: Path) -> tuple[Basis, Basis]:
-    """Rational directions take their factor of the stored weights ``w = a bᵀ``."""
-    if "rational" not in kinds:
-        if weights is not None and np.ptp(real_array(weights, f"{source}: weights")) != 0:
-            raise InputError(f"{source}: weights differ but no direction is 'rational'; "
-                             "the weights of a polynomial net are all equal")
-        return basis_u, basis_v
-    from ..cad import weight_factors
-
+                  source: Path) -> tuple[Basis, Basis, NDArray[np.float64] | None]:
+    """Rational directions take their factor of the stored weights ``w = a bᵀ``; weights
+    that differ on polynomial directions are general weights (the third item)."""
     if weights is None:
-        raise InputError(f"{source}: a rational net needs weights, the file has none")
+        if "rational" in kinds:
+            raise InputError(f"{source}: a rational net needs weights, the file has none")
+        return basis_u, basis_v, None
     w = real_array(weights, f"{source}: weights")
     if w.shape != (basis_u.size, basis_v.size) or not np.all(np.isfinite(w)) or np.any(w <= 0):
-        raise InputError(f"{source}: a rational net needs weights > 0 of shape "
+        raise InputError(f"{source}: NURBS weights must be > 0 of shape "
                          f"{(basis_u.size, basis_v.size)}, got shape {w.shape}")
-    a, b = weight_factors(w, str(source))
+    if "rational" not in kinds:
+        return basis_u, basis_v, (None if np.ptp(w) == 0 else w)
+    from ..cad import weight_factors
+
+    factors = weight_factors(w)
+    if factors is None:
+        raise InputError(f"{source}: its weights are not a product w_ij = a_i b_j, but "
+                         "its directions say 'rational' (weights per direction)")
+    a, b = factors
     return (RationalBasis(basis_u, a) if kinds[0] == "rational" else basis_u,
-            RationalBasis(basis_v, b) if kinds[1] == "rational" else basis_v)
+            RationalBasis(basis_v, b) if kinds[1] == "rational" else basis_v, None)
 
 
 def _check_knots(knots: Any, basis: BSplineBasis, where: str) -> None:
@@ -321,10 +325,10 @@ def read_control_net(path: str | os.PathLike[str], frame: int = -1) -> Surface:
                          f"(n_u, n_v, 3), got {P.shape}")
     basis_u = _basis_from(data["u"], P.shape[1], f"{source}: basis.u")
     basis_v = _basis_from(data["v"], P.shape[2], f"{source}: basis.v")
-    basis_u, basis_v = _with_weights(basis_u, basis_v, (data["u"]["kind"], data["v"]["kind"]),
-                                     data.get("weights"), source)
+    basis_u, basis_v, net_weights = _with_weights(
+        basis_u, basis_v, (data["u"]["kind"], data["v"]["kind"]), data.get("weights"), source)
     if isinstance(frame, bool) or not isinstance(frame, (int, np.integer)) \
             or not -P.shape[0] <= frame < P.shape[0]:
         raise InputError(f"frame must be an integer in [{-P.shape[0]}, {P.shape[0] - 1}] "
                          f"for {source.name} ({P.shape[0]} frame(s)), got {frame!r}")
-    return Surface(P[frame], basis_u, basis_v, name=str(data["name"]))
+    return Surface(P[frame], basis_u, basis_v, name=str(data["name"]), net_weights=net_weights)

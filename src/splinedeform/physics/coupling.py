@@ -226,7 +226,8 @@ def _rotation_jump(line: Line, off_a: int, off_b: int, size: int) -> sp.csr_matr
 
 
 def shell_c0_rotation_penalty(surface: Surface, direction: str, knot: float, beta: float,
-                              offset: int = 0, size: int | None = None, crosspoints: int = 0
+                              offset: int = 0, size: int | None = None,
+                              crosspoints: int | tuple[int, int] = 0
                               ) -> sp.csr_matrix:
     """:func:`shell_rotation_penalty` across a C0 line (:func:`c0_rotation_penalty`'s layout,
     interleaved): the crease of the rest shape there is kept."""
@@ -289,15 +290,17 @@ def c0_sides(surface: Surface, direction: str, knot: float) -> tuple[Side, Side]
 
 
 def c0_rotation_penalty(surface: Surface, direction: str, knot: float, beta: float,
-                        offset: int = 0, size: int | None = None, crosspoints: int = 0
+                        offset: int = 0, size: int | None = None,
+                        crosspoints: int | tuple[int, int] = 0
                         ) -> sp.csr_matrix:
     """Matrix of ``½ β ∫ (∂_{n_-} d_- + ∂_{n_+} d_+)² ds`` along the C0 line ``direction = knot``.
 
     ``d_-`` and ``d_+`` are the one-sided limits from the spans below and above the knot
     (:func:`splinedeform.knots.one_sided`), with their outward conormals: the interface
     between the two sides, on the same splines along the line (so the projection changes
-    nothing but the ``crosspoints``). The surface's control points are ``offset …`` of
-    ``size`` global ones (default: the surface alone).
+    nothing but the ``crosspoints``, at the line's start and end or one count for both).
+    The surface's control points are ``offset …`` of ``size`` global ones (default: the
+    surface alone).
     """
     line = _c0_line(surface, direction, knot)
     count = surface.shape[0] * surface.shape[1]

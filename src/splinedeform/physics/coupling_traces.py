@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..knots import one_sided
+from ..rational import rational_operators
 from ..surface import Surface
 
 Array = NDArray[np.float64]
@@ -104,6 +105,8 @@ class Side:
                                  shape=(s.size, surface.shape[0] * n_v))
 
         V, Df, Dr = operator(0, 0), operator(1, 0), operator(0, 1)
+        if surface.net_weights is not None:          # general weights: the quotient rule
+            V, (Df, Dr) = rational_operators(V, (Df, Dr), surface.net_weights)
         P = surface.control_points.reshape(-1, 3)
         x, x_f, x_r = V @ P, Df @ P, Dr @ P
         c = np.einsum("qi,qi->q", x_f, x_r) / np.einsum("qi,qi->q", x_r, x_r)

@@ -85,7 +85,8 @@ def matrices(surface: Surface, material: Material, lumped: bool = False
         p = slice(rows.start * qu, rows.stop * qu)
         part = replace(G, index_u=G.index_u[p], values_u=G.values_u[:, p], weight=G.weight[p],
                        a=G.a[:, p], a2=G.a2[:, p], sqrt_g=G.sqrt_g[p], g_inv=G.g_inv[p],
-                       gamma=G.gamma[:, :, p])
+                       gamma=G.gamma[:, :, p],
+                       shapes=None if G.shapes is None else {k: r[p] for k, r in G.shapes.items()})
         return part, metric.shape_derivatives(part), part.weight * part.sqrt_g
 
     def stiffness(rows: slice) -> Array:

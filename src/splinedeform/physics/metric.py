@@ -16,9 +16,12 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..quadrature import gauss_points
+from ..rational import basis_derivatives
 from ..surface import Surface
 
 Array = NDArray[np.float64]
+#: derivative orders ``(p, q)``, ``p + q <= 2``, of the shape functions
+ORDERS = ((0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2))
 DEGENERATE = 1e-9      # √g below this fraction of its largest value is a degenerate metric
 
 
@@ -42,6 +45,8 @@ class Grid:
     sqrt_g: Array
     g_inv: Array
     gamma: Array
+    #: ``D^p_u D^q_v R_k`` of a surface with general weights (:func:`shape_derivatives`)
+    shapes: dict[tuple[int, int], Array] | None = None
 
 
 def poles(surface: Surface, tol: float = 1e-10) -> tuple[str, ...]:
@@ -100,7 +105,15 @@ def grid(surface: Surface, extra_points: int = 2) -> Grid:
         return sp.csr_matrix((values.ravel(), (rows.ravel(), index.ravel())),
                              shape=(index.shape[0], n))
 
+    shapes = None
+    if surface.net_weights is not None:       # the rational basis R_k of general weights
+        _, R = basis_derivatives(iu[:, None], Bu[:, :, None], iv[None], Bv[:, None],
+                                 surface.net_weights, ORDERS)
+        shapes = {k: R[k] for k in ORDERS}
+
     def derivative(p: int, q: int) -> Array:
+        if shapes is not None:      # homogeneous coordinates and the quotient rule
+            return surface.evaluate_grid(xu, xv, p, q)
         # x_{,u^p v^q} = B_u^(p) P B_v^(q)ᵀ per coordinate, two sparse products
         tmp = (collocation(iu, Bu[p], n_u) @ P.reshape(n_u, -1)).reshape(-1, n_v, 3)
         out = collocation(iv, Bv[q], n_v) @ tmp.transpose(1, 0, 2).reshape(n_v, -1)
@@ -115,13 +128,16 @@ def grid(surface: Surface, extra_points: int = 2) -> Grid:
                       np.stack([-g[..., 1, 0], g[..., 0, 0]], -1)], -2) / det[..., None, None]
     contra = np.einsum("abij,jabc->iabc", g_inv, a)               # a^γ
     gamma = np.einsum("iabc,kabc->ikab", contra, a2)              # Γ^γ_{(11,12,22)}
-    return Grid(iu, Bu, iv, Bv, wu[:, None] * wv[None, :], a, a2, sqrt_g, g_inv, gamma)
+    return Grid(iu, Bu, iv, Bv, wu[:, None] * wv[None, :], a, a2, sqrt_g, g_inv, gamma, shapes)
 
 
 def shape_derivatives(G: Grid) -> dict[tuple[int, int], Array]:
-    """``D^p_u D^q_v N_k`` at every grid point, ``(Qu, Qv, pu·pv)`` for ``p + q <= 2``."""
+    """``D^p_u D^q_v N_k`` at every grid point, ``(Qu, Qv, pu·pv)`` for ``p + q <= 2``
+    (the rational ``R_k`` of general weights, computed with the grid)."""
+    if G.shapes is not None:
+        return G.shapes
     out = {}
-    for p, q in ((0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)):
+    for p, q in ORDERS:
         values = G.values_u[p][:, None, :, None] * G.values_v[q][None, :, None, :]
         out[p, q] = values.reshape(values.shape[0], values.shape[1], -1)
     return out

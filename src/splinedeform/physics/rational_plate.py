@@ -22,9 +22,9 @@ on random weights in ``[0.5, 2]`` (a factor 4 between neighbours), the energy of
 field is off by 3e-6 with 12 points, 1e-8 with 16, 1e-13 with 24
 (``tests/test_rational_plate.py``); CAD weights, close to 1, do much better.
 
-Not yet used by :class:`~splinedeform.Model`: a :class:`~splinedeform.Surface` carries
-weights per direction only, and :func:`splinedeform.cad.surface_from_patch` refuses
-weights that do not factor.
+Used by :func:`splinedeform.assembly.patch_matrices` for a surface with
+:attr:`~splinedeform.Surface.net_weights` (the parametric physics of
+:class:`~splinedeform.Model` and of a body).
 """
 
 from __future__ import annotations
@@ -33,15 +33,15 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
-from ..errors import InputError
 from ..knots import KnotVectorBasis
 from ..material import Material
 from ..quadrature import gauss_points
-from .metric import assemble
+from ..rational import basis_derivatives, check_weights
+from .metric import ORDERS
+from .shell import by_cell
+from .shell_assembly import Pattern, assemble_cells
 
 Array = NDArray[np.float64]
-#: derivative orders (p, q) of the basis used by the energy
-ORDERS = ((0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2))
 
 
 def rational_derivatives(basis_u: KnotVectorBasis, basis_v: KnotVectorBasis,
@@ -50,48 +50,63 @@ def rational_derivatives(basis_u: KnotVectorBasis, basis_v: KnotVectorBasis,
     """``D^p_u D^q_v R_k`` of the non-zero functions on the grid ``u × v``.
 
     Returns the flat index ``i n_v + j`` of each local function, ``(Qu, Qv, pu pv)``, and
-    ``{(p, q): (Qu, Qv, pu pv)}`` for ``p + q <= 2`` (see the module docstring).
+    ``{(p, q): (Qu, Qv, pu pv)}`` for ``p + q <= 2`` (see the module docstring), from
+    :func:`splinedeform.rational.basis_derivatives`.
     """
-    w = np.asarray(weights, dtype=float)
-    if w.shape != (basis_u.size, basis_v.size) or not np.all(w > 0):
-        raise InputError(f"general NURBS weights must be {basis_u.size} x {basis_v.size} "
-                         f"positive numbers, got shape {w.shape}")
+    w = check_weights(weights, (basis_u.size, basis_v.size), "general NURBS weights")
     iu, Bu = basis_u.nonzero_derivatives(u, 2)                  # (3, Qu, pu)
     iv, Bv = basis_v.nonzero_derivatives(v, 2)
-    local_w = w[iu[:, None, :, None], iv[None, :, None, :]]     # (Qu, Qv, pu, pv)
-    A = {(p, q): Bu[p][:, None, :, None] * Bv[q][None, :, None, :] * local_w
-         for p, q in ORDERS}
-    W = {k: a.sum(axis=(2, 3), keepdims=True) for k, a in A.items()}
-    R = {(0, 0): A[0, 0] / W[0, 0]}
-    for d in ((1, 0), (0, 1)):
-        R[d] = (A[d] - R[0, 0] * W[d]) / W[0, 0]
-    R[2, 0] = (A[2, 0] - 2 * R[1, 0] * W[1, 0] - R[0, 0] * W[2, 0]) / W[0, 0]
-    R[0, 2] = (A[0, 2] - 2 * R[0, 1] * W[0, 1] - R[0, 0] * W[0, 2]) / W[0, 0]
-    R[1, 1] = (A[1, 1] - R[1, 0] * W[0, 1] - R[0, 1] * W[1, 0] - R[0, 0] * W[1, 1]) / W[0, 0]
-    shape = local_w.shape[:2] + (-1,)
-    index = (iu[:, None, :, None] * basis_v.size + iv[None, :, None, :]).reshape(shape)
-    return index, {k: r.reshape(shape) for k, r in R.items()}
+    index, R = basis_derivatives(iu[:, None], Bu[:, :, None], iv[None], Bv[:, None], w,
+                                 ORDERS)
+    return index, {k: R[k] for k in ORDERS}
 
 
 def matrices(basis_u: KnotVectorBasis, basis_v: KnotVectorBasis, weights: Array,
              material: Material, points_per_cell: int | None = None
              ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
     """Stiffness ``K`` and consistent mass ``M`` (see the module docstring), each
-    ``(n_u n_v)²`` over the flat net ``i n_v + j``, shared by x, y and z."""
+    ``(n_u n_v)²`` over the flat net ``i n_v + j``, shared by x, y and z.
+
+    Cell by cell, a bounded number of cell rows at a time: each cell's block is ``BᵀB`` for
+    the rows ``B = [√(c_t a_q) ∂_t R]`` of its points ``q`` and terms ``t`` stacked (the
+    weights ``c_t >= 0`` of the material), scattered into a precomputed sparse pattern
+    (:mod:`.shell_assembly`), as the intrinsic physics does.
+    """
+    w = check_weights(weights, (basis_u.size, basis_v.size), "general NURBS weights")
     qu = points_per_cell or 2 * basis_u.degree + 10
     qv = points_per_cell or 2 * basis_v.degree + 10
     u, au = gauss_points(basis_u, qu)
     v, av = gauss_points(basis_v, qv)
-    index, R = rational_derivatives(basis_u, basis_v, weights, u, v)
-    dA = au[:, None, None, None] * av[None, :, None, None]
-    terms = [(material.w10, (1, 0)), (material.w01, (0, 1)), (material.w20, (2, 0)),
-             (2 * material.w11, (1, 1)), (material.w02, (0, 2))]
-    blocks = np.zeros(index.shape + index.shape[-1:])
-    for factor, order in terms:
-        if factor:
-            blocks += factor * R[order][..., :, None] * R[order][..., None, :]
-    size = basis_u.size * basis_v.size
-    K = assemble(index, blocks * dA, size)
-    M = assemble(index, material.mass * R[0, 0][..., :, None] * R[0, 0][..., None, :] * dA,
-                 size)
-    return K, M
+    iu, Bu = basis_u.nonzero_derivatives(u, 2)                  # (3, Qu, pu)
+    iv, Bv = basis_v.nonzero_derivatives(v, 2)
+    cells_u, cells_v = iu[::qu], iv[::qv]
+    pattern = Pattern.of(cells_u, cells_v, basis_u.size, basis_v.size, 1)
+    terms = [(factor, order) for factor, order in
+             ((material.w10, (1, 0)), (material.w01, (0, 1)), (material.w20, (2, 0)),
+              (2 * material.w11, (1, 1)), (material.w02, (0, 2))) if factor]
+
+    def shapes(rows: slice, orders: tuple = ORDERS
+               ) -> tuple[dict[tuple[int, int], Array], Array]:
+        p = slice(rows.start * qu, rows.stop * qu)
+        _, R = basis_derivatives(iu[p][:, None], Bu[:, p][:, :, None], iv[None], Bv[:, None],
+                                 w, orders)
+        return R, au[p][:, None] * av[None, :]
+
+    def stiffness(rows: slice) -> Array:
+        R, dA = shapes(rows)
+        k = R[0, 0].shape[-1]
+        if not terms:
+            return np.zeros((rows.stop - rows.start, cells_v.shape[0], k, k))
+        B = np.stack([np.sqrt(factor * dA)[..., None] * R[order] for factor, order in terms],
+                     axis=2)                                            # (Qa, Qv, t, k)
+        B = by_cell(B, (qu, qv))
+        B = B.reshape(B.shape[:2] + (-1, k))
+        return np.swapaxes(B, -1, -2) @ B
+
+    def mass(rows: slice) -> Array:
+        R, dA = shapes(rows, ((0, 0),))
+        N0 = by_cell(R[0, 0], (qu, qv))                                 # (A, B, q, k)
+        return np.swapaxes(N0, -1, -2) @ (by_cell(material.mass * dA, (qu, qv))[..., None] * N0)
+
+    return (assemble_cells(pattern, cells_u, cells_v, stiffness),
+            assemble_cells(pattern, cells_u, cells_v, mass))

@@ -28,7 +28,7 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from ..errors import InputError
-from ..knots import c0_refusal
+from ..rational import refuse
 from ..surface import Surface
 from . import metric
 from .shell_assembly import Pattern, assemble_cells
@@ -115,15 +115,13 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
 
     ``K = Σ_cells Σ_q Bᵀ D B`` with ``B = [B_m; B_b]`` (6 rows) and
     ``D = √g w_q diag(E t/(1−ν²) H, E t³/(12(1−ν²)) H)``, ``M = ρ t ∫ N_k N_l dA ⊗ I₃``;
-    cell by cell into a precomputed pattern (:mod:`.shell_assembly`).
+    cell by cell into a precomputed pattern (:mod:`.shell_assembly`). Across a ``C^0``
+    knot line the cells hold nothing: :class:`~.shell_model.ShellModel` adds its rotation
+    penalty (:mod:`.coupling_model`).
     """
+    refuse(surface, "the Kirchhoff–Love shell")
     if min(surface.basis_u.degree, surface.basis_v.degree) < 2:
         raise InputError("the Kirchhoff–Love shell needs degree >= 2 in u and v (curvatures)")
-    for name, basis in (("u", surface.basis_u), ("v", surface.basis_v)):
-        if getattr(basis, "continuity", basis.degree - 1) < 1:
-            error = InputError(c0_refusal(basis, name, "the Kirchhoff–Love shell"))
-            error.key = "surface"  # type: ignore[attr-defined]
-            raise error
     G = metric.grid(surface, extra_points=1)
     q = (surface.basis_u.degree + 2, surface.basis_v.degree + 2)    # Gauss points per cell
     n_u, n_v = surface.basis_u.size, surface.basis_v.size

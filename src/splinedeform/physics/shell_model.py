@@ -31,6 +31,7 @@ from ..solvers.rigid import UnresolvedSpectrum
 from ..surface import Surface
 from ..threads import owned
 from . import metric
+from .coupling_model import c0_coupling
 from .shell import ShellMaterial, matrices
 from .shell_edges import EDGES, KINDS, check_edges, constraint_matrix  # noqa: F401
 from .shell_rigid import describe, free_rigid_motions
@@ -81,10 +82,16 @@ class ShellModel:
         start = time.perf_counter()
         if not isinstance(material, ShellMaterial):
             raise InputError("a shell needs a ShellMaterial(E, nu, thickness, density)")
+        if getattr(surface, "trim", None) is not None:
+            raise InputError("the shell is not trimmed yet: a trimmed surface takes the "
+                             "parametric Model (docs/trim.md)")
         self.surface, self.material = surface, material
         self.physics = "shell"
         self.K_full, self.M_full = matrices(surface, material)
         self.edges = check_edges(surface, dict(boundary or {}))
+        kinks = c0_coupling(surface, material, self.edges)
+        if kinks is not None:                  # the crease kept across each C0 line
+            self.K_full = (self.K_full + kinks).tocsr()
         self.T = constraint_matrix(surface, self.edges, fixed)
         self._K = (self.T.T @ self.K_full @ self.T).tocsc()
         self._M = (self.T.T @ self.M_full @ self.T).tocsc()

@@ -11,6 +11,8 @@ from typing import Any, Iterator
 from ..errors import InputError, ScenarioError
 from .body import body_model, check_single_surface_loads, describe_body, is_body
 from .spec import Scenario, SurfaceSpec
+from ..trim.surface_trim import region_contains
+from .trim_build import loop_presets, trimmed
 
 
 @dataclass
@@ -55,7 +57,7 @@ def surface_and_units(scenario: Scenario) -> tuple[Any, str | None]:
     spec = scenario.surface
     surface, units = (_surface_from_cad(scenario) if spec.shape == "cad"
                       else (_surface_of_shape(scenario), None))
-    return _refined(scenario, surface), units
+    return trimmed(scenario, _refined(scenario, surface)), units
 
 
 def _refined(scenario: Scenario, surface: Any) -> Any:
@@ -268,6 +270,9 @@ def _check_parameters(scenario: Scenario, surface: Any) -> None:
             if not basis.periodic and not -1e-12 <= x <= basis.length * (1 + 1e-12):
                 raise scenario.error(path, f"{name} = {x:g} is outside the parameter domain "
                                            f"[0, {basis.length:g}] of this surface")
+        if surface.trim is not None and not region_contains(surface, [u, v]):
+            raise scenario.error(path, f"(u, v) = ({u:g}, {v:g}) is outside the trimmed "
+                                       "region of this surface (surface.trim)")
 
 
 def build(scenario: Scenario) -> Built:
@@ -320,7 +325,8 @@ def _model_on(scenario: Scenario, surface: Any, units: str | None) -> Built:
     with _located(scenario, "material"):
         material = Material(**scenario.material.weights())
     with _located(scenario, "boundary"):
-        model = Model(surface, material, boundary=scenario.boundary.edges(), fixed=fixed,
+        model = Model(surface, material, boundary={**scenario.boundary.edges(),
+                                                   **loop_presets(scenario)}, fixed=fixed,
                       mass_matrix=scenario.material.mass_matrix,
                       physics=scenario.material.physics)
     return Built(surface=surface, model=model, load=None, fixed=fixed, units=units)

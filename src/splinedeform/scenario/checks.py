@@ -152,3 +152,23 @@ def key_of(field: FieldInfo, default: Any = _REQUIRED, pair: bool = False) -> Ke
 def choice(*options: str) -> Callable[[Any], str]:
     """Checker of one string among ``options`` (a discriminator such as ``shape``)."""
     return checker(Literal[options])
+
+
+def located_checker(annotation: Any, title: str = "") -> Callable[[Any], Any]:
+    """Checker of a nested table: a problem is located at its key path inside the value
+    (``.loops[2].circle.radius``, arrays counted from 1) and says pydantic's reason."""
+    adapter = TypeAdapter(annotation)
+    text = allowed(adapter.json_schema(), title)
+
+    def check(value: Any) -> Any:
+        try:
+            return adapter.validate_python(value)
+        except ValidationError as exc:
+            error = exc.errors()[0]
+            sub = "".join(f"[{p + 1}]" if isinstance(p, int) else f".{p}"
+                          for p in error["loc"])
+            reason = error["msg"].removeprefix("Value error, ")
+            given = "" if error["type"] == "value_error" else f"; got {_describe(error['input'])}"
+            raise _Invalid(reason + given, sub=sub) from None
+    check.allowed = text  # type: ignore[attr-defined]
+    return check

@@ -12,7 +12,7 @@ import math
 from ..boundary import EDGES
 from ..model import STEP_METHODS  # noqa: F401  (re-exported for the reader)
 from . import schema as S
-from .checks import Key, choice, key_of
+from .checks import Key, choice, key_of, located_checker
 from .schema import (FORMAT_ALIASES, FORMATS, IVP_METHODS, LOAD_KINDS,  # noqa: F401
                      MASS_MATRICES, PROFILES, SHAPES, SOLVE_KINDS, TIME_MAX)
 
@@ -44,6 +44,8 @@ SURFACE_KEYS: dict[str, Key] = {
                                       "(`file`) or a CAD surface (`cad`) read from `path`"),
     **_keys(S.FromFile, (*_FITTED, "path", "frame"), path=None),
 }
+SURFACE_KEYS["trim"] = Key(located_checker(S.Trim, "{loops = [...]}"), None,
+                           SURFACE_KEYS["trim"].doc, SURFACE_KEYS["trim"].shown_default)
 
 MATERIAL_KEYS: dict[str, Key] = _keys(S.Material)
 

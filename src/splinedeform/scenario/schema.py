@@ -43,7 +43,8 @@ from .schema_types import (PROFILES, IVP_METHODS, MASS_MATRICES, CAD_UNITS, PHYS
                            SHELL_EDGES, SHELL_KEYS, PLATE_KEYS, FORMATS, FORMAT_ALIASES,
                            TIME_MAX, Real, Positive, NonNegative, Time, Integer, Text, Pair,
                            Angle, NetIndex, Cells, Knots, Preset, _Table)  # noqa: F401
-from .schema_surface import (Inserted, Added, Insertions, Elevations, Size, SIZE_DOC,
+from .schema_surface import (Trim, TrimCircle, TrimLoop, TrimSpline, TRIM_EDGES,  # noqa: F401
+                             Inserted, Added, Insertions, Elevations, Size, SIZE_DOC,
                              SHAPE_MODELS, SHAPES, Surface, _Refined, _Fitted, Plane, Tile,
                              HalfSphere, Cylinder, Torus, Saddle, FromFile, FromCad)  # noqa: F401
 

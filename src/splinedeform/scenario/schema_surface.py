@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from typing import Annotated, Any, Literal, Optional, Union
 
-from pydantic import BaseModel, ConfigDict, Field, Strict
+from pydantic import BaseModel, ConfigDict, Field, Strict, model_validator
 
 from ..basis import KNOT_KINDS
 from ..boundary import PRESETS
@@ -43,6 +43,53 @@ class _Refined(_Table):
         json_schema_extra={"doc_default": "0"})
 
 
+TRIM_EDGES = ("free", "pinned", "clamped")
+
+
+class TrimCircle(_Table):
+    centre: Pair = Field(title="[u, v]", description="centre of the circle in (u, v)")
+    radius: Positive = Field(description="radius in parameter units")
+
+
+class TrimSpline(_Table):
+    points: list[Pair] = Field(min_length=4, title="[u, v] pairs", description=(
+        "control points of a closed uniform B-spline curve in (u, v) (the curve closes "
+        "itself: the last point is not repeated)"))
+    degree: Annotated[int, Strict(), Field(ge=1, le=5)] = Field(
+        3, description="degree of the curve (needs at least degree + 2 points)")
+
+
+class TrimLoop(_Table):
+    name: Optional[Text] = Field(None, description=(
+        "a name for the loop in messages (default `outer`, `hole1`, `hole2`, … in order)"))
+    polygon: Optional[list[Pair]] = Field(None, min_length=3, title="[u, v] pairs",
+                                          description="the vertices of a closed polygon")
+    circle: Optional[TrimCircle] = Field(None, description="`{centre = [u, v], radius = r}`")
+    spline: Optional[TrimSpline] = Field(None, description=(
+        "`{points = [[u, v], …], degree = 3}`: a closed B-spline curve"))
+    edge: Literal[TRIM_EDGES] = Field(  # type: ignore[valid-type]
+        "free", description=(
+            "edge condition along the loop: pinned holds it (`d = 0`), clamped also holds its "
+            "slope (`∂n d = 0`), both by Nitsche's method"))
+
+    @model_validator(mode="after")
+    def _one_curve(self) -> "TrimLoop":
+        given = [k for k in ("polygon", "circle", "spline") if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise ValueError("a trim loop is exactly one of polygon, circle or spline, got "
+                             + (" and ".join(given) or "none"))
+        return self
+
+
+class Trim(_Table):
+    loops: list[TrimLoop] = Field(min_length=1, description=(
+        "the trim loops, each `{name, polygon | circle | spline, edge}`: the first is the "
+        "outer loop, the others holes in it (all holes with `rectangle`)"))
+    rectangle: Annotated[bool, Strict()] = Field(False, description=(
+        "the outer loop is the parameter rectangle itself: every loop is a hole in it, and "
+        "the rectangle's edges keep their `[boundary]` conditions"))
+
+
 class _Fitted(_Refined):
     cells: Optional[Union[Cells, tuple[Cells, Cells]]] = Field(
         None, title="[m_u, m_v]", description=(
@@ -60,6 +107,14 @@ class _Fitted(_Refined):
         "interpolate", description=(
             "how control points are fitted to the shape (collocation at Greville points, L2 "
             "projection, local quasi-interpolant); a point grid allows `interpolate` and `l2`"))
+    trim: Optional[Trim] = Field(
+        None, title="{loops = [...]}", description=(
+            "a trimmed region in (u, v): `[[surface.trim.loops]]` tables, each a `polygon`, "
+            "`circle` or `spline`, with a `name` and an `edge` condition (docs/trim.md); the "
+            "model then lives on the region inside the outer loop and outside the holes "
+            "(physics `parametric`, equal knot cells; the rectangle's edges free unless "
+            "`rectangle`)"),
+        json_schema_extra={"doc_default": "none (the whole rectangle)"})
 
 
 Size = Union[Positive, tuple[Positive, Positive]]

@@ -29,6 +29,8 @@ class SurfaceSpec:
     #: knots inserted per span and degrees added, ``(u, v)`` (``surface.refine``, ``.elevate``)
     refine: tuple[int, int] = (0, 0)
     elevate: tuple[int, int] = (0, 0)
+    #: ``surface.trim`` as read (:class:`~splinedeform.scenario.schema.Trim`), or None
+    trim: Any = None
 
     def __post_init__(self) -> None:
         for name in ("refine", "elevate"):

@@ -135,6 +135,8 @@ def _validate_surface(raw: Mapping[str, Any], problems: _Problems,
         _not_applicable(table, ["frame", "cells", "degree", "knots", "method"], [], "surface",
                         problems, "to shape \"cad\" (the file holds the surface's own "
                                   "degrees, knots and weights)")
+        _not_applicable(table, ["trim"], [], "surface", problems,
+                        "to shape \"cad\" (a CAD face's trim comes from its file)")
     else:
         _not_applicable(table, ["path", "frame"], [], "surface", problems,
                         f"to shape {shape!r}, only to shape = \"file\" (path also to \"cad\")")

@@ -86,6 +86,8 @@ def scenario_to_toml(scenario: Scenario) -> str:
         items += fitted
     items += [(k, list(getattr(surface, k))) for k in ("refine", "elevate")
               if getattr(surface, k) != (0, 0)]
+    if surface.trim is not None:
+        items += [("trim", surface.trim.model_dump(exclude_none=True))]
     out += _toml_table("[surface]", items)
     skip = PLATE_KEYS if s.material.physics == "shell" else SHELL_KEYS
     out += _toml_table("[material]", [(k, getattr(s.material, k)) for k in MATERIAL_KEYS

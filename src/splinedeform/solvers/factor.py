@@ -60,8 +60,16 @@ class Factorisation:
 
 def half_bandwidth(K: sp.spmatrix) -> int:
     """``max |i - j|`` over the stored entries of ``K`` (0 for a diagonal or empty matrix)."""
-    coo = K.tocoo()
-    return int(np.abs(coo.row - coo.col).max()) if coo.nnz else 0
+    rows, columns, _ = _entries(K)
+    return int(np.abs(rows - columns).max()) if rows.size else 0
+
+
+def _entries(K: sp.spmatrix) -> tuple[NDArray[np.int64], NDArray[np.int64], Array]:
+    """Row, column and value of every stored entry of ``K``, column by column (from its
+    compressed columns: no coordinate copy of the matrix)."""
+    K = K if sp.isspmatrix_csc(K) or isinstance(K, sp.csc_array) else sp.csc_matrix(K)
+    columns = np.repeat(np.arange(K.shape[1]), np.diff(K.indptr))
+    return K.indices, columns, K.data
 
 
 def factorise(K: sp.spmatrix, method: str = "auto") -> Factorisation:
@@ -72,7 +80,8 @@ def factorise(K: sp.spmatrix, method: str = "auto") -> Factorisation:
     K : sparse matrix, shape ``(N, N)``
         Symmetric; positive definite for the Cholesky methods.
     method : {"auto", "banded", "superlu", "cholmod"}
-        ``"auto"``: the band Cholesky while its storage is at most :data:`BAND_BYTES`,
+        ``"auto"``: the band Cholesky while its storage is at most :data:`BAND_BYTES`
+        and its work ``N b²`` at most :data:`BAND_FLOPS`,
         else CHOLMOD where installed, else SuperLU. A Cholesky method that finds ``K``
         not positive definite falls back to SuperLU (which then solves an indefinite
         but regular ``K`` or raises ``RuntimeError`` for a singular one, as ``splu`` does).
@@ -87,7 +96,7 @@ def factorise(K: sp.spmatrix, method: str = "auto") -> Factorisation:
         raise InputError(f"a factorised matrix must be square, got shape {K.shape}")
     if method == "auto":
         n, b = K.shape[0], half_bandwidth(K)
-        if 8 * n * (b + 1) <= BAND_BYTES:
+        if 8 * n * (b + 1) <= BAND_BYTES and n * b * b <= BAND_FLOPS:
             method = "banded"
         else:
             method = "cholmod" if _cholmod() is not None else "superlu"
@@ -130,11 +139,20 @@ def band_cholesky(K: sp.spmatrix) -> Factorisation | None:
 
 
 def _banded(K: sp.spmatrix) -> Factorisation:
-    """LAPACK band Cholesky ``K = Uᵀ U`` on the upper band (``dpbtrf`` / ``dpbtrs``)."""
-    n, b = K.shape[0], half_bandwidth(K)
-    upper = sp.triu(K, format="coo")
-    band = np.zeros((b + 1, n))
-    band[b + upper.row - upper.col, upper.col] = upper.data   # LAPACK upper band storage
+    """LAPACK band Cholesky ``K = Uᵀ U`` on the upper band (``dpbtrf`` / ``dpbtrs``).
+
+    The band is written straight from the compressed columns into Fortran-ordered storage
+    ``ab[b + i - j, j] = K_ij`` (``i <= j``), the layout LAPACK reads, so that the wrapper
+    copies nothing before ``dpbtrf`` factorises it in place (at 64² the copy of a C-ordered
+    band cost a quarter of the factorisation).
+    """
+    rows, columns, values = _entries(K)
+    upper = rows <= columns
+    rows, columns = rows[upper], columns[upper]
+    n = K.shape[0]
+    b = int((columns - rows).max()) if rows.size else 0
+    band = np.zeros((b + 1, n), order="F")
+    band[b + rows - columns, columns] = values[upper]
     U = sla.cholesky_banded(band, overwrite_ab=True, lower=False, check_finite=False)
 
     def solve(rhs: Array) -> Array:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..loads import Harmonic, Load
+from ..loads import Harmonic, Load, Profile
 from .system import Reduction
 
 Array = NDArray[np.float64]
@@ -47,6 +47,13 @@ class ReducedForcing:
             if scale:
                 out += scale * self._field(i, t)
         return out
+
+    def fixed_terms(self) -> tuple[Array | None, list[tuple[Profile, Array]]] | None:
+        """``(F_rest, [(s_i, Tᵀ F_i)])`` when no field changes in time, so that
+        ``F_r(t) = F_rest + Σ_i s_i(t) Tᵀ F_i`` (``F_rest`` None for 0); else None."""
+        if any(fixed is None for fixed in self._fixed):
+            return None
+        return self._rest, [(term.profile, fixed) for term, fixed in zip(self.terms, self._fixed)]
 
     def modal_terms(self, phi: Array, t_end: float, samples: int
                     ) -> tuple[list[tuple[float, Array]], list[tuple[float, float, Array]]]:

@@ -39,6 +39,7 @@ from .mode_acceleration import StaticCorrection, mode_acceleration  # noqa: F401
 from .factor import band_cholesky
 from .eigen_trust import GUARDS, check_by_residual, refine_doubtful
 from .rigid import check_resolved, count_by_gap
+from .sparse_eigen import BlockLanczos, factorise
 from .system import KroneckerFactors
 
 Array = NDArray[np.float64]
@@ -178,7 +179,9 @@ def sparse_basis(K: sp.spmatrix, M: sp.spmatrix, k: int | None = None,
                  omega_max: float | None = None, rigid: int | None = 0,
                  advice: str = DEFAULT_ADVICE, guard: str = "condition",
                  order: NDArray[np.int64] | None = None) -> DenseBasis:
-    """Lowest modes by shift-invert Lanczos (``eigsh`` with a sparse LU of ``K - σM``).
+    """Lowest modes by shift-invert Lanczos: without rigid modes and ``order`` the block
+    Lanczos of :mod:`.sparse_eigen` on its factor of ``K`` (level-3 solves, one Krylov
+    space for every request), else ``eigsh`` with a sparse LU of ``K - σM``.
 
     ``k`` modes, or all with ``ω <= omega_max`` (found by doubling the request). One mode more
     than kept is computed so that the first omitted frequency is known. Without rigid modes
@@ -197,12 +200,22 @@ def sparse_basis(K: sp.spmatrix, M: sp.spmatrix, k: int | None = None,
         shift = -1e-6 * scale
     else:
         shift = 0.0
-    lu = stiffness_factorisation(K, shift, M, order)
+    block = not unconstrained and order is None
+    lu = factorise(K) if block else stiffness_factorisation(K, shift, M, order)
     solve = None if unconstrained else lu.solve
+    krylov = BlockLanczos(K, M, lu) if block else None
+
+    def pairs(count: int) -> tuple[Array, Array]:
+        """The ``count`` lowest pairs (on one growing Krylov space with the block Lanczos)."""
+        if krylov is None:
+            return _eigsh(K, M, count, shift, lu)
+        modes = krylov.lowest(count - 1)
+        return _zero_small(modes.lam), modes.phi
+
     if omega_max is not None:
         want = min(32, n - 2)
         while True:
-            lam, phi = _eigsh(K, M, want, shift, lu)
+            lam, phi = pairs(want)
             if lam[-1] > omega_max**2 or want >= n - 2:
                 break
             want = min(2 * want, n - 2)
@@ -212,7 +225,7 @@ def sparse_basis(K: sp.spmatrix, M: sp.spmatrix, k: int | None = None,
                              f"{np.sqrt(lam[0]):g})")
     else:
         assert k is not None
-        lam, phi = _eigsh(K, M, min(k + 1, n - 1), shift, lu)
+        lam, phi = pairs(min(k + 1, n - 1))
     top = float(np.max(K.diagonal() / M.diagonal()))       # a Rayleigh quotient <= λ_max
     if rigid is None:
         rigid = count_by_gap(lam, "sparse eigen-solution", top)

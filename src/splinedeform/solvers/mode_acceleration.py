@@ -44,6 +44,14 @@ class StaticCorrection:
             out += np.where(t >= 0, np.sin(omega * t + phase), 0.0)[:, None, None] * part
         return out
 
+    def coordinate(self, t: Array, p: int, c: int) -> Array:
+        """The correction of coordinate ``c`` of unknown ``p`` at times ``t`` → ``(F,)``."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        out = (t[:, None] > self.jump_times[None, :]).astype(float) @ self.jump_parts[:, p, c]
+        for omega, phase, part in self.harmonics:
+            out += np.where(t >= 0, np.sin(omega * t + phase), 0.0) * part[p, c]
+        return out
+
 
 def mode_acceleration(basis: ModalBasis, K: sp.spmatrix, M: sp.spmatrix,
                       jumps: list[tuple[float, Array]],

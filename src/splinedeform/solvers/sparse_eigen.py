@@ -40,6 +40,7 @@ import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
 
 from ..errors import SingularSystemError
+from .block_cholesky import block_cholesky
 from .factor import band_cholesky
 
 Array = NDArray[np.float64]
@@ -48,15 +49,16 @@ TOLERANCE = 1e-10
 
 
 def factorise(K: sp.spmatrix) -> Any:
-    """A factorisation of ``K`` with ``solve``: the band Cholesky
-    (:func:`.factor.band_cholesky`) where the band fits and ``K`` is positive definite,
-    else the sparse LU (SuperLU, minimum-degree ordering of ``Kᵀ + K``, threshold pivoting,
+    """A factorisation of ``K`` with ``solve``: the block bidiagonal Cholesky
+    (:func:`.block_cholesky.block_cholesky`, level-3 solves of a block of vectors) or the
+    band Cholesky (:func:`.factor.band_cholesky`) where the band fits and ``K`` is positive
+    definite, else the sparse LU (SuperLU, minimum-degree ordering of ``Kᵀ + K``, threshold pivoting,
     so that a singular ``K`` is reported rather than solved).
 
     The ordering matters for the LU: at 64² the ``MMD_AT_PLUS_A`` factors have 1.07 M
     entries and factorise in 0.09 s, ``COLAMD`` (scipy's default) 1.29 M in 0.35 s.
     """
-    band = band_cholesky(K)
+    band = block_cholesky(K) or band_cholesky(K)
     if band is not None:
         return band
     try:
@@ -146,7 +148,8 @@ class BlockLanczos:
         self.lu = factorise(K) if lu is None else lu
         self.tol = tol
         self.fixed = block is not None
-        self.b = min(block or 2, self.n)
+        self.wide = getattr(self.lu, "method", "") == "block"   # level-3 solves: wider blocks
+        self.b = min(block or block_size(1, self.wide), self.n)
         self.rng = np.random.default_rng(seed)
         self.V = np.empty((self.n, 0))
         self.MV = np.empty((self.n, 0))
@@ -161,12 +164,15 @@ class BlockLanczos:
         self._append(Q, MQ)
 
     def _reserve(self, size: int) -> None:
+        """Room for ``size`` basis vectors, at least twice the room before (copies add up
+        to at most the final size). Column-major: the vectors in use are one contiguous
+        prefix, and the memory of the columns not yet written is never touched."""
         if size <= self.V.shape[1]:
             return
-        size = max(size, int(1.5 * self.V.shape[1]))
+        size = min(self.n, max(size, 2 * self.V.shape[1]))
         for name in ("V", "MV"):
             old = getattr(self, name)
-            new = np.empty((self.n, size))
+            new = np.empty((self.n, size), order="F")
             new[:, :self.p] = old[:, :self.p]
             setattr(self, name, new)
         H = np.zeros((size, size))
@@ -236,8 +242,9 @@ class BlockLanczos:
         """
         want = min(k + 1, self.n)
         if not self.fixed:
-            self.b = max(self.b, min(block_size(want), self.n))
+            self.b = max(self.b, min(block_size(want, self.wide), self.n))
         cap = min(self.n, max_dim or 6 * want + 4 * self.b)
+        self._reserve(min(cap, 3 * want + 4 * self.b))     # what it usually takes: no copies
         check = max(min(2 * want, cap), self.p)
         while True:
             if self.next is None:
@@ -253,15 +260,22 @@ class BlockLanczos:
             self._advance()
 
 
-def block_size(want: int) -> int:
-    """Block size for ``want`` eigenpairs: ``clip(want/24, 2, 8)``.
+def block_size(want: int, wide: bool = False) -> int:
+    """Block size for ``want`` eigenpairs: ``clip(want/2, 2, 8)``; 16 when ``wide`` (the
+    factor solves a block of vectors with level-3 BLAS, :mod:`.block_cholesky`).
 
     Measured at 64² (solves to reach residuals of 1e-10 with blocks of 1, 2, 4, 8): 17
     pairs 55, 56, 76, 104; 33 pairs 83, 92, 120, 160; 257 pairs with 8, 16, 32: 592, 688,
     864 (ARPACK 516). Narrow blocks need fewest solves; wide ones read the Krylov basis
-    fewer times in the orthogonalisation, which dominates from a few hundred pairs on.
+    fewer times in the orthogonalisation, which dominates from a few dozen pairs on with
+    one BLAS thread: 291 pairs at 64² took 2.9 s with blocks of 2, 0.88 s with 8, 1.3 s
+    with 16; 17, then 65, then 312 pairs on the same space 1.5 s growing the block from 2,
+    1.1 s with 8 from the start. At 128² (band solve 8.1 ms a vector, block sweeps 2.2 ms
+    in blocks of 16) 200 pairs took 472 solves with blocks of 8 and 576 with 16.
     """
-    return int(np.clip(want // 24, 2, 8))
+    if wide:
+        return 16
+    return int(np.clip(want // 2, 2, 8))
 
 
 def lowest_modes(K: sp.spmatrix, M: sp.spmatrix, k: int, lu: Any | None = None,

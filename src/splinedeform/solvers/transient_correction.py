@@ -64,14 +64,20 @@ def free_response(lam: Array, gamma: float, beta: float, tau: Array) -> Array:
     under = d < 0
     wd = np.sqrt(np.where(under, -d, 1.0))
     p_under = np.exp(-a * tau) * (np.cos(wd * tau) + a / wd * np.sin(wd * tau))
-    kappa = np.sqrt(np.where(under, 0.0, d))
-    fast = a + kappa
+    p_over = _over_damped_response(lam, a, np.where(under, 0.0, d), tau)
+    return np.where(tau > 0, np.where(under, p_under, p_over), 1.0)
+
+
+def _over_damped_response(lam: Array, a: Array, d: Array, tau: Array) -> Array:
+    """``P_11`` of :func:`free_response` where ``d = a² − λ ≥ 0`` (critically or
+    over-damped), ``τ > 0``: ``(s e^{−rτ} − r e^{−sτ})/(s − r)``, ``s = a + κ``,
+    ``r = λ/s``, ``κ = √d``; ``e^{−aτ}(1 + aτ)`` where ``s = r``."""
+    fast = a + np.sqrt(d)
     slow = lam / np.where(fast > 0, fast, 1.0)
     gap = np.where(fast - slow > 0, fast - slow, 1.0)
-    p_over = np.where(fast - slow > 0,
-                      (fast * np.exp(-slow * tau) - slow * np.exp(-fast * tau)) / gap,
-                      np.exp(-a * tau) * (1.0 + a * tau))
-    return np.where(tau > 0, np.where(under, p_under, p_over), 1.0)
+    return np.where(fast - slow > 0,
+                    (fast * np.exp(-slow * tau) - slow * np.exp(-fast * tau)) / gap,
+                    np.exp(-a * tau) * (1.0 + a * tau))
 
 
 def _chebyshev(x: Array, degree: int) -> Array:
@@ -110,8 +116,15 @@ def fitted(lam_next: float, gamma: float, beta: float, tau: Array, degree: int =
                                       np.geomspace(1e-14, 1.0, CHECK // 2)]))
     safe = np.where(check > 0, check, 1.0)  # x = 0 is set below
     pinv = np.linalg.pinv(_chebyshev(nodes, degree))
-    fit = pinv @ free_response(lam_next / nodes[:, None], gamma, beta, tau[None, :])
-    exact = free_response(lam_next / safe[:, None], gamma, beta, tau[None, :])
+
+    def response(lam: Array) -> Array:   # every λ ≥ λ_{m+1} ≥ λ_o is over-damped
+        a = 0.5 * (gamma + beta * lam)
+        lam, a, t = np.broadcast_arrays(lam, a, tau[None, :])
+        return np.where(t > 0, _over_damped_response(lam, a, np.maximum(a * a - lam, 0.0),
+                                                      t), 1.0)
+
+    fit = pinv @ response(lam_next / nodes[:, None])
+    exact = response(lam_next / safe[:, None])
     exact[check == 0] = np.exp(-tau / beta)  # λ → ∞: P_11 → e^{−τ/β}
     fit_error = np.abs(_chebyshev(check, degree) @ fit - exact).max(axis=0)
     better = fit_error < static_error
@@ -155,15 +168,25 @@ class TransientCorrection:
 
     def __call__(self, t: Array) -> Array:
         """The correction at times ``t`` (F,) → ``(F, n, c)``."""
+        return self._at(t, slice(None), slice(None))
+
+    def coordinate(self, t: Array, p: int, c: int) -> Array:
+        """The correction of coordinate ``c`` of unknown ``p`` at times ``t`` → ``(F,)``."""
+        return self._at(t, slice(p, p + 1), slice(c, c + 1))[:, 0, 0]
+
+    def _at(self, t: Array, rows: slice, columns: slice) -> Array:
         t = np.atleast_1d(np.asarray(t, dtype=float))
-        J, n, w = self.jump_parts.shape
-        out = np.zeros((t.size, n, w))
+        parts = self.jump_parts[:, rows, columns]                   # (J, r, w)
+        terms = self.terms[:, rows, :, columns]                     # (d + 1, r, J, w)
+        J, r, w = parts.shape
+        out = np.zeros((t.size, r, w))
         for j in range(J):                      # a few jumps; vectorised over times
             tau = t - self.jump_times[j]
             on = np.flatnonzero(tau > 0)
             if not on.size:
                 continue
             c, _ = fitted(self.lam_next, self.gamma, self.beta, tau[on], self.degree)
-            transient = np.einsum("ku,knw->unw", c, self.terms[:, :, j, :])
-            out[on] += self.jump_parts[j][None] - transient
+            # Σ_k c_k(τ) T_k(2X − I) R_j as one matrix product over the degrees
+            transient = (c.T @ terms[:, :, j, :].reshape(self.degree + 1, r * w))
+            out[on] += parts[j][None] - transient.reshape(on.size, r, w)
         return out

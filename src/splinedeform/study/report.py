@@ -85,14 +85,11 @@ def _positions(rows: list[dict[str, Any]], axis: str) -> tuple[list[float], list
 
 def _plot_axis(folder: Path, rows: list[dict[str, Any]], axis: str,
                results: list[str]) -> Path:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure       # no pyplot: no global figures, no backend
 
     x, labels = _positions(rows, axis)
-    fig, panels = plt.subplots(1, len(results), figsize=(3.6 * len(results), 3.2),
-                               squeeze=False)
+    fig = Figure(figsize=(3.6 * len(results), 3.2))
+    panels = fig.subplots(1, len(results), squeeze=False)
     for panel, name in zip(panels[0], results):
         y = [row.get(name) if _number(row.get(name)) else math.nan for row in rows]
         panel.plot(x, y, "o", markersize=4)
@@ -102,22 +99,23 @@ def _plot_axis(folder: Path, rows: list[dict[str, Any]], axis: str,
             panel.set_xticks(range(len(labels)), labels, rotation=30)
         elif min(x) > 0 and max(x) / min(x) > 50:
             panel.set_xscale("log")
-    fig.tight_layout()
+    # fixed margins (inches over the figure's width) rather than tight_layout, which draws
+    # the figure twice more
+    width = 3.6 * len(results)
+    fig.subplots_adjust(left=0.8 / width, right=1.0 - 0.15 / width, top=0.95,
+                        bottom=0.3 if labels is not None else 0.17, wspace=0.45)
     path = folder / f"plot_{_slug(axis)}.png"
     write_with(path, lambda tmp: fig.savefig(tmp, dpi=90, format="png"))
-    plt.close(fig)
     return path
 
 
 def _pair_plot(folder: Path, rows: list[dict[str, Any]], axes: list[str], result: str) -> Path:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     (x, xl), (y, yl) = _positions(rows, axes[0]), _positions(rows, axes[1])
     c = [row.get(result) if _number(row.get(result)) else math.nan for row in rows]
-    fig, panel = plt.subplots(figsize=(4.8, 4.0))
+    fig = Figure(figsize=(4.8, 4.0))
+    panel = fig.subplots()
     dots = panel.scatter(x, y, c=c, s=30)
     fig.colorbar(dots, ax=panel, label=result)
     panel.set_xlabel(axes[0])
@@ -129,7 +127,6 @@ def _pair_plot(folder: Path, rows: list[dict[str, Any]], axes: list[str], result
     fig.tight_layout()
     path = folder / "pairs.png"
     write_with(path, lambda tmp: fig.savefig(tmp, dpi=90, format="png"))
-    plt.close(fig)
     return path
 
 

@@ -6,9 +6,10 @@
    (:mod:`.cases`); a case whose values the scenario reader refuses gets its message;
 2. read back the cases already stored in ``out/cases/`` (by content hash) — an
    interrupted sweep run again computes only what is missing;
-3. group the remaining cases by model and submit one task per group
-   (:func:`.solve.solve_group`); Dask reschedules the task of a worker that dies, and the
-   task skips the cases its first attempt stored;
+3. group the remaining cases by model; a task solves one group, or several groups of few
+   cases together (:func:`tasks`: about :data:`TASKS_PER_WORKER` tasks a worker, so that
+   the scheduler's cost per task stays small beside the cases' work); Dask reschedules
+   the task of a worker that dies, and the task skips the cases its first attempt stored;
 4. write ``results.parquet``, ``results.csv`` and ``report.md`` (:mod:`.report`).
 """
 
@@ -24,8 +25,11 @@ from ..errors import InputError
 from .cases import Case, plan_cases
 from .cluster import dashboard, dask_client
 from .read import Sweep, load_sweep
-from .solve import solve_group
+from .solve import solve_groups
 from .store import case_file, remove_partial, stored, write_tables
+
+#: tasks a worker gets about, when the models are many and their cases few
+TASKS_PER_WORKER = 8
 
 #: ``progress(done, failed, running, total, dashboard)``, called about twice a second
 SweepProgress = Callable[[int, int, int, int, "str | None"], None]
@@ -118,17 +122,33 @@ def _row(case: Case, folder: Path) -> dict[str, Any]:
     return {**row, "case": case.index, "values": case.values}
 
 
+def tasks(groups: list[list[Case]], workers: int) -> list[list[list[Case]]]:
+    """The groups packed into tasks in design order: consecutive groups join one task
+    until it holds ``⌈cases / (TASKS_PER_WORKER · workers)⌉`` cases; a larger group is a
+    task of its own."""
+    size = -(-sum(len(g) for g in groups) // (TASKS_PER_WORKER * max(workers, 1)))
+    packed: list[list[list[Case]]] = []
+    for group in groups:
+        if packed and sum(len(g) for g in packed[-1]) + len(group) <= size:
+            packed[-1].append(group)
+        else:
+            packed.append([group])
+    return packed
+
+
 def _run_groups(client: Any, spec: Sweep, folder: Path, cases: list[Case],
                 groups: list[list[Case]], progress: SweepProgress | None,
                 result: SweepResult) -> None:
-    """Submit one task per model group and wait, reporting progress; cancel on interrupt."""
+    """Submit the groups as tasks and wait, reporting progress; cancel on interrupt."""
     from distributed import wait
 
     run_id = uuid.uuid4().hex[:8]
-    futures = {client.submit(solve_group, group, str(folder.resolve()), spec.cases_output,
-                             key=f"splinedeform-sweep-{run_id}-{i}", pure=False): group
-               for i, group in enumerate(groups, start=1)}
-    result.workers = len(client.scheduler_info().get("workers", {}))
+    workers = len(client.scheduler_info().get("workers", {}))
+    futures = {client.submit(solve_groups, task, str(folder.resolve()), spec.cases_output,
+                             key=f"splinedeform-sweep-{run_id}-{i}", pure=False):
+               [case for group in task for case in group]
+               for i, task in enumerate(tasks(groups, workers), start=1)}
+    result.workers = workers
     result.dashboard = dashboard(client)
     failed = sum(c.scenario is None for c in cases)
     try:

@@ -40,7 +40,8 @@ class Pieces:
 
     ``kind`` 0 is a straight piece from ``start`` to ``end`` (``t ∈ [0, 1]``), 1 an arc of
     the circle ``centre, radius`` with angles ``t``, 2 a span of a spline loop, the
-    polynomial ``Σ_e poly[e] t^e`` (``t ∈ [0, 1]``); ``cell`` the ``(i, j)`` of its cell.
+    polynomial ``Σ_e poly[e] t^e`` (``t ∈ [0, 1]``); ``cell`` the ``(i, j)`` of its cell;
+    ``loop`` the index of its loop in :attr:`TrimDomain.loops` (0 the outer loop).
     """
 
     kind: NDArray[np.int64]
@@ -52,6 +53,7 @@ class Pieces:
     radius: NDArray[np.float64]
     cell: NDArray[np.int64]
     poly: NDArray[np.float64]
+    loop: NDArray[np.int64] | None = None
 
     def evaluate(self, t: NDArray[np.float64]
                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -127,13 +129,15 @@ def _spline_pieces(loop: SplineLoop, grid: Grid) -> tuple[NDArray, NDArray, NDAr
     return s[keep], t[keep], nxt_t[keep]
 
 
-def loop_pieces(domain: TrimDomain, grid: Grid) -> Pieces:
-    """Split every loop of ``domain`` at the grid lines, with the loop's orientation kept."""
+def loop_pieces(domain: TrimDomain, grid: Grid, loops: tuple | None = None) -> Pieces:
+    """Split every loop of ``domain`` (or the given ``loops`` of it) at the grid lines, with
+    the loop's orientation kept; ``Pieces.loop`` counts in the loops split."""
+    loops = domain.loops if loops is None else loops
     kinds, los, his, starts, ends, centres, radii = [], [], [], [], [], [], []
-    q = 1 + max([loop.degree for loop in domain.loops if isinstance(loop, SplineLoop)],
+    q = 1 + max([loop.degree for loop in loops if isinstance(loop, SplineLoop)],
                 default=0)
     polys = []
-    for loop in domain.loops:
+    for loop in loops:
         if isinstance(loop, SplineLoop):
             span, lo, hi = _spline_pieces(loop, grid)
             kinds.append(np.full(len(lo), 2))
@@ -174,8 +178,9 @@ def loop_pieces(domain: TrimDomain, grid: Grid) -> Pieces:
     if np.any(cell < 0) or np.any(cell >= np.array(grid.cells)):
         raise InputError("a trim loop leaves the parameter domain "
                          f"[0, {grid.lengths[0]:g}] × [0, {grid.lengths[1]:g}]")
+    loop = np.repeat(np.arange(len(kinds)), [len(k) for k in kinds])
     return Pieces(pieces.kind, pieces.lo, pieces.hi, pieces.start, pieces.end, pieces.centre,
-                  pieces.radius, cell, pieces.poly)
+                  pieces.radius, cell, pieces.poly, loop)
 
 
 def classify_cells(domain: TrimDomain, grid: Grid, pieces: Pieces | None = None

@@ -147,12 +147,15 @@ def _orient(a: NDArray, b: NDArray, c: NDArray) -> NDArray[np.float64]:
 
 def _segments_cross(a1, b1, a2, b2) -> NDArray[np.bool_]:
     """Whether segments ``a1 b1`` (shape ``(k, 2)``) and ``a2 b2`` (shape ``(l, 2)``) meet,
-    as a ``(k, l)`` table (touching counts as meeting)."""
+    as a ``(k, l)`` table (touching counts as meeting). Segments meet only where their
+    bounding boxes do: two collinear segments on one line, apart, do not."""
     A1, B1 = a1[:, None], b1[:, None]
     A2, B2 = a2[None], b2[None]
     d1, d2 = _orient(A2, B2, A1), _orient(A2, B2, B1)
     d3, d4 = _orient(A1, B1, A2), _orient(A1, B1, B2)
-    return (d1 * d2 <= 0) & (d3 * d4 <= 0)
+    boxes = np.all((np.minimum(A1, B1) <= np.maximum(A2, B2))
+                   & (np.minimum(A2, B2) <= np.maximum(A1, B1)), axis=-1)
+    return (d1 * d2 <= 0) & (d3 * d4 <= 0) & boxes
 
 
 def _check_simple(loop: PolygonLoop) -> None:

@@ -26,6 +26,7 @@ from ..errors import InputError
 from .cells import Grid
 from .loops import PolygonLoop, TrimDomain
 from .quadrature import TrimQuadrature, trim_quadrature
+from .values import tensor_values
 from .web import WebBasis, normalisation, web_basis
 from .weight import DiscWeight, RvachevWeight
 
@@ -53,17 +54,9 @@ class TrimmedPlate:
 def _values(bases: tuple[BSplineBasis, BSplineBasis], p: NDArray[np.float64]
             ) -> list[sp.csr_matrix]:
     """Sparse ``b, b_x, b_y, b_xx, b_xy, b_yy`` of the tensor B-splines at ``p`` (rows)."""
-    bu, bv = bases
-    iu, du = bu.nonzero_derivatives(p[:, 0], 2)
-    iv, dv = bv.nonzero_derivatives(p[:, 1], 2)
-    cols = (iu[:, :, None] * bv.size + iv[:, None, :]).reshape(len(p), -1)
-    indptr = np.arange(0, cols.size + 1, cols.shape[1])
-    shape = (len(p), bu.size * bv.size)
-    out = []
-    for a, b in ((0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)):
-        vals = (du[a][:, :, None] * dv[b][:, None, :]).reshape(len(p), -1)
-        out.append(sp.csr_matrix((vals.ravel(), cols.ravel(), indptr), shape=shape))
-    return out
+    orders = ((0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2))
+    table = tensor_values(bases, p, orders)
+    return [table[o] for o in orders]
 
 
 def assemble_plate(domain: TrimDomain, cells: int, degree: int,

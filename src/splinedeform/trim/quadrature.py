@@ -64,6 +64,18 @@ def _vertical_crossings(domain: TrimDomain, x: float) -> NDArray[np.float64]:
     return np.array(ys, dtype=float)
 
 
+def cell_gauss(cells: NDArray[np.int64], grid: Grid, order: int
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+    """Tensor Gauss–Legendre, ``order × order`` points, on whole cells ``(C, 2)``: points
+    ``(C order², 2)``, weights and the cell of each point."""
+    xi, om = np.polynomial.legendre.leggauss(order)
+    h = np.array(grid.h)
+    ref = np.stack(np.meshgrid(xi, xi, indexing="ij"), axis=-1).reshape(-1, 2)
+    ref_w = np.outer(om, om).ravel() * 0.25 * h.prod()
+    points = ((cells[:, None, :] + 0.5 * (ref[None] + 1)) * h).reshape(-1, 2)
+    return points, np.tile(ref_w, len(cells)), np.repeat(cells, len(ref), axis=0)
+
+
 def trim_quadrature(domain: TrimDomain, grid: Grid, order: int) -> TrimQuadrature:
     """Quadrature of ``Ω ∩ [0, L_u] × [0, L_v]`` cell by cell.
 
@@ -81,13 +93,7 @@ def trim_quadrature(domain: TrimDomain, grid: Grid, order: int) -> TrimQuadratur
     pieces = loop_pieces(domain, grid)
     classes = classify_cells(domain, grid, pieces)
 
-    # inside cells: tensor Gauss
-    inside = np.argwhere(classes == INSIDE)
-    ref = np.stack(np.meshgrid(xi, xi, indexing="ij"), axis=-1).reshape(-1, 2)
-    ref_w = np.outer(om, om).ravel() * 0.25 * h.prod()
-    p_in = ((inside[:, None, :] + 0.5 * (ref[None] + 1)) * h).reshape(-1, 2)
-    w_in = np.tile(ref_w, len(inside))
-    c_in = np.repeat(inside, len(ref), axis=0)
+    p_in, w_in, c_in = cell_gauss(np.argwhere(classes == INSIDE), grid, order)
 
     # boundary pieces of the cut cells: trim pieces and right edges inside Ω
     t = 0.5 * (pieces.lo + pieces.hi)[:, None] + 0.5 * (pieces.hi - pieces.lo)[:, None] * xi

@@ -70,9 +70,12 @@ class WebBasis:
         return int(self.inner.sum())
 
 
-def web_basis(classes: NDArray[np.int64], degree: int) -> WebBasis:
+def web_basis(classes: NDArray[np.int64], degree: int,
+              allowed: NDArray[np.bool_] | None = None) -> WebBasis:
     """Inner and outer B-splines of a classified grid and Höllig's extension matrix.
 
+    ``allowed`` (a table over the B-spline indices) restricts the ``(n+1)²`` arrays the
+    outer B-splines are tied to (e.g. to coefficients an edge condition keeps free).
     Raises :class:`InputError` when no ``(n+1)²`` array of inner indices exists (the grid is
     too coarse for the trimmed region).
     """
@@ -84,7 +87,8 @@ def web_basis(classes: NDArray[np.int64], degree: int) -> WebBasis:
     number = -np.ones(shape, int)
     number[inner] = np.arange(inner.sum())
     # lower corners l of (n+1)² blocks of inner indices
-    block = sliding_window_view(inner, (n + 1, n + 1)).all(axis=(-1, -2))
+    candidates = inner if allowed is None else inner & allowed
+    block = sliding_window_view(candidates, (n + 1, n + 1)).all(axis=(-1, -2))
     corners = np.argwhere(block)
     if not len(corners):
         raise InputError(f"the trimmed region holds no {n + 1}×{n + 1} array of inner "

@@ -131,6 +131,8 @@ def mode_geometry(surface: Surface, shape: ArrayLike, resolution: int = 40, scal
     """
     phi_net = np.asarray(shape, dtype=float)
     u, v = surface.sample_parameters(resolution)
+    if surface.trim is not None:
+        return _clipped_mode_geometry(surface, phi_net, u, v, scale)
     phi = surface.evaluate_grid(u, v, control_points=phi_net[..., None])[..., 0]
     x = surface.evaluate_grid(u, v)
     _, half = _bounds(x)
@@ -138,6 +140,26 @@ def mode_geometry(surface: Surface, shape: ArrayLike, resolution: int = 40, scal
     s = scale * 2 * half / peak if peak > 0 else 0.0
     y = x + s * phi[..., None] * _unit_normals(surface, u, v)
     return y.reshape(-1, 3), phi.ravel(), grid_faces(u.size, v.size)
+
+
+def _clipped_mode_geometry(surface: Surface, phi_net: NDArray[np.float64],
+                           u: NDArray[np.float64], v: NDArray[np.float64], scale: float
+                           ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+    """:func:`mode_geometry` on the grid clipped to the trim loops
+    (:func:`splinedeform.trim.tessellate.surface_grid`)."""
+    from ..trim.tessellate import surface_grid
+
+    uv, faces = surface_grid(surface, u, v)
+    pu, pv = uv[:, 0], uv[:, 1]
+    phi = surface.derivative(pu, pv, control_points=phi_net[..., None])[:, 0]
+    x = surface.derivative(pu, pv)
+    cross = np.cross(surface.derivative(pu, pv, 1, 0), surface.derivative(pu, pv, 0, 1))
+    length = np.linalg.norm(cross, axis=-1, keepdims=True)
+    normal = cross / np.where(length > 0, length, 1.0)
+    _, half = _bounds(x)
+    peak = float(np.abs(phi).max())
+    s = scale * 2 * half / peak if peak > 0 else 0.0
+    return x + s * phi[:, None] * normal, phi, faces
 
 
 #: modes.png: each panel is MODE_PANEL_INCHES square, the colour bar's column is

@@ -1,0 +1,140 @@
+"""Cholesky factor of a banded SPD matrix as a block bidiagonal one: level-3 solves.
+
+A symmetric positive definite ``A`` of half bandwidth ``b`` (a stiffness in the Kronecker
+order of a tensor-product net, :mod:`.factor`) is block tridiagonal once cut into
+consecutive blocks of ``w ≥ b`` unknowns, and so is its Cholesky factor ``A = L Lᵀ``
+block bidiagonal:
+
+.. math:: L_{ii} L_{ii}^T = A_{ii} − C_{i−1} C_{i−1}^T, \\qquad
+          C_i = A_{i+1,i} L_{ii}^{−T},
+
+(``C_i = L_{i+1,i}``, upper triangular as ``A_{i+1,i}`` is). A solve of ``r`` right-hand
+sides is then two sweeps over the blocks, each two triangular products with ``r`` columns
+(the inverses ``L_ii⁻¹`` are kept: a triangular product runs at twice the rate of a
+triangular solve with a few dozen columns),
+
+.. math:: y_i = L_{ii}^{−1} (f_i − C_{i−1} y_{i−1}), \\qquad
+          x_i = L_{ii}^{−T} (y_i − C_i^T x_{i+1}),
+
+``2 N w r`` flops per sweep in matrix–matrix products (level-3 BLAS). What it is for: the
+block shift-invert Lanczos (:mod:`.sparse_eigen`) solves a block of vectors at a time, and
+LAPACK's band solve (``dpbtrs``) takes the right-hand sides one by one, reading the whole
+band for each (memory-bound). Measured on the bench plate, one BLAS thread
+(benchmarks/results.md): at 128² (``N = 16 129``, ``b = 384``) the band solve took
+8.1 ms a vector, these sweeps 2.2 ms in blocks of 16 (:data:`CACHED_BAND`), the two
+solutions within 1.3e-12 of each other relative to their size. The factor keeps ``2 N w``
+numbers (twice the band's: the coupling blocks are stored dense).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+from numpy.typing import NDArray
+
+from .factor import half_bandwidth
+
+Array = NDArray[np.float64]
+BLOCK_BYTES = 256 * 2**20
+"""Largest storage ``16 N w`` bytes of a block factor (128² cubic: 99 MB)."""
+CACHED_BAND = 16 * 2**20
+"""Band storage (bytes) up to which the band solve is kept: at 64² (6 MB) it solved 0.42 ms
+a vector in blocks of 8 against these sweeps' 0.79 ms, at 128² (50 MB) 8.1 ms against 3.8
+(blocks of 8), 2.2 (16) and 1.5 (32) (CPU time, one BLAS thread, best of five)."""
+SMALLEST_BLOCK = 64
+FEW = 4
+"""Blocks are at least this wide (fewer, larger products where the band is narrow)."""
+
+
+class BlockCholesky:
+    """``A = L Lᵀ`` with ``L`` block bidiagonal (module docstring); :meth:`solve`.
+
+    Parameters
+    ----------
+    A : sparse symmetric positive definite, half bandwidth ``b``.
+    width : block size ``w ≥ b`` (default ``max(b, SMALLEST_BLOCK)``).
+
+    Raises
+    ------
+    numpy.linalg.LinAlgError
+        Where a diagonal block is not positive definite (nor then is ``A``).
+    """
+
+    method = "block"
+
+    def __init__(self, A: sp.spmatrix, width: int | None = None):
+        n = A.shape[0]
+        b = half_bandwidth(A)
+        w = max(b, 1, min(SMALLEST_BLOCK, n) if width is None else int(width))
+        if width is not None and w != width:
+            raise ValueError(f"block width {width} is below the half bandwidth {b}")
+        self.n = n
+        self.edges = np.append(np.arange(0, n, w), n)
+        A = sp.csr_matrix(A)
+        self.inverse: list[Array] = []          # L_ii⁻¹ (lower triangular, Fortran order)
+        self.coupling: list[Array] = []         # C_i = L_{i+1,i}
+        previous: Array | None = None
+        for i, (lo, hi) in enumerate(zip(self.edges[:-1], self.edges[1:])):
+            block = A[lo:hi, lo:hi].toarray()
+            if previous is not None:
+                block -= previous @ previous.T
+            L = np.linalg.cholesky(block)
+            inverse, info = sla.lapack.dtrtri(L, lower=1)
+            if info:
+                raise np.linalg.LinAlgError("a diagonal block of the factor is singular")
+            self.inverse.append(np.asfortranarray(np.tril(inverse)))
+            if hi < n:
+                below = A[hi:self.edges[i + 2], lo:hi].toarray()
+                # C_i = A_{i+1,i} L_ii^{-T}: upper triangular (trapezoidal for a short last
+                # block) since A_{i+1,i} is, with w ≥ b
+                previous = below @ self.inverse[-1].T
+                self.coupling.append(np.asfortranarray(np.triu(previous)))
+
+    def solve(self, rhs: Array) -> Array:
+        """``A⁻¹ rhs`` for ``rhs`` of shape ``(N,)`` or ``(N, r)``.
+
+        Every product is a triangular one (``dtrmm``) on the transposed block rows
+        ``x_iᵀ`` (contiguous in Fortran order): ``(L_ii⁻¹ x_i)ᵀ = x_iᵀ L_ii^{−T}``, and so on.
+        """
+        f = np.asarray(rhs, dtype=float)
+        x = np.array(f.reshape(self.n, -1), order="C")
+        edges, D, C = self.edges, self.inverse, self.coupling
+        blocks = len(D)
+        for i in range(blocks):                             # L y = f
+            lo, hi = edges[i], edges[i + 1]
+            if i:
+                x[lo:hi] -= _times(C[i - 1], x[edges[i - 1]:lo], upper=True, transpose=False)
+            x[lo:hi] = _times(D[i], x[lo:hi], upper=False, transpose=False)
+        for i in range(blocks - 1, -1, -1):                 # Lᵀ x = y
+            lo, hi = edges[i], edges[i + 1]
+            if i < blocks - 1:
+                x[lo:hi] -= _times(C[i], x[hi:edges[i + 2]], upper=True, transpose=True)
+            x[lo:hi] = _times(D[i], x[lo:hi], upper=False, transpose=True)
+        return x.reshape(f.shape)
+
+
+def _times(T: Array, x: Array, upper: bool, transpose: bool) -> Array:
+    """``T x`` (or ``Tᵀ x``) for triangular ``T`` and ``x`` of shape ``(k, r)`` in C order,
+    by ``dtrmm`` on ``xᵀ``; a rectangular ``T`` (the short last block) or fewer than
+    :data:`FEW` columns by numpy's product (``dtrmm`` on one column took ten times as long)."""
+    if T.shape[0] != T.shape[1] or x.shape[1] < FEW:
+        return T.T @ x if transpose else T @ x
+    # (T x)ᵀ = xᵀ Tᵀ and (Tᵀ x)ᵀ = xᵀ T: a product from the right
+    return sla.blas.dtrmm(1.0, T, x.T, side=1, lower=0 if upper else 1,
+                          trans_a=0 if transpose else 1).T
+
+
+def block_cholesky(A: sp.spmatrix) -> BlockCholesky | None:
+    """The :class:`BlockCholesky` of ``A`` where the band storage ``8 N (b + 1)`` exceeds
+    :data:`CACHED_BAND` (below, LAPACK's band solve reads a band that stays in cache and is
+    as fast), the block factor's fits :data:`BLOCK_BYTES` and ``A`` is positive definite;
+    ``None`` otherwise (the caller's fallback then)."""
+    n, b = A.shape[0], half_bandwidth(A)
+    w = max(b, min(SMALLEST_BLOCK, n))
+    if 8 * n * (b + 1) <= CACHED_BAND or 16 * n * w > BLOCK_BYTES:
+        return None
+    try:
+        return BlockCholesky(A)
+    except np.linalg.LinAlgError:
+        return None

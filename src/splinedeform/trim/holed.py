@@ -1,0 +1,63 @@
+"""The parameter rectangle less holes: its quadrature, and the rectangle's edge conditions
+composed with Höllig's extension.
+
+When the outer trim loop is the rectangle itself
+(:func:`~splinedeform.trim.surface_trim.whole_rectangle`) the region is
+``R \\ ∪ H_k``, integrated as ``∫_{R∖H} f = Σ_C ∫_C f − Σ_k ∫_{C∩H_k} f``: tensor Gauss on
+every cell not inside a hole, less each hole's cut-cell rule
+(:func:`~splinedeform.trim.quadrature.trim_quadrature` of the hole alone). Its edges
+``u0 … v1`` keep the conditions of :mod:`splinedeform.boundary`: with ``T_e`` their map
+(identity on the kept coefficients ``K``) and ``E`` the extension (identity on the inner
+coefficients ``I``), the map is ``T = T_e E[K, F]`` over the free set ``F = I ∩ K``,
+with the holes' outer B-splines tied to arrays of kept coefficients only.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..boundary import build_constraints
+from ..errors import InputError
+from .cells import CUT, INSIDE, OUTSIDE, Grid
+from .loops import TrimDomain
+from .quadrature import TrimQuadrature, cell_gauss, trim_quadrature
+from .web import web_basis
+
+
+def holed_quadrature(domain: TrimDomain, grid: Grid, order: int) -> TrimQuadrature:
+    """Quadrature of the rectangle less the holes of ``domain`` (module docstring)."""
+    classes = np.full(grid.cells, INSIDE)
+    points, weights, cells = [], [], []
+    for hole in domain.holes:
+        q = trim_quadrature(TrimDomain(hole), grid, order)
+        classes[q.classes == INSIDE] = OUTSIDE
+        classes[q.classes == CUT] = CUT
+        on_cut = q.classes[q.cell[:, 0], q.cell[:, 1]] == CUT
+        points.append(q.points[on_cut])
+        weights.append(-q.weights[on_cut])
+        cells.append(q.cell[on_cut])
+    p, w, c = cell_gauss(np.argwhere(classes != OUTSIDE), grid, order)
+    return TrimQuadrature(np.concatenate([p, *points]), np.concatenate([w, *weights]),
+                          np.concatenate([c, *cells]), classes)
+
+
+def with_edges(surface: Any, edges: dict[str, str], classes: np.ndarray
+               ) -> tuple[sp.csr_matrix, np.ndarray]:
+    """``T = T_e E[K, F]`` and the free indices ``F`` (module docstring); the outer
+    B-splines are tied to arrays of kept coefficients only, so ``E[K]`` never needs an
+    eliminated one."""
+    held = build_constraints(surface.basis_u, surface.basis_v, edges)
+    kept = np.zeros(surface.shape, bool)
+    kept.ravel()[held.free_index] = True
+    web = web_basis(classes, surface.basis_u.degree, allowed=kept)
+    inner = np.flatnonzero(web.inner.ravel())
+    free = kept.ravel()[inner]
+    E = web.extension.tocsr()[held.free_index]
+    if abs(E[:, ~free]).sum() != 0:            # an outer B-spline among the eliminated
+        raise InputError("a hole comes too close to a held edge of the rectangle: the edge "
+                         "condition and the extension of the hole's B-splines meet; move "
+                         "the hole away from the edge or refine the net")
+    return (held.T @ E[:, free]).tocsr(), inner[free]

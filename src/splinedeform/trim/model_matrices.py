@@ -1,0 +1,241 @@
+"""The parametric energy of a trimmed surface: matrices over the trimmed region, the WEB
+map as constraint map, and Nitsche's terms for the held trim loops.
+
+With the surface's B-splines ``b_k`` (tensor, row-major ``k = i n_v + j``) and the
+trimmed quadrature ``(x_q, ω_q)`` of :func:`~splinedeform.trim.quadrature.trim_quadrature`
+(knot cells as grid), for every coordinate alike
+
+.. math:: K = Σ_{α} w_α B_αᵀ Ω B_α, \\qquad M = μ B_0ᵀ Ω B_0,
+
+``α ∈ {(1,0), (0,1), (2,0), (1,1), (0,2)}`` with weights ``w10, w01, w20, 2 w11, w02``,
+``(B_α)_{qk} = ∂^α b_k(x_q)``, ``Ω = diag ω``: the parametric energy of docs/model.md on
+``Ω`` instead of the rectangle. The displacement net is ``d = E d_free``, ``E`` Höllig's
+extension (:mod:`splinedeform.trim.web`): inner B-splines are the unknowns, outer ones
+follow them, the others stay at rest; so every solver works on ``Eᵀ K E`` and ``Eᵀ M E``
+unchanged, and the displaced surface stays a B-spline surface.
+
+**Held loops (Nitsche).** Integration by parts of ``a(d, v)`` gives the boundary term
+
+.. math:: b(d, v) = ∮_Γ g_0(d) v + g_u(d) v_u + g_v(d) v_v \\, ds,
+
+    g_u = w20 d_uu n_u + w11 d_uv n_v,  g_v = w02 d_vv n_v + w11 d_uv n_u,
+    g_0 = w10 d_u n_u + w01 d_v n_v − (w20 d_uuu n_u + w11 d_uvv n_u + w11 d_uuv n_v
+          + w02 d_vvv n_v)
+
+(``n`` the outward normal). A clamped loop (``d = ∇d = 0``) adds
+``−b(d, v) − b(v, d) + γ_0 ∮ d v + γ_1 ∮ ∇d·∇v``; a pinned loop (``d = 0``, the moment
+``g·n = 0`` natural) adds ``−b_p(d, v) − b_p(v, d) + γ_0 ∮ d v`` with
+``b_p = ∮ g_0(d) v + (g(d)·s)(∇v·s)``, ``s`` the tangent. Both are consistent (the exact
+solution satisfies the discrete equations) and symmetric;
+``γ_0 = β (w_b / h³ + w_t / h)``, ``γ_1 = β w_b / h`` with ``w_b = max(w20, w11, w02)``,
+``w_t = max(w10, w01)``, ``h`` the smaller cell side and ``β =`` :func:`nitsche_penalty`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable, Mapping
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import NDArray
+
+from ..boundary import Constraints, build_constraints, trim_conditions
+from ..errors import InputError
+from ..material import Material
+from ..solvers import rigid
+from .cells import Grid, loop_pieces
+from .loops import TrimDomain
+from .quadrature import TrimQuadrature, trim_quadrature
+from .holed import holed_quadrature, with_edges
+from .surface_trim import holed_rectangle, trim_grid
+from .values import tensor_values
+from .web import web_basis
+
+NITSCHE_FACTOR = 10.0
+"""``β = NITSCHE_FACTOR (n + 1)³`` of the Nitsche penalties: above the trace-inverse
+constant of the extended basis of degree ``n`` (bounded however a loop cuts a cell, by
+Höllig's extension). On the clamped and pinned disc plates ``K_r`` is positive definite
+from about ``β = 300`` for cubics and ``β = 1000`` for quartics; ``10 (n+1)³`` is 640 and
+1250."""
+
+
+def nitsche_penalty(degree: int) -> float:
+    """``β = NITSCHE_FACTOR (n + 1)³``."""
+    return NITSCHE_FACTOR * (degree + 1) ** 3
+
+
+#: derivative orders ``(a, b)`` of the stiffness terms and the material weight of each
+STIFFNESS_TERMS = (("w10", (1, 0), 1.0), ("w01", (0, 1), 1.0), ("w20", (2, 0), 1.0),
+                   ("w11", (1, 1), 2.0), ("w02", (0, 2), 1.0))
+
+
+def loop_keys(count: int) -> tuple[str, ...]:
+    """Boundary keys of ``count`` loops: ``outer``, then ``hole1``, ``hole2``, … in order."""
+    return ("outer",) + tuple(f"hole{k}" for k in range(1, count))
+
+
+def loop_names(domain: TrimDomain) -> tuple[str, ...]:
+    """Boundary keys of the loops of ``domain`` (:func:`loop_keys`)."""
+    return loop_keys(len(domain.loops))
+
+
+def quadrature_of(surface: Any) -> TrimQuadrature:
+    """The trimmed quadrature of a surface, ``n + 2`` Gauss points per direction (exact for
+    the ``2n`` per variable of the energies on inside cells); kept with the surface."""
+    key = ("trim quadrature",)
+    if key not in surface._cache:
+        rule = holed_quadrature if holed_rectangle(surface) else trim_quadrature
+        surface._cache[key] = rule(surface.trim, trim_grid(surface), surface.basis_u.degree + 2)
+    return surface._cache[key]
+
+
+def _points(surface: Any, quad: TrimQuadrature) -> NDArray[np.float64]:
+    """Quadrature points in the closed rectangle (cut-cell points on a cell's edge)."""
+    (_, lu), (_, lv) = surface.domain
+    return np.clip(quad.points, 0.0, [lu, lv])
+
+
+def project(surface: Any, values: Callable[[NDArray, NDArray], NDArray]
+            ) -> NDArray[np.float64]:
+    """``F_k = ∫_Ω f b_k = Σ_q ω_q f(x_q) b_k(x_q)``, shape ``(n_u n_v, 3)``; ``values(U, V)``
+    gets the points' parameter arrays ``(Q,)`` and returns ``(Q, 3)``."""
+    quad = quadrature_of(surface)
+    p = _points(surface, quad)
+    f = np.asarray(values(p[:, 0], p[:, 1]), dtype=float)
+    if f.shape != (len(p), 3):
+        raise InputError(f"a load function must return an array of shape (..., 3) matching "
+                         f"its parameter arrays {(len(p),)}, got {f.shape}")
+    if not np.all(np.isfinite(f)):
+        raise InputError("a load function returned non-finite values")
+    B = tensor_values((surface.basis_u, surface.basis_v), p, [(0, 0)])[(0, 0)]
+    return np.asarray(B.T @ (quad.weights[:, None] * f))
+
+
+@dataclass(frozen=True)
+class TrimmedSystem:
+    """Full matrices over the trimmed region (Nitsche terms included), the WEB constraint
+    map, and the dimension of ``null K_r``."""
+
+    constraints: Constraints
+    stiffness: sp.csr_matrix
+    mass: sp.csr_matrix
+    rigid_modes: int
+
+
+def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str, str],
+                   lumped: bool = False, physics: str = "parametric", fixed: Any = None,
+                   rest: str = "initial") -> TrimmedSystem:
+    """``K``, ``M`` (see the module docstring) and ``d = E d_free`` of a trimmed surface."""
+    if physics != "parametric":
+        raise InputError(f"a trimmed surface takes physics 'parametric' (its energy over the "
+                         f"trimmed region); {physics!r} is not trimmed yet")
+    if fixed is not None:
+        raise InputError("fixed control points are not combined with a trim yet: hold the "
+                         "trim loops instead (boundary = {'outer': 'clamped', ...})")
+    domain: TrimDomain = surface.trim
+    grid = trim_grid(surface)
+    names = loop_names(domain)
+    rectangle = holed_rectangle(surface)
+    edges, loops = trim_conditions(boundary, names, rectangle)
+    held = {k: loops[name] for k, name in enumerate(names) if loops[name] != "free"}
+    if held and rest == "none":
+        raise InputError("rest = 'none' (the energy of the position itself) is not combined "
+                         "with pinned or clamped trim loops yet: Nitsche's terms hold the "
+                         "displacement, not the position; use rest = 'initial'")
+    bending = max(material.w20, material.w11, material.w02)
+    if held and bending and surface.basis_u.degree < 3:
+        raise InputError("a pinned or clamped trim loop under bending weights needs degree "
+                         f">= 3 (third derivatives in Nitsche's terms), got "
+                         f"{surface.basis_u.degree}")
+    bases = (surface.basis_u, surface.basis_v)
+    quad = quadrature_of(surface)
+    orders = [(0, 0)] + [ab for key, ab, _ in STIFFNESS_TERMS if getattr(material, key)]
+    B = tensor_values(bases, _points(surface, quad), orders)
+    om = sp.diags(quad.weights)
+    K = sp.csr_matrix((B[(0, 0)].shape[1],) * 2)
+    for key, ab, factor in STIFFNESS_TERMS:
+        weight = factor * getattr(material, key)
+        if weight:
+            K = K + weight * (B[ab].T @ om @ B[ab])
+    M = material.mass * (B[(0, 0)].T @ om @ B[(0, 0)])
+    if lumped:
+        M = sp.diags(np.asarray(M.sum(axis=1)).ravel())
+    if held:
+        K = K + nitsche_terms(surface, material, grid, held)
+    if rectangle:
+        T, free_index = with_edges(surface, edges, quad.classes)
+    else:
+        web = web_basis(quad.classes, surface.basis_u.degree)
+        T, free_index = web.extension.tocsr(), np.flatnonzero(web.inner.ravel())
+    constraints = Constraints(T, None, None, free_index, {**edges, **loops}, False)
+    # held loops or edges leave no motion without energy (Nitsche's penalty, the edges'
+    # constraints); else the energy's polynomials, which the extension reproduces
+    count = 0 if held or set(edges.values()) != {"free"} else rigid.rigid_count(
+        rigid.parametric_terms(material), *bases, build_constraints(*bases, "free"))
+    return TrimmedSystem(constraints, ((K + K.T) * 0.5).tocsr(), sp.csr_matrix(M), int(count))
+
+
+def loop_quadrature(domain: TrimDomain, grid: Grid, order: int, loops: tuple | None = None
+                    ) -> tuple[NDArray[np.float64], ...]:
+    """Gauss points along every loop piece (of ``loops``, default all): points ``(P, 2)``,
+    arc-length weights ``(P,)``, outward unit normals ``(P, 2)``, unit tangents ``(P, 2)``
+    (with ``Ω`` on their left) and the loop index ``(P,)`` among those split."""
+    xi, om = np.polynomial.legendre.leggauss(order)
+    pieces = loop_pieces(domain, grid, loops)
+    half = 0.5 * (pieces.hi - pieces.lo)
+    t = 0.5 * (pieces.lo + pieces.hi)[:, None] + half[:, None] * xi
+    point, tangent = pieces.evaluate(t)
+    speed = np.hypot(tangent[..., 0], tangent[..., 1])
+    run = np.sign(half)[:, None, None] * tangent / speed[..., None]
+    ds = np.abs(half)[:, None] * om * speed
+    normal = np.stack([run[..., 1], -run[..., 0]], axis=-1)
+    loop = np.broadcast_to(pieces.loop[:, None], ds.shape)
+    return (point.reshape(-1, 2), ds.ravel(), normal.reshape(-1, 2), run.reshape(-1, 2),
+            loop.ravel())
+
+
+def nitsche_terms(surface: Any, material: Material, grid: Grid, held: Mapping[int, str]
+                  ) -> sp.csr_matrix:
+    """Nitsche's symmetric terms and penalties of the held loops (module docstring)."""
+    m = material
+    domain = surface.trim
+    first = 1 if holed_rectangle(surface) else 0       # the rectangle's edges are no loop
+    p, ds, n, s, loop = loop_quadrature(domain, grid, surface.basis_u.degree + 2,
+                                        domain.loops[first:])
+    loop = loop + first
+    (_, lu), (_, lv) = surface.domain
+    p = np.clip(p, 0.0, [lu, lv])
+    orders = [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2), (3, 0), (2, 1), (1, 2), (0, 3)]
+    if not (m.w20 or m.w11 or m.w02):
+        orders = orders[:3]
+    B = tensor_values((surface.basis_u, surface.basis_v), p, orders)
+    zero = sp.csr_matrix(B[(0, 0)].shape)
+    D = lambda ab: B.get(ab, zero)  # noqa: E731
+    nu, nv, su, sv = (sp.diags(x) for x in (n[:, 0], n[:, 1], s[:, 0], s[:, 1]))
+    g0 = (m.w10 * nu @ D((1, 0)) + m.w01 * nv @ D((0, 1))
+          - (m.w20 * nu @ D((3, 0)) + m.w11 * (nu @ D((1, 2)) + nv @ D((2, 1)))
+             + m.w02 * nv @ D((0, 3))))
+    gu = m.w20 * nu @ D((2, 0)) + m.w11 * nv @ D((1, 1))
+    gv = m.w02 * nv @ D((0, 2)) + m.w11 * nu @ D((1, 1))
+    h = min(grid.h)
+    bending, tension = max(m.w20, m.w11, m.w02), max(m.w10, m.w01)
+    beta = nitsche_penalty(surface.basis_u.degree)
+    gamma0 = beta * (bending / h ** 3 + tension / h)
+    gamma1 = beta * bending / h
+    K = sp.csr_matrix((B[(0, 0)].shape[1],) * 2)
+    for preset in ("pinned", "clamped"):
+        on = np.isin(loop, [k for k, v in held.items() if v == preset])
+        if not on.any():
+            continue
+        w = sp.diags(np.where(on, ds, 0.0))
+        b0, bu, bv = B[(0, 0)], B[(1, 0)], B[(0, 1)]
+        if preset == "clamped":
+            term = b0.T @ w @ g0 + bu.T @ w @ gu + bv.T @ w @ gv
+            penalty = gamma0 * (b0.T @ w @ b0) + gamma1 * (bu.T @ w @ bu + bv.T @ w @ bv)
+        else:
+            bs = su @ bu + sv @ bv
+            term = b0.T @ w @ g0 + bs.T @ w @ (su @ gu + sv @ gv)
+            penalty = gamma0 * (b0.T @ w @ b0)
+        K = K - term - term.T + penalty
+    return K.tocsr()

@@ -1,0 +1,87 @@
+"""A trim region checked against the surface it trims."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..basis import BSplineBasis
+from ..errors import InputError
+from .cells import Grid
+from .loops import Loop, PolygonLoop, TrimDomain
+
+
+def loop_outside(surface: Any, loop: Loop) -> str | None:
+    """What is wrong when ``loop`` does not lie strictly inside the parameter rectangle
+    ``(0, L_u) × (0, L_v)`` of ``surface`` (a loop on the rectangle's edge would leave the
+    knot cells; the rectangle itself is :func:`whole_rectangle`); None when it does. A spline loop is bounded by its control points."""
+    (_, lu), (_, lv) = surface.domain
+    low, high = (np.asarray(b, dtype=float) for b in loop.bounds())
+    if np.any(low <= 0.0) or high[0] >= lu or high[1] >= lv:
+        return (f"reaches outside the parameter domain (0, {lu:g}) × (0, {lv:g}) of the "
+                f"surface: it spans [{low[0]:g}, {high[0]:g}] × [{low[1]:g}, {high[1]:g}]")
+    return None
+
+
+def trim_grid(surface: Any) -> Grid:
+    """The knot cells of a surface that can be trimmed: equal cells in both directions
+    (``uniform`` or ``open`` knots), one degree."""
+    bases = (surface.basis_u, surface.basis_v)
+    for name, basis in zip("uv", bases):
+        if not isinstance(basis, BSplineBasis) or basis.kind not in ("uniform", "open"):
+            kind = getattr(basis, "kind", type(basis).__name__)
+            raise InputError(f"a trimmed surface needs equal knot cells ('uniform' or 'open' "
+                             f"knots) in {name}, got {kind!r}")
+    if bases[0].degree != bases[1].degree:
+        raise InputError(f"a trimmed surface needs one degree in u and v, got "
+                         f"{bases[0].degree} and {bases[1].degree}")
+    return Grid((bases[0].cells, bases[1].cells), (bases[0].length, bases[1].length))
+
+
+def whole_rectangle(surface: Any, loop: Loop) -> bool:
+    """Whether ``loop`` is the parameter rectangle itself (a polygon through its four
+    corners, to 1e-12 of its size): the outer loop of a rectangle with holes, whose edges
+    are the rectangle's edges ``u0``, ``u1``, ``v0``, ``v1``."""
+    if not isinstance(loop, PolygonLoop) or len(loop.vertices) != 4:
+        return False
+    (_, lu), (_, lv) = surface.domain
+    corners = np.array([[0.0, 0.0], [lu, 0.0], [lu, lv], [0.0, lv]])
+    gap = np.abs(loop.vertices[:, None, :] - corners[None]).max(axis=-1)
+    return bool(np.all(gap.min(axis=1) <= 1e-12 * max(lu, lv)))
+
+
+def holed_rectangle(surface: Any) -> bool:
+    """Whether the trim of ``surface`` is its rectangle less holes (:func:`whole_rectangle`)."""
+    return surface.trim is not None and whole_rectangle(surface, surface.trim.outer)
+
+
+def region_contains(surface: Any, p: Any) -> NDArray[np.bool_]:
+    """Point-in-region test of the trimmed region, the rectangle's edges inside when it is
+    the outer loop (there the even–odd test of the outer polygon is ambiguous)."""
+    if not holed_rectangle(surface):
+        return surface.trim.contains(p)
+    p = np.asarray(p, dtype=float)
+    inside = np.ones(p.shape[:-1], dtype=bool)
+    for hole in surface.trim.holes:
+        inside &= ~hole.encloses(p)
+    return inside
+
+
+def checked_trim(surface: Any, domain: Any) -> TrimDomain:
+    """``domain`` if it is a :class:`TrimDomain` whose loops all lie inside the parameter
+    rectangle of ``surface`` (:func:`loop_outside`), on a surface that can be trimmed
+    (:func:`trim_grid`)."""
+    trim_grid(surface)
+    if not isinstance(domain, TrimDomain):
+        raise InputError(f"a surface's trim must be a splinedeform.trim.TrimDomain, got "
+                         f"{type(domain).__name__}")
+    for k, loop in enumerate(domain.loops):
+        if k == 0 and whole_rectangle(surface, loop):
+            continue
+        problem = loop_outside(surface, loop)
+        if problem:
+            raise InputError(f"trim loop {'the outer loop' if k == 0 else f'hole {k}'} "
+                             f"{problem}")
+    return domain

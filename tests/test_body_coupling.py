@@ -1,0 +1,153 @@
+"""Bodies coupled by their models: non-conforming interfaces, bending across interfaces and
+C0 knot lines, through BodyModel, Model and ShellModel.
+
+The clamped unit square under a unit load, Hessian energy ``∫ (Δw)²`` (the Kirchhoff plate
+with ``D = 1``): centre ``w = 0.00126532 q a⁴ / D``. Its reference is one patch of 48 × 48
+cubic spans; the discretisation error of a body is that of one 8 × 8 patch against the
+reference (1.4e-4 relative), the coarsest side of every body here having 8 spans along the
+interface and 4 across it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import splinedeform as sd
+from splinedeform.physics import coupling
+from splinedeform.physics.shell import ShellMaterial
+from splinedeform.physics.shell_model import ShellModel
+
+from coupling_systems import CLAMPED_PLATE_CENTRE, PLATE, c0_basis, flat_patch, single
+
+LOAD = sd.Uniform((0.0, 0.0, 1.0))
+
+
+@pytest.fixture(scope="module")
+def reference() -> tuple[float, float]:
+    """The fine patch's centre deflection and the discretisation error of 8 × 8 spans."""
+    fine = single(48, PLATE, "clamped")
+    return fine, abs(single(8, PLATE, "clamped") - fine)
+
+
+def centre(model: sd.BodyModel) -> tuple[float, float]:
+    """Centre deflection from the left patch and the jump to the right one there."""
+    static = model.static(LOAD)
+    w = float(static.displacement(0.5, 0.5, patch=0)[2])
+    return w, float(static.displacement(0.0, 0.5, patch=1)[2]) - w
+
+
+def non_conforming() -> sd.BodyModel:
+    """6 × 12 and 4 × 8 spans: no knot along x = 1/2 shared but 0, 1/4, 1/2, 3/4, 1."""
+    body = sd.Body([flat_patch(0.0, 0.5, 6, 12), flat_patch(0.5, 0.5, 4, 8)])
+    assert body.summary()["non_conforming"] == 1
+    return sd.BodyModel(body, PLATE, boundary="clamped")
+
+
+def test_a_non_conforming_clamped_plate_bends_like_one_fine_patch(reference):
+    fine, error = reference
+    assert fine == pytest.approx(CLAMPED_PLATE_CENTRE, rel=4e-5)   # Timoshenko's 5 digits
+    w, jump = centre(non_conforming())
+    # within the discretisation error of the coarser side (measured 9e-5 against 1.4e-4)
+    assert abs(w - fine) <= error
+    assert abs(jump) <= error
+
+
+def test_a_decade_of_penalty_moves_the_body_less_than_its_discretisation_error(
+        reference, monkeypatch):
+    _, error = reference
+    answers = []
+    for scale in (10 ** -0.5, 1.0, 10 ** 0.5):
+        monkeypatch.setattr(coupling, "PENALTY", scale * 1e5)
+        answers.append(centre(non_conforming())[0])
+    assert np.ptp(answers) <= error      # measured 6.9e-6 of the deflection against 1.4e-4
+
+
+def test_conforming_halves_with_bending_are_the_smooth_plate():
+    halves = sd.Body([flat_patch(0.0, 0.5, 4, 8), flat_patch(0.5, 0.5, 4, 8)])
+    assert halves.summary()["non_conforming"] == 0
+    w, jump = centre(sd.BodyModel(halves, PLATE, boundary="clamped"))
+    smooth = single(8, PLATE, "clamped")
+    # merged control points and the rotation penalty: the halves' space (u = 1/2 a C0
+    # line of the 8 × 8 patch) tied back to C1 there. What is left is the penalty error,
+    # 3.6e-6 of the deflection measured, held to 1e-5: a tenth of the 8 × 8 discretisation
+    # error (1.4e-4) and far below the hinge's 10 % (test_coupling_plates.py)
+    assert abs(w - smooth) <= 1e-5 * smooth
+    assert abs(jump) <= 1e-12 * smooth          # merged: the same control points (round-off)
+    # one patch with that C0 line, coupled by Model: the same space, energy (the body's
+    # intrinsic (Δw)², which differs from the parametric Hessian energy by the slope jumps'
+    # terms, 2.4e-6 here) and penalty (the same factor at the same span length), another
+    # assembly order: round-off of a system whose condition number the penalty raises to
+    # ~1e9 (1e-8 held, 6e-10 measured)
+    c0 = sd.Model(flat_patch(0.0, 1.0, 8, 8, basis_u=c0_basis(3, 8)), PLATE,
+                  boundary="clamped", physics="intrinsic")
+    assert float(c0.static(LOAD).displacement(0.5, 0.5)[2]) == pytest.approx(w, rel=1e-8)
+
+
+def slope_jump(surface: sd.Surface, net: np.ndarray) -> float:
+    """``max |∂_u d(1/2⁺) − ∂_u d(1/2⁻)|`` along u = 1/2 over the largest ``|∂_u d|``."""
+    v = np.linspace(0.0, 1.0, 41)
+    below = surface.derivative(0.5 - 1e-12, v, 1, 0, net)      # the left span's last point
+    above = surface.derivative(0.5, v, 1, 0, net)
+    x = np.linspace(0.0, 1.0, 81)
+    slopes = surface.derivative(x[:, None], x[None, :], 1, 0, net)
+    return float(np.abs(above - below).max() / np.abs(slopes).max())
+
+
+def test_a_shell_with_a_c0_line_sags_like_the_smooth_shell():
+    # the issue's case: a flat clamped square whose u = 1/2 is repeated 3 times sagged 1.553
+    # times the closed form, with a slope jump of 0.0104
+    shell = ShellMaterial(E=1.0, nu=0.3, thickness=0.01)
+    D = shell.E * shell.thickness ** 3 / (12 * (1 - shell.nu ** 2))
+    clamped = {e: "clamped" for e in ("u0", "u1", "v0", "v1")}
+    smooth = ShellModel(flat_patch(0.0, 1.0, 8, 8), shell, clamped)
+    kinked_surface = flat_patch(0.0, 1.0, 8, 8, basis_u=c0_basis(3, 8))
+    kinked = ShellModel(kinked_surface, shell, clamped)
+    w_smooth, w = (float(m.static(LOAD).displacement(0.5, 0.5)[2]) * D
+                   for m in (smooth, kinked))
+    # the smooth 8 × 8 shell is 1.4e-4 off the closed form; the coupled C0 line within a
+    # tenth of that of it (the penalty's error; measured 1.7e-6)
+    assert abs(w_smooth / CLAMPED_PLATE_CENTRE - 1) <= 2e-4
+    assert abs(w - w_smooth) <= 1.4e-5 * w_smooth
+    net = kinked.static(LOAD).net_displacement()[..., 2:]
+    # the slope jump across the line against the largest slope: 1e-5 (measured 7.6e-6)
+    assert slope_jump(kinked_surface, net) <= 1e-5
+
+
+def test_modes_and_damped_motion_of_a_coupled_body(reference):
+    model = non_conforming()
+    fine = sd.Model(flat_patch(0.0, 1.0, 48, 48), PLATE, boundary="clamped")
+    coarse = sd.Model(flat_patch(0.0, 1.0, 8, 8), PLATE, boundary="clamped")
+    omega, shapes = model.modes(4)
+    assert [s.shape for s in shapes] == [(4, 9, 15), (4, 7, 11)]
+    exact, approx = fine.frequencies(4), coarse.frequencies(4)
+    # the coupled body's lowest frequencies within the 8 × 8 patch's own error of the fine
+    # patch's (a pair of equal ones: the square's symmetry, to the same error)
+    assert np.all(np.abs(omega - exact) <= np.abs(approx - exact) + 1e-6 * exact)
+    # damped (γ = 20: every mode decays as e^{-10 t}), a step load held from rest: at
+    # t = 5 the closed-form motion is the static answer, e^{-50} ≈ 2e-22 of it away. What
+    # is left is the modes' round-off, ε times the spectrum's range λ_max/λ_min ≈ 6.6e8
+    # that the penalty widens (1.5e-7 of the deflection; measured 7e-9)
+    damped = sd.BodyModel(model.body, sd.Material(w20=1.0, w11=1.0, w02=1.0, damping=20.0),
+                          boundary="clamped")
+    static = damped.static(LOAD)
+    motion = damped.dynamic(LOAD, 5.0, modes="all")
+    for p in range(2):
+        at_rest = static.control_points()[p] - model.patches[p].control_points
+        moved = motion.control_points(5.0)[p] - model.patches[p].control_points
+        scale = np.abs(at_rest).max()
+        assert np.abs(moved - at_rest).max() <= 1.5e-7 * scale
+
+
+def test_modes_of_a_clamped_patch_with_a_c0_line_are_the_smooth_patch_modes():
+    kinked = sd.Model(flat_patch(0.0, 1.0, 8, 8, basis_u=c0_basis(3, 8)), PLATE,
+                      boundary="clamped", physics="intrinsic")
+    smooth = sd.Model(flat_patch(0.0, 1.0, 8, 8), PLATE, boundary="clamped",
+                      physics="intrinsic")
+    # without tension the energy D (Δd)² vanishes on harmonic fields, which the clamped
+    # edges hold at zero: no rigid mode, so the penalty's wide spectrum needs no gap
+    assert kinked.rigid_modes == 0
+    # the C0 space tied back to C1 at u = 1/2: the penalty's error, largest (1.9e-5
+    # measured) for the mode antisymmetric across the line, held to 5e-5
+    np.testing.assert_allclose(kinked.frequencies(4), smooth.frequencies(4), rtol=5e-5)
+
