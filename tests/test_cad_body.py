@@ -236,19 +236,24 @@ def test_faces_are_checked_where_they_are_given(solids_3dm, tmp_path):
     assert "surface.faces" in message
 
 
-def test_a_body_of_several_faces_is_read(solids_3dm, tmp_path):
-    import importlib.util
+def test_a_body_of_several_faces_is_built_and_runs(solids_3dm, tmp_path):
+    from splinedeform.body import BodyModel
+    from splinedeform.body.body import Body
+    from splinedeform.pipeline import run
+    from splinedeform.scenario import build, load_scenario
 
     path = cad_scenario(tmp_path, solids_3dm, 'faces = ["box"]')
-    if importlib.util.find_spec("splinedeform.body.model") is None:
-        message = scenario_error(path)
-        assert ("surface.faces: multi-face bodies are read (6 faces, 12 shared edges, 0 "
-                "seam(s)); running them needs BodyModel") in message
-    else:                                   # pragma: no cover - once bodies run
-        from splinedeform.body.body import Body
-        from splinedeform.scenario import build, load_scenario
-
-        assert isinstance(build(load_scenario(path)).surface, Body)
+    # a closed box has no boundary edge; the preset of one edge alone is refused
+    assert "boundary: a body takes one preset for every boundary edge" in scenario_error(path)
+    path.write_text(path.read_text().replace('u0 = "pinned"', ''))
+    built = build(load_scenario(path))
+    assert isinstance(built.surface, Body) and isinstance(built.model, BodyModel)
+    assert built.surface.faces == (0, 1, 2, 3, 4, 5) and built.units == "in"
+    # the closed box under a pressure: a self-equilibrated load, solved with its mean
+    # motion held; every face moves
+    result = run(load_scenario(path), tmp_path / "out")
+    assert all(np.abs(n[-1] - s.control_points).max() > 0
+               for n, s in zip(result.nets, built.surface.patches))
 
 
 def test_a_face_that_cannot_be_deformed_is_skipped_and_said_why(tmp_path):

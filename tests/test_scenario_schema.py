@@ -96,9 +96,14 @@ def test_models_and_reader_keys_agree_key_for_key():
     profile = fields(S._Profiled)
     assert set(profile) == {"profile"} | {k for ks in PROFILE_KEYS.values() for k in ks}
     same_defaults(profile, LOAD_KEYS, profile)
+    on_face = fields(S._OnFace, without=set(profile))     # face: optional for every kind
+    assert set(on_face) == {"face"}
+    same_defaults(on_face, LOAD_KEYS, on_face)
     for model in S.LOAD_MODELS:
         kind = model.model_fields["kind"].annotation.__args__[0]
-        assert set(fields(model, without=set(profile) | {"kind"})) == set(LOAD_KIND_KEYS[kind])
+        assert set(fields(model, without=set(profile) | {"kind", "face"})) == \
+            set(LOAD_KIND_KEYS[kind])
+        assert "face" in model.model_fields
     for model in S.SOLVE_MODELS:
         kind = model.model_fields["kind"].annotation.__args__[0]
         own = fields(model, without={"kind"})

@@ -127,6 +127,17 @@ def show(resource: str, amount: float) -> str:
     return f"{amount:.0f}"
 
 
+def net_size(model: Any) -> tuple[int, int, int]:
+    """``(n_u, n_v, p)``: the model's control net and its highest degree; a body's patches
+    are counted as one net of all their control points (``n_u = Σ n_u n_v``, ``n_v = 1``)."""
+    patches = getattr(model, "patches", None) or (model.surface,)
+    if len(patches) == 1:
+        n_u, n_v = patches[0].shape
+    else:
+        n_u, n_v = sum(s.shape[0] * s.shape[1] for s in patches), 1
+    return n_u, n_v, max(max(s.basis_u.degree, s.basis_v.degree) for s in patches)
+
+
 def estimate(scenario: Any, model: Any) -> Estimate:
     """Resources of running ``scenario`` with its built ``model`` (see the module docstring)."""
     from .budget_outputs import output_terms
@@ -135,9 +146,8 @@ def estimate(scenario: Any, model: Any) -> Estimate:
     F = len(solve.frame_times()) if solve.kind == "dynamic" else solve.frames
     frames_key = "solve.times" if solve.kind == "dynamic" and solve.times is not None \
         else "solve.frames"
-    n_u, n_v = model.surface.shape
+    n_u, n_v, p = net_size(model)
     G, n = n_u * n_v, model.n_free
-    p = max(model.surface.basis_u.degree, model.surface.basis_v.degree)
     outputs = output_terms(scenario, model, F, frames_key)
 
     nets = Term(F * G * 24.0, f"{F} frames x {n_u} x {n_v} control points x 24 bytes",
@@ -240,7 +250,7 @@ def explicit_work(solve: Any, model: Any) -> Term:
     """
     M, C, K = model.matrices()
     n = model.n_free
-    p = max(model.surface.basis_u.degree, model.surface.basis_v.degree)
+    p = net_size(model)[2]
     omega = highest_frequency(model)
     evaluations = EXPLICIT_EVALUATIONS[solve.method] * float(solve.t_end or 0.0) * omega
     per_evaluation = 6.0 * (K.nnz + C.nnz + 4.0 * n * (2 * p + 1) ** 2) + EVALUATION_OVERHEAD

@@ -83,15 +83,14 @@ def output_terms(scenario: Any, model: Any, frames: int, frames_key: str
                  ) -> dict[str, list[Any]]:
     """Terms of ``memory`` (stages held one at a time), ``disk``, ``files`` and ``work`` of
     every output of ``scenario`` over ``frames`` frames (see the module docstring)."""
-    from .budget import Term
+    from .budget import Term, net_size
 
     output, solve = scenario.output, scenario.solve
     formats = set(output.formats)
     F, r = frames, output.resolution
     r2 = r ** 2
-    n_u, n_v = model.surface.shape
+    n_u, n_v, p = net_size(model)
     G, n = n_u * n_v, model.n_free
-    p = max(model.surface.basis_u.degree, model.surface.basis_v.degree)
     res, fmt, probes_key = "output.resolution", "output.formats", "output.probes"
     P = max(len(output.probes), 1)          # the centre of the domain when none is given
     memory: list[Term] = [Term(F * r2 * 24.0 * 2, f"{F} frames x {r}² surface samples x "
@@ -204,15 +203,14 @@ def mode_terms(scenario: Any, model: Any, frames: int, frames_key: str
         ``A`` animations per format, each as the run's own animation: ``F`` frames
         sampled and rendered, ``F (1.5·10⁸ + 1.5·10⁴ r² + 10⁷)`` operations.
     """
-    from .budget import Term
+    from .budget import Term, net_size
 
     output = scenario.output
     formats = set(output.formats)
     F, r = frames, output.resolution
     r2 = r ** 2
-    n_u, n_v = model.surface.shape
+    n_u, n_v, p = net_size(model)
     G = n_u * n_v
-    p = max(model.surface.basis_u.degree, model.surface.basis_v.degree)
     K = min(scenario.solve.modes, model.n_free)
     res, fmt, modes_key = "output.resolution", "output.formats", "solve.modes"
     memory: list[Term] = []

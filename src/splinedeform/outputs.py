@@ -15,7 +15,10 @@ from typing import TYPE_CHECKING, Any, Protocol
 import numpy as np
 
 from .mode_outputs import animated_modes, mode_file_names, mode_frames
+from .outputs_body import body_outputs, write_body_files
+from .run_report import solution_timings, add_energies_and_probes, mode_table, solver_section
 from .scenario import scenario_to_toml
+from .scenario.body import is_body
 
 if TYPE_CHECKING:
     from .pipeline import RunResult
@@ -49,6 +52,8 @@ def planned_outputs(result: RunResult) -> list[str]:
     from .export import frame_file_names
 
     s = result.scenario
+    if is_body(result.built.surface):
+        return body_outputs(result)
     formats, name = s.output.formats, s.name
     names = [f"{name}.{ext}" for ext in ("obj", "stl", "ply") if ext in formats]
     if "vtu" in formats:
@@ -81,7 +86,10 @@ def write_outputs(result: RunResult, folder: Path, stages: Stages) -> None:
                          frame_pattern=re.escape(name) + r"_\d{4,}\.vtu")
     try:
         result.removed, result.kept = claim.removed, claim.kept
-        _write_files(result, folder, stages)
+        if is_body(result.built.surface):
+            write_body_files(result, folder, stages)
+        else:
+            _write_files(result, folder, stages)
         with stages.stage("manifest"):
             result.outputs.append(("manifest", claim.finish()))
     finally:
@@ -161,10 +169,17 @@ def _write_files(result: RunResult, folder: Path, stages: Stages) -> None:
     if mode_file_names(result):
         _write_mode_files(result, folder, stages)
     if "report" in formats:
-        with stages.stage("report"):
-            result.report = make_report(result)
-            paths = export.write_report(folder, result.report)
-            result.outputs += [("report .json", paths[0]), ("report .md", paths[1])]
+        write_report(result, folder, stages)
+
+
+def write_report(result: RunResult, folder: Path, stages: Stages) -> None:
+    """report.json and report.md of :func:`make_report` (a body's: of its report)."""
+    from . import export
+
+    with stages.stage("report"):
+        result.report = make_report(result)
+        paths = export.write_report(folder, result.report)
+        result.outputs += [("report .json", paths[0]), ("report .md", paths[1])]
 
 
 def peak_frame(result: RunResult) -> int:
@@ -307,6 +322,10 @@ def _write_mode_files(result: RunResult, folder: Path, stages: Stages) -> None:
 
 def make_report(result: RunResult) -> dict[str, Any]:
     """The content of ``report.json`` / ``report.md``: inputs, solver, timings, energies, probes."""
+    if is_body(result.built.surface):
+        from .outputs_body import body_report
+
+        return body_report(result)
     s, surface = result.scenario, result.built.surface
     report: dict[str, Any] = {
         "inputs": {"source": s.source, **tomllib.loads(scenario_to_toml(s))},
@@ -317,31 +336,18 @@ def make_report(result: RunResult) -> dict[str, Any]:
                     "units": result.built.units or "none",
                     "fit_error": surface.fit_error,
                     _unknowns(result.built.model): result.n_free},
-        "solver": {"kind": s.solve.kind,
-                   "method": s.solve.method if s.solve.kind == "dynamic" else "direct",
-                   "t_end": s.solve.t_end if s.solve.kind == "dynamic" else None,
-                   "frames": len(result.times),
-                   "max displacement": result.max_displacement},
-        "timings": {**_solution_timings(result), **result.timings},
+        "solver": solver_section(result),
+        "timings": {**solution_timings(result), **result.timings},
     }
     from .export.shell_fields import is_shell, mode_maxima, stress_report
 
     shell = is_shell(result.built.model)
     if result.omegas is not None:
-        report["modes"] = {"mode": list(range(1, len(result.omegas) + 1)),
-                           "omega": result.omegas,
-                           "frequency (omega / 2 pi)": np.asarray(result.omegas) / (2 * np.pi)}
+        report["modes"] = mode_table(result.omegas)
         if shell and result.shell_modes is not None:
             report["modes"].update(mode_maxima(result.built.model, result.shell_modes,
                                                s.output.resolution))
-    if result.energy is not None:
-        report["energies"] = result.energy
-    frame_label = {"dynamic": "time", "static": "load factor", "modes": "phase"}[s.solve.kind]
-    probes: dict[str, Any] = {frame_label: result.times}
-    for name, d in result.probes.items():
-        probes.update({f"{name} d{c}": d[:, i] for i, c in enumerate("xyz")})
-        probes[f"{name} magnitude"] = np.linalg.norm(d, axis=1)
-    report["probes"] = probes
+    frame_label = add_energies_and_probes(report, result)
     if shell:
         report.update(stress_report(result.built.model, result.rest_net, result.times,
                                     result.nets, s.output.resolution, result.probe_points,
@@ -349,17 +355,15 @@ def make_report(result: RunResult) -> dict[str, Any]:
     return report
 
 
-def _solution_timings(result: RunResult) -> dict[str, float]:
-    timings = getattr(result.solution, "timings", None) or {}
-    return {f"solver: {k}": float(v) for k, v in timings.items()}
-
-
 def summary_rows(result: RunResult) -> list[tuple[str, str]]:
     """(label, value) rows of the closing summary: sizes, times per stage, outputs."""
     s, surface = result.scenario, result.built.surface
+    net = (f"{len(surface)} faces, {sum(p.shape[0] * p.shape[1] for p in surface)} points"
+           if is_body(surface) else
+           f"{surface.shape[0]} x {surface.shape[1]} ({surface.shape[0] * surface.shape[1]} "
+           "points)")
     rows = [("scenario", s.title or s.name),
-            ("control net", f"{surface.shape[0]} x {surface.shape[1]} "
-                            f"({surface.shape[0] * surface.shape[1]} points)"),
+            ("control net", net),
             (_unknowns(result.built.model), str(result.n_free)),
             ("solve", s.solve.kind + (f" ({s.solve.method})" if s.solve.kind == "dynamic"
                                       else "")),

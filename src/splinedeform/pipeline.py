@@ -19,6 +19,9 @@ from .errors import InputError
 from .outputs import make_report, planned_outputs, summary_rows, write_outputs
 from .load_scale import ScaledSolution, load_scale
 from .scenario import Built, Scenario, SolveSpec, _located, build, build_load
+from .pipeline_body import solve_body
+from .run_measures import displacement_per_frame, energies
+from .scenario.body import is_body
 
 #: ``progress(stage, done, total)``, called as each stage advances
 ProgressCallback = Callable[[str, int, int], None]
@@ -70,6 +73,9 @@ class RunResult:
 
     @property
     def rest_net(self) -> Any:
+        """The rest control net (a body's: a list, one per patch)."""
+        if is_body(self.built.surface):
+            return [s.control_points for s in self.built.surface.patches]
         return self.built.surface.control_points
 
 
@@ -124,7 +130,11 @@ def run(scenario: Scenario, outdir: str | Path | None = None,
         with stages.stage("build"):
             built = build(scenario)
             check_budget(scenario, built.model, budget)
-        result = _solve(scenario, built, stages)
+        if is_body(built.surface):
+            result = solve_body(scenario, built, stages)
+            _require_finite(result)
+        else:
+            result = _solve(scenario, built, stages)
         result.timings = stages.timings
         if folder is not None:
             write_outputs(result, folder, stages)
@@ -175,23 +185,9 @@ def _prepare_outdir(scenario: Scenario, outdir: str | Path | None) -> Path:
 def _solve(scenario: Scenario, built: Built, stages: _Stages) -> RunResult:
     import numpy as np
 
-    solve, model = scenario.solve, built.model
-    solution, omegas, shapes = None, None, None
-    times = np.asarray(solve.frame_times() if solve.kind == "dynamic"
-                       else np.linspace(0.0, 1.0, solve.frames))
-    scale = load_scale(scenario)           # extreme loads solved at order one, then scaled
-    with stages.stage("solve"), _located(scenario, "solve"), stages.simulated("solve"):
-        load = built.load if scale == 1.0 else build_load(scenario, scale)
-        if solve.kind == "static":
-            solution = model.static(load)
-        elif solve.kind == "dynamic":
-            solution = model.dynamic(load, solve.t_end, method=solve.method,
-                                     **_method_options(solve, times, scenario.output.time))
-        if solution is not None and scale != 1.0:
-            solution = ScaledSolution(solution, scale)
-    if solve.modes > 0 and solve.kind != "static":
-        with stages.stage("modes"), _located(scenario, "solve.modes"):
-            omegas, shapes = model.modes(min(solve.modes, model.n_free))
+    times = np.asarray(scenario.solve.frame_times() if scenario.solve.kind == "dynamic"
+                       else np.linspace(0.0, 1.0, scenario.solve.frames))
+    solution, omegas, shapes = solve_and_modes(scenario, built, stages, times)
     mode_nets = None if shapes is None else mode_displacements(built.surface, shapes)
     with stages.stage("frames"), _located(scenario, "solve"):
         nets = _frames(scenario, built, solution, times, mode_nets)
@@ -206,6 +202,30 @@ def _solve(scenario: Scenario, built: Built, stages: _Stages) -> RunResult:
         _measure(result)
     _require_finite(result)
     return result
+
+
+def solve_and_modes(scenario: Scenario, built: Built, stages: _Stages, times: Any,
+                    static: Callable[[Any, Any], Any] | None = None) -> tuple[Any, Any, Any]:
+    """``(solution, omegas, shapes)``: the static or dynamic solution at ``times`` (None
+    for modes) and the modes when asked for; ``static(model, load)`` solves a static one
+    (default ``model.static(load)``)."""
+    solve, model = scenario.solve, built.model
+    solution, omegas, shapes = None, None, None
+    scale = load_scale(scenario)           # extreme loads solved at order one, then scaled
+    with stages.stage("solve"), _located(scenario, "solve"), stages.simulated("solve"):
+        load = built.load if scale == 1.0 else build_load(
+            scenario, scale, built.surface if is_body(built.surface) else None)
+        if solve.kind == "static":
+            solution = (static or (lambda m, f: m.static(f)))(model, load)
+        elif solve.kind == "dynamic":
+            solution = model.dynamic(load, solve.t_end, method=solve.method,
+                                     **_method_options(solve, times, scenario.output.time))
+        if solution is not None and scale != 1.0:
+            solution = ScaledSolution(solution, scale)
+    if solve.modes > 0 and solve.kind != "static":
+        with stages.stage("modes"), _located(scenario, "solve.modes"):
+            omegas, shapes = model.modes(min(solve.modes, model.n_free))
+    return solution, omegas, shapes
 
 
 def _extreme_inputs(scenario: Scenario) -> list[tuple[str, float]]:
@@ -233,7 +253,8 @@ def _require_finite(result: RunResult) -> None:
     """Refuse a solution, energy or probe that overflowed to NaN or inf before anything is written."""
     import numpy as np
 
-    arrays = [result.nets, result.max_displacement, *result.probes.values(),
+    nets = result.nets if isinstance(result.nets, list) else [result.nets]
+    arrays = [*nets, result.max_displacement, *result.probes.values(),
               *(result.energy or {}).values()]
     if result.omegas is not None:
         arrays.append(result.omegas)
@@ -319,8 +340,6 @@ def _measure(result: RunResult) -> None:
     """Probe histories, the largest surface displacement and the energies."""
     import numpy as np
 
-    from .rational import grid_nets
-
     scenario, surface = result.scenario, result.built.surface
     D = result.nets - surface.control_points
     probes = scenario.output.probes or (_domain_centre(surface),)
@@ -333,28 +352,10 @@ def _measure(result: RunResult) -> None:
         name = f"p{i} ({u:g}, {v:g})"
         result.probes[name] = histories[i - 1]
         result.probe_points[name] = (float(u), float(v))
-    if surface.trim is not None:             # the displacement inside the trim loops only
-        from .export import tessellate_frames
-
-        grid = tessellate_frames(surface, D, scenario.output.resolution)[0]
-    else:
-        uu, vv = surface.sample_parameters(scenario.output.resolution)
-        grid = grid_nets(surface, uu, vv, D)
-    # |d| per frame, scaled so that the squares of a tiny d do not underflow
-    size = float(np.abs(grid).max(initial=0.0))
-    scale = size if 0.0 < size < np.inf else 1.0
-    per_frame = scale * np.linalg.norm(grid / scale, axis=-1).reshape(len(grid), -1).max(axis=1)
+    per_frame = displacement_per_frame(surface, D, scenario.output.resolution)
     result.displacement_per_frame = per_frame
     result.max_displacement = float(per_frame.max(initial=0.0))
-    solution = result.solution
-    if scenario.solve.kind == "dynamic":
-        energy = solution.energy(result.times)
-        result.energy = {"time": result.times, "kinetic": energy.kinetic,
-                         "strain": energy.strain, "work": energy.work, "total": energy.total}
-    elif scenario.solve.kind == "static":
-        energy = solution.energy()
-        result.energy = {"strain": float(energy.strain), "work": float(energy.work),
-                         "total": float(energy.total)}
+    result.energy = energies(result)
 
 
 def _domain_centre(surface: Any) -> tuple[float, float]:

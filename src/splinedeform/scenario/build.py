@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any, Iterator
 
 from ..errors import InputError, ScenarioError
+from .body import body_model, check_single_surface_loads, describe_body, is_body
 from .spec import Scenario, SurfaceSpec
 from ..trim.surface_trim import region_contains
 from .trim_build import loop_presets, trimmed
@@ -105,15 +106,18 @@ def _fit_options(spec: SurfaceSpec) -> dict[str, Any]:
 
 def _surface_from_cad(scenario: Scenario) -> tuple[Any, str | None]:
     """Surface ``face`` of a CAD file, as a deformable NURBS surface (trimming dropped),
-    and its unit: ``surface.units`` if given, else the file's; with ``faces``, the body
-    of the faces chosen (:func:`_body_from_cad`)."""
+    and its unit: ``surface.units`` if given, else the file's; without ``face``, the body
+    of the faces chosen by ``faces`` (default ``"all"``; :func:`.body.body_from_cad`)."""
     from ..cad import read_cad, surface_from_patch
 
     path = scenario.surface.path
     assert path is not None
     face = scenario.surface.parameters["face"]
-    if scenario.surface.parameters.get("faces") is not None:
-        body, face, units = _body_from_cad(scenario)
+    raw = scenario.raw.get("surface", {})
+    if "face" not in raw or "faces" in raw:          # faces = "all" unless face is given
+        from .body import body_from_cad
+
+        body, face, units = body_from_cad(scenario)
         if body is not None:
             return body, scenario.surface.parameters.get("units") or units
     with _located(scenario, "surface.path"):
@@ -121,44 +125,6 @@ def _surface_from_cad(scenario: Scenario) -> tuple[Any, str | None]:
         surface = surface_from_patch(patch, name=f"{path.stem} face {face}",
                                      source=f"{path} face {face}")
     return surface, scenario.surface.parameters.get("units") or patch.units
-
-
-def _body_from_cad(scenario: Scenario) -> tuple[Any, int, str | None]:
-    """``(body, face, units)`` of ``surface.faces``: one face chosen gives no body and
-    that face (read as ``face`` is); several give a ``Body`` of their surfaces and the
-    file's interfaces, which needs :class:`~splinedeform.body.model.BodyModel` to run."""
-    from ..cad_body import body_of, choose_faces, read_listing
-
-    spec, raw = scenario.surface, scenario.raw.get("surface", {})
-    if "face" in raw:
-        raise scenario.error("surface.faces", "give face (one face) or faces (a body), "
-                                              "not both")
-    path, faces = spec.path, spec.parameters["faces"]
-    with _located(scenario, "surface.path"):
-        listing = read_listing(path)
-        if not listing["faces"]:
-            raise InputError(f"{path}: the file holds no surface")
-    with _located(scenario, "surface.faces"):
-        chosen = choose_faces(listing, list(faces) if isinstance(faces, tuple) else faces,
-                              str(path))
-    if len(chosen) == 1:
-        return None, chosen[0], listing["units"]
-    with _located(scenario, "surface.faces"):
-        surfaces, topology, info = body_of(path, listing, chosen)
-    try:
-        from ..body.body import Body
-        from ..body.model import BodyModel  # noqa: F401  (what runs a body)
-    except ImportError:
-        counts = topology.counts
-        raise scenario.error("surface.faces", (
-            f"multi-face bodies are read ({len(surfaces)} faces, {counts['shared']} shared "
-            f"edges, {counts['seam']} seam(s)); running them needs BodyModel "
-            "(splinedeform.body.model), which this version lacks: choose one face with "
-            "face = k")) from None
-    for key in ("refine", "elevate"):
-        if getattr(spec, key) != (0, 0):
-            raise scenario.error(f"surface.{key}", "applies to one face, not yet to a body")
-    return Body(surfaces, topology.interfaces), chosen[0], info["units"]
 
 
 def _surface_from_file(scenario: Scenario) -> Any:
@@ -225,15 +191,17 @@ def _point_grid(scenario: Scenario, path: Path) -> Any:
         return real_array(data, f"point grid {path.name}")
 
 
-def build_load(scenario: Scenario, scale: float = 1.0) -> Any:
+def build_load(scenario: Scenario, scale: float = 1.0, body: Any = None) -> Any:
     """The sum of the ``[[load]]`` tables as a :mod:`splinedeform.loads` object (or None),
-    with forces and pressures divided by ``scale`` (see :mod:`splinedeform.load_scale`).
+    with forces and pressures divided by ``scale`` (see :mod:`splinedeform.load_scale`);
+    on a ``body``, a load naming its ``face`` acts on that face only.
 
     Under ``physics = "shell"`` a ``uniform`` load is a force per unit surface area
     (:class:`~splinedeform.AreaForce`, e.g. self-weight).
     """
     from .. import loads as L
     from ..physics.shell_model import AreaForce
+    from .body import on_faces
 
     uniform = AreaForce if scenario.material.physics == "shell" else L.Uniform
 
@@ -249,6 +217,7 @@ def build_load(scenario: Scenario, scale: float = 1.0) -> Any:
             load = {"point": lambda: L.Point(spec.at[0], spec.at[1], force, profile),
                     "uniform": lambda: uniform(force=force, profile=profile),
                     "pressure": lambda: L.Pressure(q, profile)}[spec.kind]()
+        load = on_faces(scenario, body, load, i)
         total = load if total is None else total + load
     return total
 
@@ -309,9 +278,10 @@ def _check_parameters(scenario: Scenario, surface: Any) -> None:
 def build(scenario: Scenario) -> Built:
     """Surface, model and load of a scenario; library input errors name the scenario key."""
     surface, units = _checked_surface(scenario)
-    _check_parameters(scenario, surface)
+    if not is_body(surface):
+        _check_parameters(scenario, surface)
     built = _model_on(scenario, surface, units)
-    built.load = build_load(scenario)
+    built.load = build_load(scenario, body=surface if is_body(surface) else None)
     return built
 
 
@@ -343,6 +313,11 @@ def _model_on(scenario: Scenario, surface: Any, units: str | None) -> Built:
     from ..material import Material
     from ..model import Model
 
+    if is_body(surface):
+        return Built(surface=surface, model=body_model(scenario, surface), load=None,
+                     units=units)
+    check_single_surface_loads(scenario, scenario.surface.parameters.get("face")
+                               if scenario.surface.shape == "cad" else None)
     fixed = free_region_mask(scenario, surface)
     if scenario.material.physics == "shell":
         return Built(surface=surface, model=_shell_model(scenario, surface, fixed),
@@ -372,7 +347,9 @@ def describe(scenario: Scenario, built: Built | None = None) -> list[tuple[str, 
     """(label, value) rows saying what :func:`run` would do (for ``splinedeform validate``)."""
     s = scenario
     rows = [("scenario", s.title or s.name), ("surface", s.surface.shape)]
-    if built is not None:
+    if built is not None and is_body(built.surface):
+        rows += describe_body(built)
+    elif built is not None:
         n_u, n_v = built.surface.shape
         rows += [("control net", f"{n_u} x {n_v} ({n_u * n_v} points)"),
                  (getattr(built.model, "unknowns_label", "free control points"),

@@ -67,11 +67,14 @@ def length_problems(surface: Any, material: Any) -> list[tuple[str, str]]:
 
 
 def extent_problem(surface: Any, thickness: float | None) -> str | None:
-    """For a surface read from a file: a message when its control net's extent lies outside
-    the usable range, or the shell ``thickness`` is too small for it; None when fine."""
+    """For a surface read from a file (or a body of its faces): a message when its control
+    nets' extent lies outside the usable range, or the shell ``thickness`` is too small for
+    it; None when fine."""
     import numpy as np
 
-    P = np.asarray(surface.control_points, dtype=float).reshape(-1, 3)
+    nets = surface.patches if hasattr(surface, "patches") else (surface,)
+    P = np.concatenate([np.asarray(s.control_points, dtype=float).reshape(-1, 3)
+                        for s in nets])
     extent = float(np.ptp(P, axis=0).max()) if P.size else 0.0
     low, high = LENGTH_RANGE
     if math.isfinite(extent) and extent > 0 and not low <= extent <= high:

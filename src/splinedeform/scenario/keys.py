@@ -64,10 +64,11 @@ LOAD_KEYS: dict[str, Key] = {
     **_keys(S.PointLoad, ("at", "force"), at=None, force=None),
     **_keys(S.PressureLoad, ("q",), q=None),
     **_keys(S._Profiled, _PROFILED, t_off=math.inf),
+    **_keys(S._OnFace, ("face",), face=None),
 }
 
 #: load keys allowed for each kind and each profile
-LOAD_KIND_KEYS = {kind: tuple(n for n in model.model_fields if n not in (*_PROFILED, "kind"))
+LOAD_KIND_KEYS = {kind: tuple(n for n in model.model_fields if n not in (*_PROFILED, "kind", "face"))
                   for kind, model in zip(LOAD_KINDS, S.LOAD_MODELS)}
 PROFILE_KEYS = {"constant": (), "step": ("t_on", "t_off"), "piecewise": ("points",),
                 "harmonic": ("omega", "phase")}

@@ -134,7 +134,16 @@ class _Profiled(_Table):
     phase: Real = Field(0.0, description="`harmonic`: φ")
 
 
-class PointLoad(_Profiled):
+class _OnFace(_Profiled):
+    face: Optional[Annotated[int, Strict(), Field(ge=0)]] = Field(
+        None, description=(
+            "body of CAD faces only: the face (its number in the file, as `splinedeform "
+            "faces FILE` lists it) the load acts on; a point load's `at` are that face's "
+            "parameters"),
+        json_schema_extra={"doc_default": "every face (required for `point` on a body)"})
+
+
+class PointLoad(_OnFace):
     kind: Literal["point"]
     at: Pair = Field(title="[u, v]", description="where a point force acts",
         json_schema_extra={"doc_default": 'required for `point`'})
@@ -144,7 +153,7 @@ class PointLoad(_Profiled):
         json_schema_extra={"doc_default": 'required for `point`, `uniform`'})
 
 
-class UniformLoad(_Profiled):
+class UniformLoad(_OnFace):
     kind: Literal["uniform"]
     force: tuple[Real, Real, Real] = Field(title="[fx, fy, fz]", description=(
             "the force (point) or force per parameter area (uniform; per unit surface area "
@@ -152,7 +161,7 @@ class UniformLoad(_Profiled):
         json_schema_extra={"doc_default": 'required for `point`, `uniform`'})
 
 
-class PressureLoad(_Profiled):
+class PressureLoad(_OnFace):
     kind: Literal["pressure"]
     q: Real = Field(description=(
             "pressure; the force density is `q x0_u × x0_v`, so a positive `q` pushes along the "

@@ -188,15 +188,16 @@ class FromCad(_Refined):
         json_schema_extra={"doc_default": "required for `cad`"})
     face: Annotated[int, Strict(), Field(ge=0)] = Field(0, description=(
             "which surface of the file, counting plain surfaces and Brep faces in file "
-            "order from 0; a trimmed face is taken untrimmed, with a warning"))
+            "order from 0, read alone; a trimmed face is taken untrimmed, with a warning"),
+        json_schema_extra={"doc_default": "every face (`faces`)"})
     faces: Optional[Union[Literal["all"], Annotated[list[FaceNumber], Field(min_length=1)],
                           Annotated[list[FaceName], Field(min_length=1)]]] = Field(
         None, description=(
             "several faces read as one body: `\"all\"` (every face of every surface object), "
             "face numbers (as `splinedeform faces FILE` lists them) or names of objects or "
             "layers (`.3dm`), with the file's topology (shared edges, seams); one face "
-            "chosen is the same as `face`; not with `face`"),
-        json_schema_extra={"doc_default": "`face` alone"})
+            "chosen (a file of one face) is the same as `face`; not with `face`"),
+        json_schema_extra={"doc_default": '"all" unless `face` is given'})
     units: Optional[Literal[CAD_UNITS]] = Field(  # type: ignore[valid-type]
         None, description=(
             "length unit of the file's coordinates, overriding the unit the file declares "

@@ -115,6 +115,7 @@ class LoadSpec:
     points: tuple[tuple[float, float], ...] | None = None
     omega: float | None = None
     phase: float = 0.0
+    face: int | None = None
 
 
 @dataclass(frozen=True)

@@ -57,7 +57,7 @@ def _solve_items(solve: SolveSpec) -> list[tuple[str, Any]]:
 
 def _load_items(load: LoadSpec) -> list[tuple[str, Any]]:
     keys = ("kind",) + LOAD_KIND_KEYS[load.kind] + ("profile",) + PROFILE_KEYS[load.profile]
-    return [(k, getattr(load, k)) for k in keys]
+    return [(k, getattr(load, k)) for k in keys] + [("face", load.face)]
 
 
 def scenario_to_toml(scenario: Scenario) -> str:
@@ -79,6 +79,8 @@ def scenario_to_toml(scenario: Scenario) -> str:
         items += [item for item in fitted if grid or item[0] in given]
         items += [("frame", surface.frame)] if "frame" in given else []
     elif surface.shape == "cad":
+        if "face" not in s.raw.get("surface", {}):       # every face (faces), not face 0
+            items = [item for item in items if item[0] != "face"]
         items += [("path", surface.path)]
     else:
         items += fitted

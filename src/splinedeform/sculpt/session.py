@@ -21,6 +21,7 @@ import numpy as np
 
 from ..errors import InputError, ScenarioError
 from ..scenario import build, free_region_mask, scenario_to_toml, with_overrides
+from ..scenario.body import is_body
 from ..scenario.spec import Scenario
 from .carry import transfer
 from .correction import StaticCorrection, offline_data, static_correction
@@ -94,7 +95,11 @@ class Session:
     def _solve_now(self, scenario: Scenario, carry: bool = True) -> None:
         start = time.perf_counter()
         self._stage("assembling the matrices", start)
-        model = build(scenario).model
+        built = build(scenario)
+        if is_body(built.surface):
+            raise scenario.error("surface.faces", f"sculpting opens one surface, not yet a body "
+                                 f"of {len(built.surface)} faces: choose one with face = k")
+        model = built.model
         k = None if self.modes is None or self.modes >= model.n_free else int(self.modes)
         self._stage(f"computing {k or model.n_free} modes", start)
         basis = sculpt_basis(model, self.resolution, k)

@@ -136,13 +136,49 @@ def render_surfaces(path: str | os.PathLike[str], surface: Surface, rest_net: Ar
     if not (isinstance(warp, (int, float)) and np.isfinite(warp) and warp > 0):
         raise InputError(f"warp must be finite and > 0, got {warp!r}")
     X, mag, faces = _displaced_meshes(surface, rest_net, nets, resolution, float(warp))
+    return _render(target, X, mag, faces, titles, float(warp), camera)
+
+
+def render_body_surfaces(path: str | os.PathLike[str], patches: Sequence[Surface],
+                         rest_nets: Sequence[ArrayLike], nets: Sequence[Sequence[ArrayLike]],
+                         titles: Sequence[str], resolution: int = 48, warp: float = 1.0,
+                         camera: tuple[float, float] = CAMERA) -> Path:
+    """:func:`render_surfaces` of a body: every patch drawn in every panel.
+
+    ``nets[i]`` holds panel ``i``'s net of each patch. The patches are sampled on their
+    ``r × r`` grids and welded where they meet (:func:`splinedeform.export.welded_body`),
+    so a panel is one mesh of the whole body coloured by ``|x - x_rest|``.
+    """
+    from ..export.body import welded_body
+
+    target = Path(path)
+    if target.suffix.lower() != ".png":
+        raise InputError(f"render_body_surfaces writes PNG; got {target.name!r}")
+    if len(nets) == 0 or len(nets) != len(titles):
+        raise InputError(f"give one title per panel and at least one panel; got {len(nets)} "
+                         f"panel(s) and {len(titles)} title(s)")
+    if not (isinstance(warp, (int, float)) and np.isfinite(warp) and warp > 0):
+        raise InputError(f"warp must be finite and > 0, got {warp!r}")
+    frames = [np.stack([np.asarray(rest, dtype=float)] + [np.asarray(panel[k], dtype=float)
+                                                          for panel in nets])
+              for k, rest in enumerate(rest_nets)]
+    X, faces, _ = welded_body(patches, frames, resolution)
+    d = X[1:] - X[0]
+    return _render(target, X[0] + float(warp) * d, np.linalg.norm(d, axis=-1), faces,
+                   [str(t) for t in titles], float(warp), camera)
+
+
+def _render(target: Path, X: NDArray[np.float64], mag: NDArray[np.float64],
+            faces: NDArray[np.int64], titles: Sequence[str], warp: float,
+            camera: tuple[float, float]) -> Path:
+    """The picture of drawn panels ``X`` coloured by ``mag``, PyVista else matplotlib."""
     vmax = float(mag.max())
     titles = [str(t) for t in titles]
-    caption = warp_caption(float(warp))
+    caption = warp_caption(warp)
     if _pyvista() is not None:
         try:
             return _render_pyvista(target, X, mag, faces, titles, vmax, caption)
         except Exception:   # noqa: BLE001  (no off-screen context: draw with matplotlib)
             pass
-    return _render_matplotlib(target, X, mag, faces, titles, vmax, camera, float(warp))
+    return _render_matplotlib(target, X, mag, faces, titles, vmax, camera, warp)
 

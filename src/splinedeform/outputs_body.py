@@ -1,0 +1,155 @@
+"""Writing a body's outputs: every face in every file (:mod:`splinedeform.export.body`).
+
+* ``obj`` / ``stl`` / ``ply``: the deformed body (at ``output.time``, else the last frame)
+  as one mesh welded across shared edges and seams, with ``patch`` and ``displacement``;
+* ``vtu``: a ParaView series ``name.pvd`` of welded ``.vtu`` meshes, one per frame;
+* ``3dm``, ``step``, ``iges``: the deformed body's faces in the file's unit (the ``.3dm``
+  one named surface per face, STEP / IGES sewn into one shell);
+* ``images``: ``surfaces.png`` (every face at rest and at the frame of largest
+  displacement, one welded mesh), ``probes.png`` for a dynamic solve (the faces' centres);
+* ``report``: ``report.json`` / ``report.md`` naming the unit, the faces and the topology.
+
+Other formats are refused for a body when the scenario is built
+(:func:`splinedeform.scenario.body.check_body_scenario`).
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from .outputs import Stages
+    from .pipeline import RunResult
+
+
+def _suffixes() -> dict[str, str]:
+    from .outputs import STEP_FILES
+
+    return STEP_FILES
+
+
+def body_outputs(result: RunResult) -> list[str]:
+    """Names of every file :func:`write_body_files` writes, in order."""
+    from .export import frame_file_names
+
+    s = result.scenario
+    formats, name = s.output.formats, s.name
+    names = [f"{name}.{ext}" for ext in ("obj", "stl", "ply") if ext in formats]
+    if "vtu" in formats:
+        names += [*frame_file_names(name, len(result.times)), f"{name}.pvd"]
+    names += [f"{name}.3dm"] if "3dm" in formats else []
+    names += [f"{name}{suffix}" for ext, suffix in _suffixes().items() if ext in formats]
+    if "images" in formats:
+        names += ["surfaces.png"] + (["probes.png"] if s.solve.kind == "dynamic" else [])
+    return names + (["report.json", "report.md"] if "report" in formats else [])
+
+
+def deformed_nets(result: RunResult) -> list[Any]:
+    """Per face the net written as a mesh or CAD file: ``output.time``, else the last frame."""
+    time_ = result.scenario.output.time
+    if time_ is not None and result.scenario.solve.kind == "dynamic":
+        return [np.asarray(n) for n in result.solution.control_points(time_)]
+    return [n[-1] for n in result.nets]
+
+
+def peak_frame(result: RunResult) -> int:
+    """The first frame of the largest displacement on the faces' output grids."""
+    return int(np.argmax(result.displacement_per_frame))
+
+
+def write_body_files(result: RunResult, folder: Path, stages: Stages) -> None:
+    """Every requested format of a body (module docstring)."""
+    from .export import body as body_files
+
+    s = result.scenario
+    formats, name, res = s.output.formats, s.name, s.output.resolution
+    body, units = result.built.surface, result.built.units
+    patches, rest = list(body.patches), result.rest_net
+    names = [f"{s.name} face {f}" for f in getattr(body, "faces", range(len(patches)))]
+    for ext in ("obj", "stl", "ply"):
+        if ext in formats:
+            with stages.stage(f"mesh .{ext}"):
+                result.outputs.append((f"mesh .{ext}", body_files.write_body_mesh(
+                    folder / f"{name}.{ext}", patches, deformed_nets(result), rest, res)))
+    if "vtu" in formats:
+        with stages.stage("time series"):
+            result.outputs.append(("time series .pvd", body_files.write_body_series(
+                folder, name, patches, rest, result.times, result.nets, res)))
+    if "3dm" in formats:
+        with stages.stage("CAD surfaces"):
+            result.outputs.append(("NURBS surfaces .3dm", body_files.write_body_3dm(
+                folder / f"{name}.3dm", patches, deformed_nets(result), names, units)))
+    for ext, suffix in _suffixes().items():
+        if ext in formats:
+            with stages.stage(f"CAD surfaces {suffix}"):
+                result.outputs.append((f"NURBS surfaces {suffix}", body_files.write_body_step(
+                    folder / f"{name}{suffix}", patches, deformed_nets(result), units)))
+    if "images" in formats:
+        _write_images(result, folder, stages)
+    if "report" in formats:
+        from .outputs import write_report
+
+        write_report(result, folder, stages)
+
+
+def _write_images(result: RunResult, folder: Path, stages: Stages) -> None:
+    from . import viz
+    from .outputs import FRAME_LABELS
+
+    s = result.scenario
+    label = FRAME_LABELS[s.solve.kind]
+    with stages.stage("images"):
+        peak = peak_frame(result)
+        result.outputs.append(("picture", viz.render_body_surfaces(
+            folder / "surfaces.png", list(result.built.surface.patches), result.rest_net,
+            [[n[0] for n in result.nets], [n[peak] for n in result.nets]],
+            [f"initial ({label} = {result.times[0]:g})",
+             f"largest displacement ({label} = {result.times[peak]:.4g})"],
+            warp=_warp(result), camera=s.output.camera)))
+        if s.solve.kind == "dynamic":
+            result.outputs.append(("probe plot", viz.plot_probes(
+                folder / "probes.png", result.times, result.probes)))
+
+
+def _warp(result: RunResult) -> float:
+    """The pictures' warp factor (:func:`splinedeform.outputs.picture_warp`) on the body's
+    box: ``output.warp``, 1 for modes, else :func:`splinedeform.viz.warp.auto_warp`."""
+    from .viz.warp import auto_warp
+
+    warp = result.scenario.output.warp
+    if warp != "auto":
+        return float(warp)
+    if result.scenario.solve.kind == "modes":
+        return 1.0
+    rest = np.concatenate([np.asarray(r).reshape(-1, 3) for r in result.rest_net])
+    return auto_warp(float(result.max_displacement), float(np.ptp(rest, axis=0).max()))
+
+
+def body_report(result: RunResult) -> dict[str, Any]:
+    """The content of ``report.json`` / ``report.md`` of a body: inputs, the body (unit,
+    faces, topology counts, nets), solver, timings, energies, modes and the faces' centres."""
+    from .run_report import solution_timings, add_energies_and_probes, mode_table, solver_section
+    from .scenario import scenario_to_toml
+
+    s, body = result.scenario, result.built.surface
+    faces = list(getattr(body, "faces", range(len(body))))
+    report: dict[str, Any] = {
+        "inputs": {"source": s.source, **tomllib.loads(scenario_to_toml(s))},
+        "body": {"shape": s.surface.shape, "units": result.built.units or "none",
+                 "faces": faces, "patches": len(body),
+                 "topology": getattr(body, "counts", None) or body.summary(),
+                 "interfaces": len(body.interfaces),
+                 "nets": [f"{p.shape[0]} x {p.shape[1]}" for p in body],
+                 "degrees": [[p.basis_u.degree, p.basis_v.degree] for p in body],
+                 "free control points": result.n_free},
+        "solver": solver_section(result),
+        "timings": {**solution_timings(result), **result.timings},
+    }
+    if result.omegas is not None:
+        report["modes"] = mode_table(result.omegas)
+    add_energies_and_probes(report, result)
+    return report

@@ -1,0 +1,177 @@
+"""Scenarios of a body: several faces of a CAD file deformed as one connected surface.
+
+``[surface] shape = "cad"`` with ``faces`` choosing more than one face builds a
+:class:`FileBody` (the patches, the file's interfaces, the file face number of each patch)
+and a :class:`~splinedeform.body.BodyModel`. What a body takes from a scenario:
+
+* ``[boundary]``: one preset for every boundary edge (an edge no other face meets), so
+  ``u0 = u1 = v0 = v1``; a free region or listed points are a single surface's;
+* ``[[load]]``: a uniform force or a pressure acts on every face, or on face ``face``
+  only; a point load names its face (``face = k``, the file's face number) and ``at`` in
+  that face's parameters;
+* ``[output]``: the formats of :data:`BODY_FORMATS`; probes are the faces' centres.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+from ..body.body import Body
+from .spec import Scenario
+
+#: output formats written for a body (:mod:`splinedeform.outputs_body`)
+BODY_FORMATS = ("vtu", "obj", "stl", "ply", "3dm", "step", "iges", "images", "report")
+#: physics a body runs with (the shell's coupling across interfaces lands separately)
+BODY_PHYSICS = ("intrinsic", "parametric")
+
+
+class FileBody(Body):
+    """A :class:`~splinedeform.body.Body` read from a CAD file.
+
+    Parameters
+    ----------
+    patches, interfaces
+        As for :class:`~splinedeform.body.Body` (the interfaces are the file's).
+    faces : sequence of int
+        The file's face number of each patch.
+    counts : dict
+        The file's edge counts (shared, boundary, seam, non_manifold, off_sides).
+    """
+
+    def __init__(self, patches: Sequence[Any], interfaces: Sequence[Any],
+                 faces: Sequence[int], counts: dict[str, int]):
+        super().__init__(patches, interfaces)
+        self.faces = tuple(int(f) for f in faces)
+        self.counts = dict(counts)
+
+    def patch_of_face(self, face: int) -> int | None:
+        """The patch index of the file's face ``face`` (None if the body lacks it)."""
+        return self.faces.index(face) if face in self.faces else None
+
+
+def is_body(surface: Any) -> bool:
+    """Whether a built surface is a body of patches."""
+    return isinstance(surface, Body)
+
+
+def body_from_cad(scenario: Scenario) -> tuple[Any, int, str | None]:
+    """``(body, face, units)`` of ``surface.faces`` (``"all"`` when neither ``face`` nor
+    ``faces`` is given): one face chosen gives no body and that face (read as ``face``
+    is); several give a :class:`FileBody` of their surfaces and the file's interfaces."""
+    from ..cad_body import body_of, choose_faces, read_listing
+    from ..errors import InputError
+    from .build import _located
+
+    spec, raw = scenario.surface, scenario.raw.get("surface", {})
+    if "face" in raw and "faces" in raw:
+        raise scenario.error("surface.faces", "give face (one face) or faces (a body), "
+                                              "not both")
+    path, faces = spec.path, spec.parameters.get("faces") or "all"
+    with _located(scenario, "surface.path"):
+        listing = read_listing(path)
+        if not listing["faces"]:
+            raise InputError(f"{path}: the file holds no surface")
+    with _located(scenario, "surface.faces"):
+        chosen = choose_faces(listing, list(faces) if isinstance(faces, tuple) else faces,
+                              str(path))
+    if len(chosen) == 1:
+        return None, chosen[0], listing["units"]
+    with _located(scenario, "surface.faces"):
+        surfaces, topology, info = body_of(path, listing, chosen)
+    for key in ("refine", "elevate"):
+        if getattr(spec, key) != (0, 0):
+            raise scenario.error(f"surface.{key}", "applies to one face, not yet to a body")
+    return (FileBody(surfaces, topology.interfaces, info["faces"], topology.counts),
+            chosen[0], info["units"])
+
+
+def check_body_scenario(scenario: Scenario, body: FileBody) -> None:
+    """Refuse, at its key, what a body does not take (module docstring)."""
+    s = scenario
+    if s.material.physics not in BODY_PHYSICS:
+        raise s.error("material.physics", f"a body of {len(body)} faces runs with physics "
+                      f"{' or '.join(BODY_PHYSICS)}; the shell is not coupled across a body's "
+                      "interfaces yet (choose one face with face = k)")
+    presets = s.boundary.edges()
+    if len(set(presets.values())) > 1:
+        raise s.error("boundary", "a body takes one preset for every boundary edge (an edge "
+                      "no other face meets): give u0 = u1 = v0 = v1, got " + ", ".join(
+                          f"{e} = {p!r}" for e, p in presets.items()))
+    raw = s.raw.get("boundary", {})
+    for key in ("free_region", "free_points"):
+        if key in raw:
+            raise s.error(f"boundary.{key}", "applies to one surface, not to a body of "
+                                             f"{len(body)} faces")
+    if s.output.probes:
+        raise s.error("output.probes", "applies to one surface; a body's probes are its "
+                                       "faces' centres")
+    for ext in s.output.formats:
+        if ext not in BODY_FORMATS:
+            raise s.error("output.formats", f"{ext} is not written for a body of "
+                          f"{len(body)} faces yet; a body writes {', '.join(BODY_FORMATS)}")
+    for i, spec in enumerate(s.loads, start=1):
+        if spec.face is None:
+            if spec.kind == "point":
+                raise s.error(f"load[{i}].face", "a point load on a body names its face: "
+                              f"face = k, one of the file's faces {list(body.faces)}")
+            continue
+        patch = body.patch_of_face(spec.face)
+        if patch is None:
+            raise s.error(f"load[{i}].face", f"face {spec.face} is not in this body, whose "
+                                             f"faces are {list(body.faces)}")
+        if spec.at is not None:
+            _check_at(s, f"load[{i}].at", spec.at, body[patch])
+
+
+def _check_at(scenario: Scenario, path: str, at: tuple[float, float], surface: Any) -> None:
+    for x, basis, name in ((at[0], surface.basis_u, "u"), (at[1], surface.basis_v, "v")):
+        if not basis.periodic and not -1e-12 <= x <= basis.length * (1 + 1e-12):
+            raise scenario.error(path, f"{name} = {x:g} is outside the parameter domain "
+                                       f"[0, {basis.length:g}] of this face")
+
+
+def check_single_surface_loads(scenario: Scenario, face: int | None) -> None:
+    """``load.face`` on one surface: only the face it is (a CAD face), else refused."""
+    for i, spec in enumerate(scenario.loads, start=1):
+        if spec.face is not None and spec.face != face:
+            where = (f"the one face read ({face})" if face is not None
+                     else "a body of CAD faces")
+            raise scenario.error(f"load[{i}].face", f"face {spec.face}: this load acts on "
+                                                    f"{where}; remove face or choose faces")
+
+
+def body_model(scenario: Scenario, body: FileBody) -> Any:
+    """The :class:`~splinedeform.body.BodyModel` of a body scenario."""
+    from ..body.model import BodyModel
+    from ..material import Material
+    from .build import _located
+
+    check_body_scenario(scenario, body)
+    with _located(scenario, "material"):
+        material = Material(**scenario.material.weights())
+    with _located(scenario, "boundary"):
+        return BodyModel(body, material, boundary=scenario.boundary.u0,
+                         mass_matrix=scenario.material.mass_matrix,
+                         physics=scenario.material.physics)
+
+
+def on_faces(scenario: Scenario, body: Any, load: Any, index: int) -> Any:
+    """``load`` of ``[[load]]`` number ``index`` on its face only, when it names one."""
+    face = scenario.loads[index - 1].face
+    if face is None or not isinstance(body, FileBody):
+        return load
+    from ..body.loads import OnPatch
+
+    return OnPatch(load, body.patch_of_face(face))
+
+
+def describe_body(built: Any) -> list[tuple[str, str]]:
+    """Rows of ``splinedeform validate`` for a body: faces, nets, topology, unknowns."""
+    body = built.surface
+    points = sum(s.shape[0] * s.shape[1] for s in body)
+    counts = getattr(body, "counts", None) or body.summary()
+    rows = [("faces", f"{len(body)} ({', '.join(str(f) for f in body.faces)})"),
+            ("control nets", f"{points} points in {len(body)} nets"),
+            ("edges", ", ".join(f"{v} {k.replace('_', '-')}" for k, v in counts.items())),
+            ("free control points", str(built.model.n_free))]
+    return rows + ([("length unit", built.units)] if built.units is not None else [])
