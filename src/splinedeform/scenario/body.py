@@ -78,11 +78,43 @@ def body_from_cad(scenario: Scenario) -> tuple[Any, int, str | None]:
         return None, chosen[0], listing["units"]
     with _located(scenario, "surface.faces"):
         surfaces, topology, info = body_of(path, listing, chosen)
-    for key in ("refine", "elevate"):
-        if getattr(spec, key) != (0, 0):
-            raise scenario.error(f"surface.{key}", "applies to one face, not yet to a body")
     return (FileBody(surfaces, topology.interfaces, info["faces"], topology.counts),
             chosen[0], info["units"])
+
+
+def refined_body(scenario: Scenario, body: FileBody) -> FileBody:
+    """``body`` with every face elevated by ``surface.elevate`` degrees, then with
+    ``surface.refine`` knots inserted per span (:func:`splinedeform.refine.refine_surface`).
+
+    A shared edge may be a u edge on one face and a v edge on the other, so the counts must
+    be the same in u and v (else refused at the key): each side of an edge is then refined
+    alike (``k`` knots at equal distances in every span of its normalised knot vector,
+    which is symmetric under mirroring; degrees raised by ``p``), and an interface that
+    conformed conforms still. Each interface's ``conforming`` is checked again on the
+    refined faces (:func:`splinedeform.body.topology.conforming`)."""
+    from dataclasses import replace
+
+    from ..body.topology import conforming
+    from ..refine import refine_surface
+    from .build import _located
+
+    spec = scenario.surface
+    for key in ("elevate", "refine"):
+        u, v = getattr(spec, key)
+        if u != v:
+            raise scenario.error(f"surface.{key}", f"a body takes the same count in u and v "
+                                 f"(got u = {u}, v = {v}): a shared edge can be a u edge of "
+                                 "one face and a v edge of its neighbour, and both sides "
+                                 "must get the same knots; give one count, e.g. "
+                                 f"{key} = {max(u, v)}")
+    key = "surface.elevate" if spec.elevate != (0, 0) else "surface.refine"
+    with _located(scenario, key):
+        patches = [refine_surface(s, spec.elevate, spec.refine) for s in body]
+    tol = body.topology.tol
+    interfaces = [replace(i, conforming=conforming(patches[i.a], i.edge_a, patches[i.b],
+                                                   i.edge_b, i.reversed, tol))
+                  if i.conforming else i for i in body.interfaces]
+    return FileBody(patches, interfaces, body.faces, body.counts)
 
 
 def check_body_scenario(scenario: Scenario, body: FileBody) -> None:
