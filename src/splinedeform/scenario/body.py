@@ -5,7 +5,11 @@
 and a :class:`~splinedeform.body.BodyModel`. What a body takes from a scenario:
 
 * ``[boundary]``: one preset for every boundary edge (an edge no other face meets), so
-  ``u0 = u1 = v0 = v1``; a free region or listed points are a single surface's;
+  ``u0 = u1 = v0 = v1``, replaced edge by edge by ``[boundary.faces]``
+  (``3 = {u0 = "clamped"}``, the file's face numbers; :func:`face_presets`); a free region
+  or listed points are a single surface's;
+* ``surface.refine`` / ``surface.elevate``: every face alike, the same count in u and v
+  (:func:`refined_body`);
 * ``[[load]]``: a uniform force or a pressure acts on every face, or on face ``face``
   only; a point load names its face (``face = k``, the file's face number) and ``at`` in
   that face's parameters;
@@ -163,13 +167,48 @@ def _check_at(scenario: Scenario, path: str, at: tuple[float, float], surface: A
 
 
 def check_single_surface_loads(scenario: Scenario, face: int | None) -> None:
-    """``load.face`` on one surface: only the face it is (a CAD face), else refused."""
+    """``load.face`` on one surface: only the face it is (a CAD face), else refused;
+    ``boundary.faces`` is a body's, refused on one surface."""
+    if "faces" in scenario.raw.get("boundary", {}):
+        raise scenario.error("boundary.faces", "names edges of the faces of a body of CAD "
+                             "faces; one surface takes u0, u1, v0 and v1")
     for i, spec in enumerate(scenario.loads, start=1):
         if spec.face is not None and spec.face != face:
             where = (f"the one face read ({face})" if face is not None
                      else "a body of CAD faces")
             raise scenario.error(f"load[{i}].face", f"face {spec.face}: this load acts on "
                                                     f"{where}; remove face or choose faces")
+
+
+def face_presets(scenario: Scenario, body: FileBody) -> str | dict[tuple[int, str], str]:
+    """The boundary of a body: ``boundary.u0`` (the one preset) on every boundary edge,
+    replaced on the edges that ``boundary.faces`` names (``{face: {edge: preset}}``, the
+    file's face numbers), as ``{(patch, edge): preset}``; a face not in the body, or an
+    edge that is an interface or a pole, is refused at its key."""
+    named = scenario.raw.get("boundary", {}).get("faces")
+    if not named:
+        return scenario.boundary.u0
+    topology = body.topology
+    out = {edge: scenario.boundary.u0 for edge in topology.boundary}
+    joined = {(i.a, i.edge_a): (i.b, i.edge_b) for i in topology.interfaces}
+    joined.update({(i.b, i.edge_b): (i.a, i.edge_a) for i in topology.interfaces})
+    for key, edges in named.items():
+        patch = body.patch_of_face(int(key))
+        if patch is None:
+            raise scenario.error(f"boundary.faces.{key}", f"face {key} is not in this body, "
+                                 f"whose faces are {list(body.faces)}")
+        for edge, preset in edges.items():
+            where = f"boundary.faces.{key}.{edge}"
+            if (patch, edge) in joined:
+                other, side = joined[(patch, edge)]
+                raise scenario.error(where, f"edge {edge} of face {key} is an interface (it "
+                                     f"meets edge {side} of face {body.faces[other]}): an "
+                                     "interface takes no condition, only a boundary edge does")
+            if (patch, edge) in topology.poles:
+                raise scenario.error(where, f"edge {edge} of face {key} is a pole (collapsed "
+                                            "to a point): it takes no condition")
+            out[(patch, edge)] = preset
+    return out
 
 
 def body_model(scenario: Scenario, body: FileBody) -> Any:
@@ -181,8 +220,9 @@ def body_model(scenario: Scenario, body: FileBody) -> Any:
     check_body_scenario(scenario, body)
     with _located(scenario, "material"):
         material = Material(**scenario.material.weights())
+    boundary = face_presets(scenario, body)
     with _located(scenario, "boundary"):
-        return BodyModel(body, material, boundary=scenario.boundary.u0,
+        return BodyModel(body, material, boundary=boundary,
                          mass_matrix=scenario.material.mass_matrix,
                          physics=scenario.material.physics)
 
