@@ -1,6 +1,7 @@
 """Refinement and per-face boundary conditions of bodies from scenarios (scenario/body.py):
-a 2 × 2 × 2 box of six bilinear faces built here with rhino3dm, elevated to cubic and
-refined, bending under internal pressure; an open box (five faces) held by one edge."""
+the 2 × 2 × 2 box of six bilinear faces that tests/test_body_run.py builds with rhino3dm,
+elevated to cubic and refined, bending under internal pressure; an open box (five faces)
+held by one edge."""
 
 import json
 
@@ -12,22 +13,11 @@ from splinedeform import cli
 
 r3 = pytest.importorskip("rhino3dm", reason="the 'cad' extra (rhino3dm) is not installed")
 
+# the 2 × 2 × 2 box (in inches) and the sampling of a .3dm read back
+from test_body_run import SIZE, box_3dm, edge_of, grid_of  # noqa: E402,F401
+
 runner = CliRunner()
-SIZE = 2.0
 PLATE = "[material]\nw10 = 1.0\nw01 = 1.0\nw20 = 1.0\nw02 = 1.0\n"
-
-
-@pytest.fixture(scope="module")
-def box_3dm(tmp_path_factory):
-    """A closed 2 × 2 × 2 box of six bilinear faces (object "box")."""
-    path = tmp_path_factory.mktemp("bodyrefine") / "box.3dm"
-    model = r3.File3dm()
-    attributes = r3.ObjectAttributes()
-    attributes.Name = "box"
-    model.Objects.AddBrep(r3.Brep.CreateFromBox(r3.Box(r3.BoundingBox(0, 0, 0, SIZE, SIZE,
-                                                                      SIZE))), attributes)
-    assert model.Write(str(path), 7)
-    return path
 
 
 def scenario_file(folder, source, surface="", boundary="", formats='["report"]'):
@@ -49,18 +39,6 @@ def built_surface(path):
     from splinedeform.scenario.build import surface_and_units
 
     return surface_and_units(load_scenario(path))[0]
-
-
-def grid_of(srf, n=9):
-    """Points of a rhino3dm surface on an ``n × n`` grid of its own domain."""
-    u = np.linspace(srf.Domain(0).T0, srf.Domain(0).T1, n)
-    v = np.linspace(srf.Domain(1).T0, srf.Domain(1).T1, n)
-    return np.array([[[p.X, p.Y, p.Z] for p in (srf.PointAt(a, b) for b in v)] for a in u])
-
-
-def edge_of(grid, edge):
-    """The side ``edge`` ("u0", "u1", "v0", "v1") of a sampled grid ``(n, n, 3)``."""
-    return {"u0": grid[0], "u1": grid[-1], "v0": grid[:, 0], "v1": grid[:, -1]}[edge]
 
 
 def sample(surface, n=13):
