@@ -56,8 +56,7 @@ BOUNDARY_KEYS: dict[str, Key] = {
     "free_region": Key(_table_value, None, S.Boundary.model_fields["free_region"].description),
     **_keys(S.Boundary, ("free_points",)),
     "faces": Key(located_checker(dict[S.FaceKey, S.FaceEdges], "{k = {u0 = ...}}"), None,
-                 S.Boundary.model_fields["faces"].description,
-                 S.Boundary.model_fields["faces"].json_schema_extra["doc_default"]),  # type: ignore[index]
+                 _keys(S.Boundary, ("faces",))["faces"].doc, "none"),
 }
 
 _PROFILED = tuple(S._Profiled.model_fields)
