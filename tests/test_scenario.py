@@ -188,7 +188,10 @@ FILE_TEXTS = [file_scenario("net.json", "frame = 0"),
               file_scenario("solids.3dm", 'faces = ["box"]').replace('"file"', '"cad"'),
               # a load on one face of a body: run by tests/test_body_run.py
               file_scenario("box.3dm", "").replace('"file"', '"cad"')
-              + '[[load]]\nkind = "pressure"\nq = 1.0\nface = 2\n']
+              + '[[load]]\nkind = "pressure"\nq = 1.0\nface = 2\n',
+              # an edge of a body's face clamped: run by tests/test_body_refine_run.py
+              file_scenario("box.3dm", 'faces = [0, 1, 2, 3, 4]').replace('"file"', '"cad"')
+              + '[boundary.faces]\n0 = { v1 = "clamped" }\n']
 
 
 def all_test_texts() -> list[str]:

@@ -5,7 +5,11 @@
 and a :class:`~splinedeform.body.BodyModel`. What a body takes from a scenario:
 
 * ``[boundary]``: one preset for every boundary edge (an edge no other face meets), so
-  ``u0 = u1 = v0 = v1``; a free region or listed points are a single surface's;
+  ``u0 = u1 = v0 = v1``, replaced edge by edge by ``[boundary.faces]``
+  (``3 = {u0 = "clamped"}``, the file's face numbers; :func:`face_presets`); a free region
+  or listed points are a single surface's;
+* ``surface.refine`` / ``surface.elevate``: every face alike, the same count in u and v
+  (:func:`refined_body`);
 * ``[[load]]``: a uniform force or a pressure acts on every face, or on face ``face``
   only; a point load names its face (``face = k``, the file's face number) and ``at`` in
   that face's parameters;
@@ -78,11 +82,43 @@ def body_from_cad(scenario: Scenario) -> tuple[Any, int, str | None]:
         return None, chosen[0], listing["units"]
     with _located(scenario, "surface.faces"):
         surfaces, topology, info = body_of(path, listing, chosen)
-    for key in ("refine", "elevate"):
-        if getattr(spec, key) != (0, 0):
-            raise scenario.error(f"surface.{key}", "applies to one face, not yet to a body")
     return (FileBody(surfaces, topology.interfaces, info["faces"], topology.counts),
             chosen[0], info["units"])
+
+
+def refined_body(scenario: Scenario, body: FileBody) -> FileBody:
+    """``body`` with every face elevated by ``surface.elevate`` degrees, then with
+    ``surface.refine`` knots inserted per span (:func:`splinedeform.refine.refine_surface`).
+
+    A shared edge may be a u edge on one face and a v edge on the other, so the counts must
+    be the same in u and v (else refused at the key): each side of an edge is then refined
+    alike (``k`` knots at equal distances in every span of its normalised knot vector,
+    which is symmetric under mirroring; degrees raised by ``p``), and an interface that
+    conformed conforms still. Each interface's ``conforming`` is checked again on the
+    refined faces (:func:`splinedeform.body.topology.conforming`)."""
+    from dataclasses import replace
+
+    from ..body.topology import conforming
+    from ..refine import refine_surface
+    from .build import _located
+
+    spec = scenario.surface
+    for key in ("elevate", "refine"):
+        u, v = getattr(spec, key)
+        if u != v:
+            raise scenario.error(f"surface.{key}", f"a body takes the same count in u and v "
+                                 f"(got u = {u}, v = {v}): a shared edge can be a u edge of "
+                                 "one face and a v edge of its neighbour, and both sides "
+                                 "must get the same knots; give one count, e.g. "
+                                 f"{key} = {max(u, v)}")
+    key = "surface.elevate" if spec.elevate != (0, 0) else "surface.refine"
+    with _located(scenario, key):
+        patches = [refine_surface(s, spec.elevate, spec.refine) for s in body]
+    tol = body.topology.tol
+    interfaces = [replace(i, conforming=conforming(patches[i.a], i.edge_a, patches[i.b],
+                                                   i.edge_b, i.reversed, tol))
+                  if i.conforming else i for i in body.interfaces]
+    return FileBody(patches, interfaces, body.faces, body.counts)
 
 
 def check_body_scenario(scenario: Scenario, body: FileBody) -> None:
@@ -131,13 +167,48 @@ def _check_at(scenario: Scenario, path: str, at: tuple[float, float], surface: A
 
 
 def check_single_surface_loads(scenario: Scenario, face: int | None) -> None:
-    """``load.face`` on one surface: only the face it is (a CAD face), else refused."""
+    """``load.face`` on one surface: only the face it is (a CAD face), else refused;
+    ``boundary.faces`` is a body's, refused on one surface."""
+    if "faces" in scenario.raw.get("boundary", {}):
+        raise scenario.error("boundary.faces", "names edges of the faces of a body of CAD "
+                             "faces; one surface takes u0, u1, v0 and v1")
     for i, spec in enumerate(scenario.loads, start=1):
         if spec.face is not None and spec.face != face:
             where = (f"the one face read ({face})" if face is not None
                      else "a body of CAD faces")
             raise scenario.error(f"load[{i}].face", f"face {spec.face}: this load acts on "
                                                     f"{where}; remove face or choose faces")
+
+
+def face_presets(scenario: Scenario, body: FileBody) -> str | dict[tuple[int, str], str]:
+    """The boundary of a body: ``boundary.u0`` (the one preset) on every boundary edge,
+    replaced on the edges that ``boundary.faces`` names (``{face: {edge: preset}}``, the
+    file's face numbers), as ``{(patch, edge): preset}``; a face not in the body, or an
+    edge that is an interface or a pole, is refused at its key."""
+    named = scenario.raw.get("boundary", {}).get("faces")
+    if not named:
+        return scenario.boundary.u0
+    topology = body.topology
+    out = {edge: scenario.boundary.u0 for edge in topology.boundary}
+    joined = {(i.a, i.edge_a): (i.b, i.edge_b) for i in topology.interfaces}
+    joined.update({(i.b, i.edge_b): (i.a, i.edge_a) for i in topology.interfaces})
+    for key, edges in named.items():
+        patch = body.patch_of_face(int(key))
+        if patch is None:
+            raise scenario.error(f"boundary.faces.{key}", f"face {key} is not in this body, "
+                                 f"whose faces are {list(body.faces)}")
+        for edge, preset in edges.items():
+            where = f"boundary.faces.{key}.{edge}"
+            if (patch, edge) in joined:
+                other, side = joined[(patch, edge)]
+                raise scenario.error(where, f"edge {edge} of face {key} is an interface (it "
+                                     f"meets edge {side} of face {body.faces[other]}): an "
+                                     "interface takes no condition, only a boundary edge does")
+            if (patch, edge) in topology.poles:
+                raise scenario.error(where, f"edge {edge} of face {key} is a pole (collapsed "
+                                            "to a point): it takes no condition")
+            out[(patch, edge)] = preset
+    return out
 
 
 def body_model(scenario: Scenario, body: FileBody) -> Any:
@@ -149,8 +220,9 @@ def body_model(scenario: Scenario, body: FileBody) -> Any:
     check_body_scenario(scenario, body)
     with _located(scenario, "material"):
         material = Material(**scenario.material.weights())
+    boundary = face_presets(scenario, body)
     with _located(scenario, "boundary"):
-        return BodyModel(body, material, boundary=scenario.boundary.u0,
+        return BodyModel(body, material, boundary=boundary,
                          mass_matrix=scenario.material.mass_matrix,
                          physics=scenario.material.physics)
 

@@ -9,7 +9,8 @@ from pathlib import Path
 from typing import Any, Iterator
 
 from ..errors import InputError, ScenarioError
-from .body import body_model, check_single_surface_loads, describe_body, is_body
+from .body import (body_model, check_single_surface_loads, describe_body, is_body,
+                   refined_body)
 from .spec import Scenario, SurfaceSpec
 from ..trim.surface_trim import region_contains
 from .trim_build import loop_presets, trimmed
@@ -62,10 +63,13 @@ def surface_and_units(scenario: Scenario) -> tuple[Any, str | None]:
 
 def _refined(scenario: Scenario, surface: Any) -> Any:
     """``surface`` elevated by ``surface.elevate`` degrees, then with ``surface.refine``
-    knots inserted per span (:func:`splinedeform.refine.refine_surface`; same geometry)."""
+    knots inserted per span (:func:`splinedeform.refine.refine_surface`; same geometry);
+    a body face by face (:func:`.body.refined_body`)."""
     spec = scenario.surface
     if spec.refine == (0, 0) and spec.elevate == (0, 0):
         return surface
+    if is_body(surface):                 # face by face, kept conforming
+        return refined_body(scenario, surface)
     from ..refine import refine_surface
 
     key = "surface.elevate" if spec.elevate != (0, 0) else "surface.refine"

@@ -55,6 +55,8 @@ BOUNDARY_KEYS: dict[str, Key] = {
     **_keys(S.Boundary, EDGES),
     "free_region": Key(_table_value, None, S.Boundary.model_fields["free_region"].description),
     **_keys(S.Boundary, ("free_points",)),
+    "faces": Key(located_checker(dict[S.FaceKey, S.FaceEdges], "{k = {u0 = ...}}"), None,
+                 _keys(S.Boundary, ("faces",))["faces"].doc, "none"),
 }
 
 _PROFILED = tuple(S._Profiled.model_fields)

@@ -92,6 +92,19 @@ class FreeRegion(_Table):
         json_schema_extra={"doc_default": 'whole range'})
 
 
+#: edge conditions a face of a body takes (:data:`splinedeform.body.constraints.BODY_PRESETS`)
+FacePreset = Literal["free", "pinned", "clamped"]
+#: a face of a body named in ``boundary.faces``: its number in the file
+FaceKey = Annotated[str, Field(pattern=r"^[0-9]+$")]
+
+
+class FaceEdges(_Table):
+    u0: Optional[FacePreset] = Field(None, description="edge `u = 0` of the face")
+    u1: Optional[FacePreset] = Field(None, description="edge `u = L_u` of the face")
+    v0: Optional[FacePreset] = Field(None, description="edge `v = 0` of the face")
+    v1: Optional[FacePreset] = Field(None, description="edge `v = L_v` of the face")
+
+
 class Boundary(_Table):
     u0: Preset = Field("free", description=(
             "edge `u = 0`: pinned holds it (`d = 0`), clamped also holds its slope (`∂n d = 0`), "
@@ -113,6 +126,13 @@ class Boundary(_Table):
             "`j` along v, from 0 (what `splinedeform sculpt` paints); all others are fixed at "
             "rest; not with `free_region`"),
         json_schema_extra={"doc_default": 'none (all move)'})
+    faces: Optional[dict[FaceKey, FaceEdges]] = Field(
+        None, title="{k = {u0 = ...}}", description=(
+            "body of CAD faces only: presets of single boundary edges, keyed by the face's "
+            "number in the file (`[boundary.faces]` then `3 = { u0 = \"clamped\" }`): "
+            "`free`, `pinned` or `clamped`; they replace the one preset `u0 = u1 = v0 = v1` "
+            "on those edges; an edge another face meets (an interface) or a pole takes none"),
+        json_schema_extra={"doc_default": "none"})
 
 
 # -- [[load]] ----------------------------------------------------------------------------------

@@ -196,6 +196,7 @@ def _validate_boundary(raw: Mapping[str, Any], problems: _Problems,
             problems.add(f"boundary.{edge}", f"{kind!r} is an edge of the Kirchhoff–Love shell "
                                              f"only (material.physics = \"shell\"), not of "
                                              f"physics {physics!r}")
+    values.pop("faces", None)           # a body's, read by scenario.body.face_presets
     region = values.pop("free_region", None)
     box: dict[str, tuple[float, float] | None] = {"free_u": None, "free_v": None}
     if region is not None:
