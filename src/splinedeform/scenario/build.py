@@ -11,6 +11,7 @@ from typing import Any, Iterator
 from ..errors import InputError, ScenarioError
 from .spec import Scenario, SurfaceSpec
 from ..trim.surface_trim import region_contains
+from .cad_trim import reader_warnings, with_face_trim
 from .trim_build import loop_presets, trimmed
 
 
@@ -54,9 +55,18 @@ def surface_and_units(scenario: Scenario) -> tuple[Any, str | None]:
     """The initial surface (see :func:`build_surface`) and its length unit: a CAD file's
     (or ``surface.units``), None for other surfaces."""
     spec = scenario.surface
-    surface, units = (_surface_from_cad(scenario) if spec.shape == "cad"
-                      else (_surface_of_shape(scenario), None))
-    return trimmed(scenario, _refined(scenario, surface)), units
+    if spec.shape == "cad":
+        return _cad_surface(scenario)
+    return trimmed(scenario, _refined(scenario, _surface_of_shape(scenario))), None
+
+
+def _cad_surface(scenario: Scenario) -> tuple[Any, str | None]:
+    """A CAD surface, refined, on its face's trimmed region where the model can take it
+    (:mod:`splinedeform.scenario.cad_trim`), and its unit."""
+    with reader_warnings() as caught:
+        surface, units = _surface_from_cad(scenario)
+    surface = with_face_trim(scenario, _refined(scenario, surface), caught)
+    return trimmed(scenario, surface), units
 
 
 def _refined(scenario: Scenario, surface: Any) -> Any:
@@ -104,7 +114,7 @@ def _fit_options(spec: SurfaceSpec) -> dict[str, Any]:
 
 
 def _surface_from_cad(scenario: Scenario) -> tuple[Any, str | None]:
-    """Surface ``face`` of a CAD file, as a deformable NURBS surface (trimming dropped),
+    """Surface ``face`` of a CAD file, as a deformable NURBS surface (its whole surface),
     and its unit: ``surface.units`` if given, else the file's; with ``faces``, the body
     of the faces chosen (:func:`_body_from_cad`)."""
     from ..cad import read_cad, surface_from_patch

@@ -17,9 +17,9 @@ from .loops import CircleLoop, PolygonLoop, TrimDomain
 from .spline_loop import SplineLoop
 
 INSIDE, OUTSIDE, CUT = 1, 0, 2
-#: distance (relative to the grid's lengths) within which a piece on the far side
-#: ``u = L_u`` or ``v = L_v`` is taken to lie on it
-SIDE_TOL = 1e-12
+#: distance (relative to the diagonal of the parameter rectangle) within which a loop is
+#: taken to run along its sides (a CAD face's outer loop) rather than outside them
+SIDE_TOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -178,9 +178,9 @@ def loop_pieces(domain: TrimDomain, grid: Grid, loops: tuple | None = None) -> P
     mid, _ = pieces.evaluate(0.5 * (pieces.lo + pieces.hi)[:, None])
     h, cells = np.array(grid.h), np.array(grid.cells)
     cell = np.floor(mid[:, 0] / h).astype(int)
-    # a piece along a side of the box, to round-off of it, lies in the cell beside it: on
+    # a piece along a side of the box (within SIDE_TOL) lies in the cell beside it: on
     # the far side u = L_u (or v = L_v) its midpoint's floor is one past the last cell
-    slack = SIDE_TOL * np.array(grid.lengths)
+    slack = SIDE_TOL * float(np.hypot(*grid.lengths))
     far = (cell == cells) & (mid[:, 0] <= np.array(grid.lengths) + slack)
     near = (cell == -1) & (mid[:, 0] >= -slack)
     cell = np.where(far, cells - 1, np.where(near, 0, cell))
