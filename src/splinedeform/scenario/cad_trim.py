@@ -61,7 +61,7 @@ def with_face_trim(scenario: Any, surface: Any, caught: list[warnings.WarningMes
     spec = scenario.surface
     asked = spec.parameters.get("trimmed")
     if not isinstance(surface, Surface) or spec.trim is not None or asked is False:
-        _shown(caught, drop_whole=False)
+        _shown(caught, drop_whole=asked is False)          # the whole face was asked for
         return surface
     from ..cad_trims import read_trims
 
