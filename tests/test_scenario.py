@@ -185,7 +185,9 @@ FILE_TEXTS = [file_scenario("net.json", "frame = 0"),
               file_scenario("patch.3dm", 'face = 1\nunits = "in"\nrefine = {u = 2, v = 1}\n'
                                          'elevate = [0, 1]').replace('"file"', '"cad"'),
               # several faces of a CAD file: run by tests/test_cad_body.py on files built there
-              file_scenario("solids.3dm", 'faces = ["box"]').replace('"file"', '"cad"')]
+              file_scenario("solids.3dm", 'faces = ["box"]').replace('"file"', '"cad"'),
+              # a trimmed face on its trimmed region: run by tests/test_cad_trim_run.py
+              file_scenario("planes.3dm", 'trimmed = true').replace('"file"', '"cad"')]
 
 
 def all_test_texts() -> list[str]:
