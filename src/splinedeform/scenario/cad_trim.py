@@ -40,6 +40,19 @@ def _shown(caught: list[warnings.WarningMessage], drop_whole: bool) -> None:
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
 
+def _face_number(spec: Any) -> int:
+    """The face read: ``face``, or the one face chosen by ``faces`` (as the reader chose it,
+    :func:`splinedeform.cad_body.choose_faces`)."""
+    faces = spec.parameters.get("faces")
+    if faces is None:
+        return int(spec.parameters["face"])
+    from ..cad_body import choose_faces, read_listing
+
+    chosen = choose_faces(read_listing(spec.path),
+                          list(faces) if isinstance(faces, tuple) else faces, str(spec.path))
+    return int(chosen[0])
+
+
 def why_untrimmable(scenario: Any, surface: Any) -> str | None:
     """Why the trimmed model cannot hold ``surface`` in this scenario; None when it can."""
     if scenario.material.physics != "parametric":
@@ -65,7 +78,7 @@ def with_face_trim(scenario: Any, surface: Any, caught: list[warnings.WarningMes
         return surface
     from ..cad_trims import read_trims
 
-    face, path = spec.parameters["face"], spec.path
+    face, path = _face_number(spec), spec.path
     source = f"{path} face {face}"
     try:
         domain = read_trims(path, face)
