@@ -17,6 +17,7 @@ from contextlib import contextmanager
 from typing import Any, Iterator
 
 from ..errors import InputError, InputWarning
+from ..knots import RationalBasis
 from ..surface import Surface
 from ..trim.surface_trim import equal_cell_form, whole_rectangle
 
@@ -59,7 +60,7 @@ def why_untrimmable(scenario: Any, surface: Any) -> str | None:
         return (f"physics {scenario.material.physics!r} is not trimmed yet (a trimmed "
                 "surface takes \"parametric\")")
     if surface.net_weights is not None or any(
-            type(b).__name__ == "RationalBasis" for b in (surface.basis_u, surface.basis_v)):
+            isinstance(b, RationalBasis) for b in (surface.basis_u, surface.basis_v)):
         return "it is rational (NURBS weights), which the trimmed model does not take"
     if scenario.boundary.has_free_region:
         return ("fixed control points (boundary.free_region, free_points) are not combined "
@@ -82,12 +83,13 @@ def with_face_trim(scenario: Any, surface: Any, caught: list[warnings.WarningMes
     source = f"{path} face {face}"
     try:
         domain = read_trims(path, face)
-    except InputError as exc:
-        raise scenario.error("surface.path", str(exc)) from None
-    if domain is None or (not domain.holes and whole_rectangle(surface, domain.outer)):
-        _shown(caught, drop_whole=False)
-        return surface                                      # not trimmed: nothing to attach
-    reason = why_untrimmable(scenario, surface)
+    except InputError as exc:                               # loops that cannot be read
+        domain, reason = None, f"its trim loops cannot be read ({exc})"
+    else:
+        if domain is None or (not domain.holes and whole_rectangle(surface, domain.outer)):
+            _shown(caught, drop_whole=False)
+            return surface                                  # not trimmed: nothing to attach
+        reason = why_untrimmable(scenario, surface)
     trimmed = None
     if reason is None:
         try:
