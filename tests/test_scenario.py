@@ -191,7 +191,9 @@ FILE_TEXTS = [file_scenario("net.json", "frame = 0"),
               + '[[load]]\nkind = "pressure"\nq = 1.0\nface = 2\n',
               # an edge of a body's face clamped: run by tests/test_body_refine_run.py
               file_scenario("box.3dm", 'faces = [0, 1, 2, 3, 4]').replace('"file"', '"cad"')
-              + '[boundary.faces]\n0 = { v1 = "clamped" }\n']
+              + '[boundary.faces]\n0 = { v1 = "clamped" }\n',
+              # a trimmed face on its trimmed region: run by tests/test_cad_trim_run.py
+              file_scenario("planes.3dm", 'trimmed = true').replace('"file"', '"cad"')]
 
 
 def all_test_texts() -> list[str]:

@@ -13,6 +13,7 @@ from .body import (body_model, check_single_surface_loads, describe_body, is_bod
                    refined_body)
 from .spec import Scenario, SurfaceSpec
 from ..trim.surface_trim import region_contains
+from .cad_trim import reader_warnings, with_face_trim
 from .trim_build import loop_presets, trimmed
 
 
@@ -56,9 +57,18 @@ def surface_and_units(scenario: Scenario) -> tuple[Any, str | None]:
     """The initial surface (see :func:`build_surface`) and its length unit: a CAD file's
     (or ``surface.units``), None for other surfaces."""
     spec = scenario.surface
-    surface, units = (_surface_from_cad(scenario) if spec.shape == "cad"
-                      else (_surface_of_shape(scenario), None))
-    return trimmed(scenario, _refined(scenario, surface)), units
+    if spec.shape == "cad":
+        return _cad_surface(scenario)
+    return trimmed(scenario, _refined(scenario, _surface_of_shape(scenario))), None
+
+
+def _cad_surface(scenario: Scenario) -> tuple[Any, str | None]:
+    """A CAD surface, refined, on its face's trimmed region where the model can take it
+    (:mod:`splinedeform.scenario.cad_trim`), and its unit."""
+    with reader_warnings() as caught:
+        surface, units = _surface_from_cad(scenario)
+    surface = with_face_trim(scenario, _refined(scenario, surface), caught)
+    return trimmed(scenario, surface), units
 
 
 def _refined(scenario: Scenario, surface: Any) -> Any:
@@ -109,7 +119,7 @@ def _fit_options(spec: SurfaceSpec) -> dict[str, Any]:
 
 
 def _surface_from_cad(scenario: Scenario) -> tuple[Any, str | None]:
-    """Surface ``face`` of a CAD file, as a deformable NURBS surface (trimming dropped),
+    """Surface ``face`` of a CAD file, as a deformable NURBS surface (its whole surface),
     and its unit: ``surface.units`` if given, else the file's; without ``face``, the body
     of the faces chosen by ``faces`` (default ``"all"``; :func:`.body.body_from_cad`)."""
     from ..cad import read_cad, surface_from_patch

@@ -189,8 +189,18 @@ class FromCad(_Refined):
         json_schema_extra={"doc_default": "required for `cad`"})
     face: Annotated[int, Strict(), Field(ge=0)] = Field(0, description=(
             "which surface of the file, counting plain surfaces and Brep faces in file "
-            "order from 0, read alone; a trimmed face is taken untrimmed, with a warning"),
+            "order from 0, read alone; a trimmed face is simulated on its trimmed region "
+            "(`trimmed`)"),
         json_schema_extra={"doc_default": "every face (`faces`)"})
+    trimmed: Optional[Annotated[bool, Strict()]] = Field(
+        None, description=(
+            "simulate a trimmed face on the region inside its trim loops (loops `outer`, "
+            "`hole1`, …; an outer loop that is the parameter rectangle keeps the `[boundary]` "
+            "edges): `true` refuses a face the trimmed model cannot take (physics other than "
+            "`parametric`, rational, periodic, unequal knot cells or degrees), `false` takes "
+            "the whole underlying surface"),
+        json_schema_extra={"doc_default": "the trim where the model can take it, else the "
+                                          "whole surface with one warning"})
     faces: Optional[Union[Literal["all"], Annotated[list[FaceNumber], Field(min_length=1)],
                           Annotated[list[FaceName], Field(min_length=1)]]] = Field(
         None, description=(

@@ -17,6 +17,9 @@ from .loops import CircleLoop, PolygonLoop, TrimDomain
 from .spline_loop import SplineLoop
 
 INSIDE, OUTSIDE, CUT = 1, 0, 2
+#: distance (relative to the diagonal of the parameter rectangle) within which a loop is
+#: taken to run along its sides (a CAD face's outer loop) rather than outside them
+SIDE_TOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -173,9 +176,15 @@ def loop_pieces(domain: TrimDomain, grid: Grid, loops: tuple | None = None) -> P
                     np.concatenate(starts), np.concatenate(ends), np.concatenate(centres),
                     np.concatenate(radii), np.zeros((0, 2), int), np.concatenate(polys))
     mid, _ = pieces.evaluate(0.5 * (pieces.lo + pieces.hi)[:, None])
-    h = np.array(grid.h)
+    h, cells = np.array(grid.h), np.array(grid.cells)
     cell = np.floor(mid[:, 0] / h).astype(int)
-    if np.any(cell < 0) or np.any(cell >= np.array(grid.cells)):
+    # a piece along a side of the box (within SIDE_TOL) lies in the cell beside it: on
+    # the far side u = L_u (or v = L_v) its midpoint's floor is one past the last cell
+    slack = SIDE_TOL * float(np.hypot(*grid.lengths))
+    far = (cell == cells) & (mid[:, 0] <= np.array(grid.lengths) + slack)
+    near = (cell == -1) & (mid[:, 0] >= -slack)
+    cell = np.where(far, cells - 1, np.where(near, 0, cell))
+    if np.any(cell < 0) or np.any(cell >= cells):
         raise InputError("a trim loop leaves the parameter domain "
                          f"[0, {grid.lengths[0]:g}] × [0, {grid.lengths[1]:g}]")
     loop = np.repeat(np.arange(len(kinds)), [len(k) for k in kinds])

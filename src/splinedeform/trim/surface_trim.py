@@ -9,18 +9,21 @@ from numpy.typing import NDArray
 
 from ..basis import BSplineBasis
 from ..errors import InputError
-from .cells import Grid
+from .cells import SIDE_TOL, Grid
 from .loops import Loop, PolygonLoop, TrimDomain
 
 
 def loop_outside(surface: Any, loop: Loop) -> str | None:
-    """What is wrong when ``loop`` does not lie strictly inside the parameter rectangle
-    ``(0, L_u) × (0, L_v)`` of ``surface`` (a loop on the rectangle's edge would leave the
-    knot cells; the rectangle itself is :func:`whole_rectangle`); None when it does. A spline loop is bounded by its control points."""
+    """What is wrong when ``loop`` leaves the parameter rectangle ``[0, L_u] × [0, L_v]``
+    of ``surface`` by more than :data:`SIDE_TOL` of its diagonal (a loop may run
+    along its sides, as most outer loops of CAD faces do: its pieces there lie in the
+    cells beside them, :func:`~splinedeform.trim.cells.loop_pieces`); None when it does
+    not. A spline loop is bounded by its control points."""
     (_, lu), (_, lv) = surface.domain
+    tol = SIDE_TOL * float(np.hypot(lu, lv))
     low, high = (np.asarray(b, dtype=float) for b in loop.bounds())
-    if np.any(low <= 0.0) or high[0] >= lu or high[1] >= lv:
-        return (f"reaches outside the parameter domain (0, {lu:g}) × (0, {lv:g}) of the "
+    if np.any(low < -tol) or high[0] > lu + tol or high[1] > lv + tol:
+        return (f"reaches outside the parameter domain [0, {lu:g}] × [0, {lv:g}] of the "
                 f"surface: it spans [{low[0]:g}, {high[0]:g}] × [{low[1]:g}, {high[1]:g}]")
     return None
 
@@ -41,15 +44,24 @@ def trim_grid(surface: Any) -> Grid:
 
 
 def whole_rectangle(surface: Any, loop: Loop) -> bool:
-    """Whether ``loop`` is the parameter rectangle itself (a polygon through its four
-    corners, to 1e-12 of its size): the outer loop of a rectangle with holes, whose edges
-    are the rectangle's edges ``u0``, ``u1``, ``v0``, ``v1``."""
-    if not isinstance(loop, PolygonLoop) or len(loop.vertices) != 4:
+    """Whether ``loop`` is the parameter rectangle itself: a polygon through its four
+    corners with every vertex on its sides (collinear midpoints of a CAD face's edges
+    allowed), both to :data:`SIDE_TOL` of the rectangle's diagonal. It is the outer
+    loop of a rectangle with holes, whose edges are the rectangle's edges ``u0``, ``u1``,
+    ``v0``, ``v1``."""
+    if not isinstance(loop, PolygonLoop):
         return False
     (_, lu), (_, lv) = surface.domain
+    tol = SIDE_TOL * float(np.hypot(lu, lv))
     corners = np.array([[0.0, 0.0], [lu, 0.0], [lu, lv], [0.0, lv]])
     gap = np.abs(loop.vertices[:, None, :] - corners[None]).max(axis=-1)
-    return bool(np.all(gap.min(axis=1) <= 1e-12 * max(lu, lv)))
+    u, v = loop.vertices.T
+    off_side = np.minimum(np.minimum(np.abs(u), np.abs(u - lu)),
+                          np.minimum(np.abs(v), np.abs(v - lv)))
+    inside_box = ((u >= -tol) & (u <= lu + tol) & (v >= -tol) & (v <= lv + tol))
+    area = abs(loop.signed_area)
+    return bool(np.all(gap.min(axis=0) <= tol) and np.all(off_side <= tol)
+                and np.all(inside_box) and abs(area - lu * lv) <= tol * (lu + lv))
 
 
 def holed_rectangle(surface: Any) -> bool:
@@ -85,3 +97,26 @@ def checked_trim(surface: Any, domain: Any) -> TrimDomain:
             raise InputError(f"trim loop {'the outer loop' if k == 0 else f'hole {k}'} "
                              f"{problem}")
     return domain
+
+
+def equal_cell_form(surface: Any) -> Any:
+    """``surface`` with each direction whose general knot vector is clamped with equal
+    cells (to :data:`SIDE_TOL` of its length; a CAD face refined by ``refine`` and
+    ``elevate``) given as the same B-splines in the ``open`` layout, which a trim needs
+    (:func:`trim_grid`); other directions, and the control net, unchanged."""
+    from dataclasses import replace
+
+    from ..knots import KnotVectorBasis
+
+    bases = []
+    for basis in (surface.basis_u, surface.basis_v):
+        if isinstance(basis, KnotVectorBasis):
+            cells, length = len(basis.breaks) - 1, float(basis.breaks[-1])
+            open_basis = BSplineBasis(basis.degree, cells, length, "open")
+            if (basis.breaks[0] == 0.0 and len(basis.knots) == len(open_basis.knots)
+                    and np.abs(basis.knots - open_basis.knots).max() <= SIDE_TOL * length):
+                basis = open_basis
+        bases.append(basis)
+    if bases[0] is surface.basis_u and bases[1] is surface.basis_v:
+        return surface
+    return replace(surface, basis_u=bases[0], basis_v=bases[1])

@@ -1,0 +1,108 @@
+"""A trimmed CAD face in a scenario: its own trim loops attached to the built surface.
+
+Face ``face`` of a ``.3dm``, STEP or IGES file is read as its whole underlying surface;
+its loops (:func:`splinedeform.cad_trims.read_trims`) are attached after ``elevate`` and
+``refine`` (the loops live in parameter space, refinement does not move them), so the
+model and every output use the trimmed region only. ``surface.trimmed`` switches this:
+by default the trim is taken where the trimmed model can hold the surface (physics
+``parametric``, one degree, equal knot cells, no weights, not periodic) and the whole face
+is used otherwise, with one warning line naming the face and the reason; ``trimmed =
+true`` refuses such a face, ``trimmed = false`` takes the whole face without a word.
+"""
+
+from __future__ import annotations
+
+import warnings
+from contextlib import contextmanager
+from typing import Any, Iterator
+
+from ..errors import InputError, InputWarning
+from ..knots import RationalBasis
+from ..surface import Surface
+from ..trim.surface_trim import equal_cell_form, whole_rectangle
+
+#: what the CAD readers say of a trimmed face read whole; replaced by this module's word
+WHOLE_SURFACE = "whole underlying surface is used"
+
+
+@contextmanager
+def reader_warnings() -> Iterator[list[warnings.WarningMessage]]:
+    """Record the warnings of reading a face, to be shown by :func:`with_face_trim`."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        yield caught
+
+
+def _shown(caught: list[warnings.WarningMessage], drop_whole: bool) -> None:
+    """Show the recorded warnings again, those about the whole surface left out."""
+    for w in caught:
+        if drop_whole and WHOLE_SURFACE in str(w.message):
+            continue
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+
+
+def _face_number(spec: Any) -> int:
+    """The face read: ``face``, or the one face chosen by ``faces`` (as the reader chose it,
+    :func:`splinedeform.cad_body.choose_faces`)."""
+    faces = spec.parameters.get("faces")
+    if faces is None:
+        return int(spec.parameters["face"])
+    from ..cad_body import choose_faces, read_listing
+
+    chosen = choose_faces(read_listing(spec.path),
+                          list(faces) if isinstance(faces, tuple) else faces, str(spec.path))
+    return int(chosen[0])
+
+
+def why_untrimmable(scenario: Any, surface: Any) -> str | None:
+    """Why the trimmed model cannot hold ``surface`` in this scenario; None when it can."""
+    if scenario.material.physics != "parametric":
+        return (f"physics {scenario.material.physics!r} is not trimmed yet (a trimmed "
+                "surface takes \"parametric\")")
+    if surface.net_weights is not None or any(
+            isinstance(b, RationalBasis) for b in (surface.basis_u, surface.basis_v)):
+        return "it is rational (NURBS weights), which the trimmed model does not take"
+    if scenario.boundary.has_free_region:
+        return ("fixed control points (boundary.free_region, free_points) are not combined "
+                "with a trim")
+    return None
+
+
+def with_face_trim(scenario: Any, surface: Any, caught: list[warnings.WarningMessage]) -> Any:
+    """``surface`` (face ``surface.face`` of ``surface.path``, refined) with the face's trim
+    loops attached, or whole (module docstring); the reader's warnings ``caught`` shown
+    again, its word on the whole surface replaced by one line of this module's."""
+    spec = scenario.surface
+    asked = spec.parameters.get("trimmed")
+    if not isinstance(surface, Surface) or spec.trim is not None or asked is False:
+        _shown(caught, drop_whole=asked is False)          # the whole face was asked for
+        return surface
+    from ..cad_trims import read_trims
+
+    face, path = _face_number(spec), spec.path
+    source = f"{path} face {face}"
+    try:
+        domain = read_trims(path, face)
+    except InputError as exc:                               # loops that cannot be read
+        domain, reason = None, f"its trim loops cannot be read ({exc})"
+    else:
+        if domain is None or (not domain.holes and whole_rectangle(surface, domain.outer)):
+            _shown(caught, drop_whole=False)
+            return surface                                  # not trimmed: nothing to attach
+        reason = why_untrimmable(scenario, surface)
+    trimmed = None
+    if reason is None:
+        try:
+            trimmed = equal_cell_form(surface).with_trim(domain)
+        except InputError as exc:
+            reason = str(exc)
+    if reason is not None:
+        if asked:
+            raise scenario.error("surface.trimmed", f"{source} is trimmed, but {reason}; "
+                                 "set trimmed = false to take its whole surface")
+        _shown(caught, drop_whole=True)
+        warnings.warn(f"{source} is trimmed; its whole underlying surface is used: {reason}",
+                      InputWarning, stacklevel=2)
+        return surface
+    _shown(caught, drop_whole=True)
+    return trimmed
