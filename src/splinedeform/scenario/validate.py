@@ -42,6 +42,25 @@ def _check_table(raw: Any, schema: Mapping[str, Key], path: str, problems: _Prob
     return values
 
 
+def top_level(raw: Mapping[str, Any], top_keys: Mapping[str, Key], tables: Iterable[str],
+              table_names: Iterable[str], problems: _Problems) -> dict[str, Any]:
+    """The checked values of a file's top-level keys; an unknown key or table, or a bad
+    value, is added to ``problems`` at its key (``table_names`` as the message lists them)."""
+    tables = set(tables)
+    for key in raw:
+        if key not in tables and key not in top_keys:
+            problems.add(key, "unknown key or table; allowed: "
+                              f"{', '.join([*top_keys, *table_names])}")
+    top: dict[str, Any] = {}
+    for key in top_keys:
+        if key in raw:
+            try:
+                top[key] = top_keys[key].check(raw[key])
+            except _Invalid as exc:
+                problems.add(key, str(exc))
+    return top
+
+
 def _require(values: Mapping[str, Any], raw: Any, keys: Iterable[str], schema: Mapping[str, Key],
              path: str, problems: _Problems, reason: str = "") -> None:
     """Report each key of ``keys`` missing from the table ``raw``."""
@@ -78,17 +97,7 @@ def _validate(raw: dict[str, Any], source: str, lines: Mapping[str, int],
               origins: Mapping[str, str], directory: Path,
               allow_outside_paths: bool = False) -> Scenario:
     problems = _Problems(source, lines, origins)
-    for key in raw:
-        if key not in TABLES and key not in TOP_KEYS:
-            problems.add(key, "unknown key or table; allowed: "
-                              f"{', '.join(list(TOP_KEYS) + [f'[{t}]' for t in TABLES])}")
-    top = {}
-    for key in TOP_KEYS:
-        if key in raw:
-            try:
-                top[key] = TOP_KEYS[key].check(raw[key])
-            except _Invalid as exc:
-                problems.add(key, str(exc))
+    top = top_level(raw, TOP_KEYS, TABLES, [f"[{t}]" for t in TABLES], problems)
     surface = _validate_surface(raw, problems, directory, allow_outside_paths)
     material = _validate_material(raw, problems, surface)
     if surface is not None and material is not None:

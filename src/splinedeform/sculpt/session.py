@@ -11,11 +11,12 @@ named relative to the saved scenario, copied beside it when it lies outside its 
 from __future__ import annotations
 
 import dataclasses
+from contextlib import contextmanager
 import shutil
 import threading
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
 
@@ -127,10 +128,7 @@ class Session:
         :class:`~splinedeform.errors.InputError` for values the physics refuses; the
         current basis stays in place then.
         """
-        if not self._lock.acquire(blocking=False):
-            raise Busy("a re-solve is already running")
-        try:
-            self.progress.update(busy=True, error=None, stage="validating", elapsed=0.0)
+        with self._re_solving("validating"):
             overrides: dict[str, Any] = {f"material.{k}": getattr(message.material, k)
                                          for k in MATERIAL_FIELDS}
             overrides.update({f"boundary.{e}": getattr(message.boundary, e) for e in EDGE_NAMES})
@@ -143,12 +141,20 @@ class Session:
             try:
                 self._solve(with_overrides(self.scenario, overrides, origin="sculpt page"))
             except ScenarioError as exc:    # the page's settings, not a line of the file
-                message = in_page_words(str(exc), self.scenario.source)
-                self.progress.update(error=message, stage="failed")
-                raise InputError(message) from None
-            except Exception as exc:
-                self.progress.update(error=str(exc), stage="failed")
-                raise
+                raise InputError(in_page_words(str(exc), self.scenario.source)) from None
+
+    @contextmanager
+    def _re_solving(self, stage: str) -> Iterator[None]:
+        """Hold the re-solve lock (:class:`Busy` if it is held) with the progress ``stage``;
+        an error is shown on the page (stage ``failed``) and raised again."""
+        if not self._lock.acquire(blocking=False):
+            raise Busy("a re-solve is already running")
+        try:
+            self.progress.update(busy=True, error=None, stage=stage, elapsed=0.0)
+            yield
+        except Exception as exc:
+            self.progress.update(error=str(exc), stage="failed")
+            raise
         finally:
             self.progress["busy"] = False
             self._lock.release()
@@ -159,10 +165,7 @@ class Session:
     def bake(self, message: BakeMessage) -> None:
         """Make the shape of the modal state ``message.q`` the rest shape and re-solve
         (:mod:`.history`); :attr:`transfer` maps the old modes onto the new ones."""
-        if not self._lock.acquire(blocking=False):
-            raise Busy("a re-solve is already running")
-        try:
-            self.progress.update(busy=True, error=None, stage="baking", elapsed=0.0)
+        with self._re_solving("baking"):
             with self._state_lock:
                 self._check_version(message.version)
                 basis, scenario = self.basis, self.scenario
@@ -183,12 +186,6 @@ class Session:
             except Exception:
                 path.unlink(missing_ok=True)        # refused: no file of a shape never used
                 raise
-        except Exception as exc:
-            self.progress.update(error=str(exc), stage="failed")
-            raise
-        finally:
-            self.progress["busy"] = False
-            self._lock.release()
 
     def export(self, message: ExportMessage) -> tuple[bytes, str, str]:
         """The shape of ``message.q`` as a file (:func:`.shape_files.shape_file`)."""
@@ -203,19 +200,10 @@ class Session:
         """A surface (or a whole scenario) from a file the page sent (:mod:`.upload`)."""
         from .upload import loaded
 
-        if not self._lock.acquire(blocking=False):
-            raise Busy("a re-solve is already running")
-        try:
-            self.progress.update(busy=True, error=None, stage="reading " + name, elapsed=0.0)
+        with self._re_solving("reading " + name):
             stem = f"{self.save_path.stem}-loaded-{self._versions + 1}"
             with loaded(self.scenario, name, content, self.save_path.parent, stem) as scenario:
                 self._solve(scenario, carry=False)
-        except Exception as exc:
-            self.progress.update(error=str(exc), stage="failed")
-            raise
-        finally:
-            self.progress["busy"] = False
-            self._lock.release()
 
     def undo(self, version: int) -> None:
         """Back to the basis before the current one (exactly: kept, not solved again)."""

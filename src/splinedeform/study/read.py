@@ -15,10 +15,10 @@ from typing import Any
 
 from ..errors import ScenarioError
 from ..scenario import Scenario, load_scenario
-from ..scenario.checks import Key, _Invalid, key_of
+from ..scenario.checks import Key, key_of
 from ..scenario.locate import _Problems, key_lines
 from ..scenario.read import read_toml
-from ..scenario.validate import _check_table
+from ..scenario.validate import _check_table, top_level
 from . import schema as S
 from .keys import KeyPath, UnknownKey, parse_key
 
@@ -96,17 +96,7 @@ def parse_sweep(content: str, source: str = "<sweep>", directory: Path | None = 
     directory = directory or Path.cwd()
     raw = read_toml(content, source)
     problems = _SweepProblems(source, key_lines(content))
-    for key in raw:
-        if key not in TOP_KEYS and key not in TABLES:
-            problems.add(key, "unknown key or table; allowed: "
-                              f"{', '.join([*TOP_KEYS, '[design]', '[[axis]]', '[output]'])}")
-    top: dict[str, Any] = {}
-    for key in TOP_KEYS:
-        if key in raw:
-            try:
-                top[key] = TOP_KEYS[key].check(raw[key])
-            except _Invalid as exc:
-                problems.add(key, str(exc))
+    top = top_level(raw, TOP_KEYS, TABLES, ["[design]", "[[axis]]", "[output]"], problems)
     if "scenario" not in raw:
         problems.add("scenario", f"missing; expected {TOP_KEYS['scenario'].allowed}: the base "
                                  "scenario file, relative to the sweep file")
