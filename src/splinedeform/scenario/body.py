@@ -21,12 +21,13 @@ from __future__ import annotations
 from typing import Any, Sequence
 
 from ..body.body import Body
+from .schema_types import SHELL_EDGES
 from .spec import Scenario
 
 #: output formats written for a body (:mod:`splinedeform.outputs_body`)
 BODY_FORMATS = ("vtu", "obj", "stl", "ply", "3dm", "step", "iges", "images", "report")
-#: physics a body runs with (the shell's coupling across interfaces lands separately)
-BODY_PHYSICS = ("intrinsic", "parametric")
+#: physics a body runs with
+BODY_PHYSICS = ("intrinsic", "parametric", "shell")
 
 
 class FileBody(Body):
@@ -61,7 +62,9 @@ def is_body(surface: Any) -> bool:
 def body_from_cad(scenario: Scenario) -> tuple[Any, int, str | None]:
     """``(body, face, units)`` of ``surface.faces`` (``"all"`` when neither ``face`` nor
     ``faces`` is given): one face chosen gives no body and that face (read as ``face``
-    is); several give a :class:`FileBody` of their surfaces and the file's interfaces."""
+    is); several give a :class:`FileBody` of their surfaces and the file's interfaces, or,
+    where the file has no edges among them (plain surfaces, no Brep), the interfaces found
+    where their edges meet."""
     from ..cad_body import body_of, choose_faces, read_listing
     from ..errors import InputError
     from .build import _located
@@ -82,8 +85,12 @@ def body_from_cad(scenario: Scenario) -> tuple[Any, int, str | None]:
         return None, chosen[0], listing["units"]
     with _located(scenario, "surface.faces"):
         surfaces, topology, info = body_of(path, listing, chosen)
-    return (FileBody(surfaces, topology.interfaces, info["faces"], topology.counts),
-            chosen[0], info["units"])
+        if any(topology.counts.values()):
+            return (FileBody(surfaces, topology.interfaces, info["faces"], topology.counts),
+                    chosen[0], info["units"])
+        # plain surfaces, not a Brep or shell: the file has no edges, so where the faces
+        # touch is found from their geometry (:func:`splinedeform.body.topology.find_topology`)
+        return FileBody(surfaces, None, info["faces"], {}), chosen[0], info["units"]
 
 
 def refined_body(scenario: Scenario, body: FileBody) -> FileBody:
@@ -199,6 +206,10 @@ def face_presets(scenario: Scenario, body: FileBody) -> str | dict[tuple[int, st
                                  f"whose faces are {list(body.faces)}")
         for edge, preset in edges.items():
             where = f"boundary.faces.{key}.{edge}"
+            if preset in SHELL_EDGES and scenario.material.physics != "shell":
+                raise scenario.error(where, f"{preset!r} is an edge of the Kirchhoff–Love "
+                                     "shell only (material.physics = \"shell\"), not of "
+                                     f"physics {scenario.material.physics!r}")
             if (patch, edge) in joined:
                 other, side = joined[(patch, edge)]
                 raise scenario.error(where, f"edge {edge} of face {key} is an interface (it "
@@ -212,15 +223,26 @@ def face_presets(scenario: Scenario, body: FileBody) -> str | dict[tuple[int, st
 
 
 def body_model(scenario: Scenario, body: FileBody) -> Any:
-    """The :class:`~splinedeform.body.BodyModel` of a body scenario."""
+    """The model of a body scenario: a :class:`~splinedeform.body.BodyModel` (the thin plate
+    under tension), or under ``physics = "shell"`` a
+    :class:`~splinedeform.physics.shell_model.ShellModel` of the body (conforming interfaces
+    merged, the rest and every interface's rotation coupled, :mod:`..physics.shell_body`)."""
     from ..body.model import BodyModel
     from ..material import Material
     from .build import _located
 
     check_body_scenario(scenario, body)
+    boundary = face_presets(scenario, body)
+    if scenario.material.physics == "shell":
+        from ..physics.shell import ShellMaterial
+        from ..physics.shell_model import ShellModel
+
+        with _located(scenario, "material"):
+            shell = ShellMaterial(**scenario.material.shell())
+        with _located(scenario, "boundary"):
+            return ShellModel(body, shell, boundary)
     with _located(scenario, "material"):
         material = Material(**scenario.material.weights())
-    boundary = face_presets(scenario, body)
     with _located(scenario, "boundary"):
         return BodyModel(body, material, boundary=boundary,
                          mass_matrix=scenario.material.mass_matrix,

@@ -92,8 +92,9 @@ class FreeRegion(_Table):
         json_schema_extra={"doc_default": 'whole range'})
 
 
-#: edge conditions a face of a body takes (:data:`splinedeform.body.constraints.BODY_PRESETS`)
-FacePreset = Literal["free", "pinned", "clamped"]
+#: edge conditions a face of a body takes (:data:`splinedeform.body.constraints.BODY_PRESETS`,
+#: and the shell's own under ``physics = "shell"``)
+FacePreset = Literal["free", "pinned", "clamped", "diaphragm", "symmetry"]
 #: a face of a body named in ``boundary.faces``: its number in the file
 FaceKey = Annotated[str, Field(pattern=r"^[0-9]+$")]
 
@@ -130,7 +131,8 @@ class Boundary(_Table):
         None, title="{k = {u0 = ...}}", description=(
             "body of CAD faces only: presets of single boundary edges, keyed by the face's "
             "number in the file (`[boundary.faces]` then `3 = { u0 = \"clamped\" }`): "
-            "`free`, `pinned` or `clamped`; they replace the one preset `u0 = u1 = v0 = v1` "
+            "`free`, `pinned` or `clamped`, and under physics `shell` also `diaphragm` or "
+            "`symmetry`; they replace the one preset `u0 = u1 = v0 = v1` "
             "on those edges; an edge another face meets (an interface) or a pole takes none"),
         json_schema_extra={"doc_default": "none"})
 
