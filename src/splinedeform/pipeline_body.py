@@ -93,25 +93,37 @@ def _frames(scenario: Scenario, patches: Any, solution: Any, times: Any, mode_ne
     return [r + phase * m[0] for r, m in zip(rests, mode_nets)]
 
 
+def body_readout(model: Any) -> Any:
+    """The :class:`~splinedeform.readout.BodyReadout` of a body's model (a plate body's
+    own, or the shell body's patches, map and reduced matrices)."""
+    from .readout import BodyReadout
+
+    readout = getattr(model, "readout", None)
+    if isinstance(readout, BodyReadout):
+        return readout
+    M, _, K = model.matrices()
+    return BodyReadout(tuple(model.patches), model.T, M, K)
+
+
 def _measure(result: Any) -> None:
-    """Each face's centre displacement per frame (the probes), the largest displacement on
-    the patches' output grids per frame, and the energies."""
+    """The probes' displacements per frame (:mod:`splinedeform.probes_body`: each face's
+    centre unless ``output.probes`` names points), the largest displacement on the patches'
+    output grids per frame, and the energies."""
+    from .probes_body import body_probes
     from .run_measures import displacement_per_frame, energies
 
     scenario, body = result.scenario, result.built.surface
-    F = len(result.times)
-    per_frame = np.zeros(F)
-    for k, (surface, nets) in enumerate(zip(body.patches, result.nets)):
-        D = nets - surface.control_points
-        (_, lu), (_, lv) = surface.domain
-        E = surface.evaluation_matrix(np.array([0.5 * lu]), np.array([0.5 * lv]))
-        face = body.faces[k] if hasattr(body, "faces") else k
-        name = f"face {face} centre"
-        result.probes[name] = np.asarray(E @ np.moveaxis(D.reshape(F, -1, 3), 0, 1)
-                                         .reshape(E.shape[1], F * 3)).reshape(F, 3)
-        result.probe_points[name] = (0.5 * lu, 0.5 * lv)
+    readout = body_readout(result.built.model)
+    with _located(scenario, "output.probes"):
+        probes = body_probes(scenario, body)
+    for probe in probes:
+        result.probes[probe.name] = readout.probe(result.nets, probe.patch, *probe.at)
+        result.probe_points[probe.name] = probe.at
+        result.probe_patches[probe.name] = probe.patch
+    per_frame = np.zeros(len(result.times))
+    for surface, nets in zip(body.patches, result.nets):
         per_frame = np.maximum(per_frame, displacement_per_frame(
-            surface, D, scenario.output.resolution))
+            surface, nets - surface.control_points, scenario.output.resolution))
     result.displacement_per_frame = per_frame
     result.max_displacement = float(per_frame.max(initial=0.0))
     result.energy = energies(result)

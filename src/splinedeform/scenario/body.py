@@ -13,7 +13,9 @@ and a :class:`~splinedeform.body.BodyModel`. What a body takes from a scenario:
 * ``[[load]]``: a uniform force or a pressure acts on every face, or on face ``face``
   only; a point load names its face (``face = k``, the file's face number) and ``at`` in
   that face's parameters;
-* ``[output]``: the formats of :data:`BODY_FORMATS`; probes are the faces' centres.
+* ``[output]``: the formats of :data:`BODY_FORMATS`; ``probes`` name their face
+  (``probe_faces``) or are points in space read on their nearest face
+  (:mod:`splinedeform.probes_body`); without them, each face's centre.
 """
 
 from __future__ import annotations
@@ -145,9 +147,6 @@ def check_body_scenario(scenario: Scenario, body: FileBody) -> None:
         if key in raw:
             raise s.error(f"boundary.{key}", "applies to one surface, not to a body of "
                                              f"{len(body)} faces")
-    if s.output.probes:
-        raise s.error("output.probes", "applies to one surface; a body's probes are its "
-                                       "faces' centres")
     for ext in s.output.formats:
         if ext not in BODY_FORMATS:
             raise s.error("output.formats", f"{ext} is not written for a body of "
@@ -163,10 +162,11 @@ def check_body_scenario(scenario: Scenario, body: FileBody) -> None:
             raise s.error(f"load[{i}].face", f"face {spec.face} is not in this body, whose "
                                              f"faces are {list(body.faces)}")
         if spec.at is not None:
-            _check_at(s, f"load[{i}].at", spec.at, body[patch])
+            check_at(s, f"load[{i}].at", spec.at, body[patch])
 
 
-def _check_at(scenario: Scenario, path: str, at: tuple[float, float], surface: Any) -> None:
+def check_at(scenario: Scenario, path: str, at: tuple[float, float], surface: Any) -> None:
+    """Refuse at ``path`` parameters ``at`` outside the domain of a body's face."""
     for x, basis, name in ((at[0], surface.basis_u, "u"), (at[1], surface.basis_v, "v")):
         if not basis.periodic and not -1e-12 <= x <= basis.length * (1 + 1e-12):
             raise scenario.error(path, f"{name} = {x:g} is outside the parameter domain "
@@ -175,7 +175,10 @@ def _check_at(scenario: Scenario, path: str, at: tuple[float, float], surface: A
 
 def check_single_surface_loads(scenario: Scenario, face: int | None) -> None:
     """``load.face`` on one surface: only the face it is (a CAD face), else refused;
-    ``boundary.faces`` is a body's, refused on one surface."""
+    ``boundary.faces`` and ``output.probe_faces`` are a body's, refused on one surface."""
+    if scenario.output.probe_faces is not None:
+        raise scenario.error("output.probe_faces", "names faces of a body of CAD faces; one "
+                             "surface's probes are [u, v] on it")
     if "faces" in scenario.raw.get("boundary", {}):
         raise scenario.error("boundary.faces", "names edges of the faces of a body of CAD "
                              "faces; one surface takes u0, u1, v0 and v1")

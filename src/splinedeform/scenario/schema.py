@@ -258,9 +258,18 @@ class Output(_Table):
     resolution: Annotated[int, Strict(), Field(ge=2, le=1024)] = Field(
         32, description=(
             "tessellation samples per direction for meshes, pictures, animation, viewer"))
-    probes: list[Pair] = Field([], title="[u, v] pairs", description=(
-            "points whose displacement is reported (`report`) and plotted (`probes.png`)"),
-        json_schema_extra={"doc_default": 'the domain centre'})
+    probes: list[Union[Pair, tuple[Real, Real, Real]]] = Field(
+        [], title="[u, v] pairs", description=(
+            "points whose displacement is reported (`report`) and plotted (`probes.png`); on "
+            "a body of CAD faces `[u, v]` of the face `probe_faces` names, or a point "
+            "`[x, y, z]` in space, read at the nearest point of its face (of `probe_faces`, "
+            "else of the face it is nearest to)"),
+        json_schema_extra={"doc_default": "the domain centre (a body: each face's centre)"})
+    probe_faces: Optional[list[Annotated[int, Strict(), Field(ge=0)]]] = Field(
+        None, title="face numbers", description=(
+            "body of CAD faces only: the face of each probe, one per entry of `probes` (the "
+            "file's face numbers, as `splinedeform faces FILE` lists them)"),
+        json_schema_extra={"doc_default": "a point's nearest face (required for `[u, v]`)"})
     time: Optional[Time] = Field(None, description="dynamic: the state written as OBJ / STL / PLY",
         json_schema_extra={"doc_default": 'the last frame'})
     warp: Union[Literal["auto"], Annotated[float, Strict(), Field(gt=0, le=1e6,
