@@ -26,8 +26,10 @@ from ..body.body import Body
 from .schema_types import SHELL_EDGES
 from .spec import Scenario
 
-#: output formats written for a body (:mod:`splinedeform.outputs_body`)
-BODY_FORMATS = ("vtu", "obj", "stl", "ply", "3dm", "step", "iges", "images", "report")
+#: output formats written for a body (:mod:`splinedeform.outputs_body`): all but the
+#: viewer, whose page draws one surface
+BODY_FORMATS = ("vtu", "obj", "stl", "ply", "json", "npz", "3dm", "step", "iges", "images",
+                "gif", "mp4", "report")
 #: physics a body runs with
 BODY_PHYSICS = ("intrinsic", "parametric", "shell")
 
@@ -151,6 +153,9 @@ def check_body_scenario(scenario: Scenario, body: FileBody) -> None:
         if ext not in BODY_FORMATS:
             raise s.error("output.formats", f"{ext} is not written for a body of "
                           f"{len(body)} faces yet; a body writes {', '.join(BODY_FORMATS)}")
+    if s.output.animate_modes not in (None, (1,)):
+        raise s.error("output.animate_modes", "a body animates its lowest mode (as the "
+                      "gif / mp4 of a modes solve); its other modes are not animated yet")
     for i, spec in enumerate(s.loads, start=1):
         if spec.face is None:
             if spec.kind == "point":
