@@ -8,8 +8,9 @@ and a :class:`~splinedeform.body.BodyModel`. What a body takes from a scenario:
   ``u0 = u1 = v0 = v1``, replaced edge by edge by ``[boundary.faces]``
   (``3 = {u0 = "clamped"}``, the file's face numbers; :func:`face_presets`); a free region
   or listed points are a single surface's;
-* ``surface.refine`` / ``surface.elevate``: every face alike, the same count in u and v
-  (:func:`refined_body`);
+* ``surface.refine`` / ``surface.elevate``: every face alike, in its own u and v; where
+  the counts differ in u and v, interfaces are made to conform again by exact elevation
+  and knot insertion (:func:`refined_body`);
 * ``[[load]]``: a uniform force or a pressure acts on every face, or on face ``face``
   only; a point load names its face (``face = k``, the file's face number) and ``at`` in
   that face's parameters;
@@ -99,37 +100,73 @@ def body_from_cad(scenario: Scenario) -> tuple[Any, int, str | None]:
 
 def refined_body(scenario: Scenario, body: FileBody) -> FileBody:
     """``body`` with every face elevated by ``surface.elevate`` degrees, then with
-    ``surface.refine`` knots inserted per span (:func:`splinedeform.refine.refine_surface`).
+    ``surface.refine`` knots inserted per span, each face in its own u and v
+    (:func:`splinedeform.refine.refine_surface`).
 
-    A shared edge may be a u edge on one face and a v edge on the other, so the counts must
-    be the same in u and v (else refused at the key): each side of an edge is then refined
-    alike (``k`` knots at equal distances in every span of its normalised knot vector,
-    which is symmetric under mirroring; degrees raised by ``p``), and an interface that
-    conformed conforms still. Each interface's ``conforming`` is checked again on the
-    refined faces (:func:`splinedeform.body.topology.conforming`)."""
+    A shared edge can be a u edge of one face and a v edge of its neighbour, so counts
+    that differ in u and v give the two sides of an edge different degrees or knots. Such
+    an interface that conformed is made to conform again, exactly: after the elevation the
+    side of lower degree is elevated along the edge until the degrees agree
+    (:func:`matched_degrees`), after the insertion each side gets the knots of the other
+    that it lacks (:func:`splinedeform.body.body.insert_missing_knots`, Boehm's
+    insertion), each repeated while a direction's new degree or knots reach other edges.
+    Each interface's ``conforming`` is checked again on the refined faces
+    (:func:`splinedeform.body.topology.conforming`)."""
     from dataclasses import replace
 
+    from ..body.body import MAX_PASSES, insert_missing_knots
     from ..body.topology import conforming
+    from ..errors import InputError
     from ..refine import refine_surface
     from .build import _located
 
     spec = scenario.surface
-    for key in ("elevate", "refine"):
-        u, v = getattr(spec, key)
-        if u != v:
-            raise scenario.error(f"surface.{key}", f"a body takes the same count in u and v "
-                                 f"(got u = {u}, v = {v}): a shared edge can be a u edge of "
-                                 "one face and a v edge of its neighbour, and both sides "
-                                 "must get the same knots; give one count, e.g. "
-                                 f"{key} = {max(u, v)}")
+    uneven = spec.elevate[0] != spec.elevate[1] or spec.refine[0] != spec.refine[1]
+    joined = [i for i in body.interfaces if i.conforming]
     key = "surface.elevate" if spec.elevate != (0, 0) else "surface.refine"
     with _located(scenario, key):
-        patches = [refine_surface(s, spec.elevate, spec.refine) for s in body]
+        patches = [refine_surface(s, spec.elevate) for s in body]
+        if uneven:
+            patches = matched_degrees(patches, joined)
+        patches = [refine_surface(s, (0, 0), spec.refine) for s in patches]
+        for _ in range(MAX_PASSES if uneven else 0):
+            if not insert_missing_knots(patches, joined):
+                break
+        else:
+            if uneven:
+                raise InputError(f"knot insertion did not make the refined faces conform "
+                                 f"again in {MAX_PASSES} rounds; give one count for u and v")
     tol = body.topology.tol
     interfaces = [replace(i, conforming=conforming(patches[i.a], i.edge_a, patches[i.b],
                                                    i.edge_b, i.reversed, tol))
                   if i.conforming else i for i in body.interfaces]
     return FileBody(patches, interfaces, body.faces, body.counts)
+
+
+def matched_degrees(patches: list[Any], interfaces: Sequence[Any]) -> list[Any]:
+    """``patches`` with the side of lower degree of each interface elevated along its
+    edge (:func:`splinedeform.refine.refine_surface`, exact) until both sides agree."""
+    from ..body.body import MAX_PASSES
+    from ..body.topology import edge_basis
+    from ..errors import InputError
+    from ..refine import refine_surface
+
+    patches = list(patches)
+    for _ in range(MAX_PASSES):
+        wanted: dict[tuple[int, int], int] = {}
+        for i in interfaces:
+            pa = edge_basis(patches[i.a], i.edge_a).degree
+            pb = edge_basis(patches[i.b], i.edge_b).degree
+            for p, edge, by in ((i.a, i.edge_a, pb - pa), (i.b, i.edge_b, pa - pb)):
+                axis = 1 if edge[0] == "u" else 0          # the direction along the edge
+                if by > 0:
+                    wanted[(p, axis)] = max(wanted.get((p, axis), 0), by)
+        if not wanted:
+            return patches
+        for (p, axis), by in wanted.items():
+            patches[p] = refine_surface(patches[p], (by, 0) if axis == 0 else (0, by))
+    raise InputError(f"degree elevation did not give the faces' edges common degrees in "
+                     f"{MAX_PASSES} rounds; give one count for u and v")
 
 
 def check_body_scenario(scenario: Scenario, body: FileBody) -> None:
