@@ -259,7 +259,7 @@ class Output(_Table):
         32, description=(
             "tessellation samples per direction for meshes, pictures, animation, viewer"))
     probes: list[Union[Pair, tuple[Real, Real, Real]]] = Field(
-        [], title="[u, v] pairs", description=(
+        [], title="[u, v] pairs (a body: or [x, y, z] points)", description=(
             "points whose displacement is reported (`report`) and plotted (`probes.png`); on "
             "a body of CAD faces `[u, v]` of the face `probe_faces` names, or a point "
             "`[x, y, z]` in space, read at the nearest point of its face (of `probe_faces`, "
