@@ -24,11 +24,11 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import InputError
-from ..input_files import check_array_file, load_json, open_input
+from ..input_files import load_json
 from ..surface import Surface
 from .atomic import _check_stem, _require_folder, write_text, write_with
 from .nets import (CONTROL_NET_FORMATS, _npz_arrays, control_net_document, json_fields,
-                   npz_fields, surface_of)
+                   load_npz_arrays, npz_fields, surface_of)
 
 BODY_NETS_FORMAT = "splinedeform-body-control-nets"
 BODY_NETS_VERSION = 1
@@ -98,13 +98,7 @@ def read_body_control_nets(path: str | os.PathLike[str], frame: int = -1
                              "net document")
         return {int(k): surface_of(json_fields(v, source), source, frame)
                 for k, v in nets.items()}
-    try:
-        with open_input(source, "control-net file") as fh:
-            check_array_file(fh, source)
-            with np.load(fh, allow_pickle=False) as z:
-                data = {key: z[key] for key in z.files}
-    except (OSError, ValueError, EOFError) as exc:
-        raise InputError(f"{source}: not a valid .npz control-net file: {exc}") from None
+    data = load_npz_arrays(source)
     _check_header(source, {k: data[k].item() for k in ("format", "version") if k in data})
     faces = [int(f) for f in np.atleast_1d(data.get("faces", np.zeros(0)))]
     out = {}

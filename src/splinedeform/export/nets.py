@@ -167,14 +167,18 @@ def json_fields(doc: Any, path: Path) -> dict[str, Any]:
 
 
 def _load_npz_nets(path: Path) -> dict[str, Any]:
+    return npz_fields(load_npz_arrays(path), path)
+
+
+def load_npz_arrays(path: Path) -> dict[str, NDArray[Any]]:
+    """Every array of a control-net ``.npz`` file (no pickles), refused where unreadable."""
     try:
         with open_input(path, "control-net file") as fh:
             check_array_file(fh, path)
             with np.load(fh, allow_pickle=False) as z:
-                data = {key: z[key] for key in z.files}
+                return {key: z[key] for key in z.files}
     except (OSError, ValueError, EOFError) as exc:
         raise InputError(f"{path}: not a valid .npz control-net file: {exc}") from None
-    return npz_fields(data, path)
 
 
 def npz_fields(data: Mapping[str, Any], path: Path) -> dict[str, Any]:
