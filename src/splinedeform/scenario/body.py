@@ -312,5 +312,6 @@ def describe_body(built: Any) -> list[tuple[str, str]]:
     rows = [("faces", f"{len(body)} ({', '.join(str(f) for f in body.faces)})"),
             ("control nets", f"{points} points in {len(body)} nets"),
             ("edges", ", ".join(f"{v} {k.replace('_', '-')}" for k, v in counts.items())),
-            ("free control points", str(built.model.n_free))]
+            (getattr(built.model, "unknowns_label", "free control points"),
+             str(built.model.n_free))]
     return rows + ([("length unit", built.units)] if built.units is not None else [])
