@@ -7,6 +7,8 @@
   one named surface per face, STEP / IGES sewn into one shell);
 * ``images``: ``surfaces.png`` (every face at rest and at the frame of largest
   displacement, one welded mesh), ``probes.png`` for a dynamic solve (the faces' centres);
+* ``viewer``: ``viewer.html``, every frame of the welded mesh and every face's net
+  (:func:`splinedeform.viz.viewer_body.write_body_viewer`);
 * ``report``: ``report.json`` / ``report.md`` naming the unit, the faces and the topology.
 
 Other formats are refused for a body when the scenario is built
@@ -45,6 +47,7 @@ def body_outputs(result: RunResult) -> list[str]:
     names += [f"{name}{suffix}" for ext, suffix in _suffixes().items() if ext in formats]
     if "images" in formats:
         names += ["surfaces.png"] + (["probes.png"] if s.solve.kind == "dynamic" else [])
+    names += ["viewer.html"] if "viewer" in formats else []
     return names + (["report.json", "report.md"] if "report" in formats else [])
 
 
@@ -90,6 +93,13 @@ def write_body_files(result: RunResult, folder: Path, stages: Stages) -> None:
                     folder / f"{name}{suffix}", patches, deformed_nets(result), units)))
     if "images" in formats:
         _write_images(result, folder, stages)
+    if "viewer" in formats:
+        from .viz.viewer_body import write_body_viewer
+
+        with stages.stage("viewer"):
+            result.outputs.append(("viewer", write_body_viewer(
+                folder / "viewer.html", patches, rest, result.times, result.nets, res,
+                title=s.title or s.name)))
     if "report" in formats:
         from .outputs import write_report
 

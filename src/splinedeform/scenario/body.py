@@ -24,7 +24,8 @@ from ..body.body import Body
 from .spec import Scenario
 
 #: output formats written for a body (:mod:`splinedeform.outputs_body`)
-BODY_FORMATS = ("vtu", "obj", "stl", "ply", "3dm", "step", "iges", "images", "report")
+BODY_FORMATS = ("vtu", "obj", "stl", "ply", "3dm", "step", "iges", "images", "viewer",
+                "report")
 #: physics a body runs with (the shell's coupling across interfaces lands separately)
 BODY_PHYSICS = ("intrinsic", "parametric")
 

@@ -9,7 +9,8 @@ Bake makes the current shape the rest shape: the control net ``P + d`` with
 ``d = T Φ_net q`` (the page's modal displacement ``q``, ``(k, 3)``) becomes the model's
 initial surface, written as a control-net file beside the save file, whose knot vectors it
 keeps (:func:`baked_scenario`); the modes are then solved again on it. A body's faces are
-written together as one ``.3dm`` (its interfaces found again where the faces meet).
+written together as one STEP shell, sewn where they meet, so that the file read back has
+the body's shared edges (:func:`splinedeform.export.body.write_body_step`).
 """
 
 from __future__ import annotations
@@ -90,14 +91,14 @@ def baked_net(basis: SculptBasis, q: NDArray[np.float64]) -> NDArray[np.float64]
 def baked_scenario(scenario: Scenario, basis: SculptBasis, nets: list[NDArray[np.float64]],
                    folder: Path, stem: str) -> tuple[Scenario, Path]:
     """``scenario`` on the surface of control nets ``nets`` (same bases), written to
-    ``folder/stem.json`` (one surface) or ``folder/stem.3dm`` (a body: every face, in the
-    body's unit, read back with ``faces = "all"``); the scenario reads it from ``folder``
-    (its directory then)."""
+    ``folder/stem.json`` (one surface) or ``folder/stem.step`` (a body: every face in one
+    shell, in the body's unit, read back with ``faces = "all"``); the scenario reads it
+    from ``folder`` (its directory then)."""
     from ..export import write_control_nets
 
     moved = dataclasses.replace(scenario, directory=folder.resolve())
     if basis.is_body:
-        return _baked_body(moved, basis, nets, folder / f"{stem}.3dm")
+        return _baked_body(moved, basis, nets, folder / f"{stem}.step")
     surface = basis.model.surface
     path, = write_control_nets(folder, stem, surface, [0.0], nets[0][None], formats=("json",))
     table: dict[str, Any] = {"shape": "file", "path": path.name}
@@ -106,14 +107,13 @@ def baked_scenario(scenario: Scenario, basis: SculptBasis, nets: list[NDArray[np
 
 def _baked_body(scenario: Scenario, basis: SculptBasis, nets: list[NDArray[np.float64]],
                 path: Path) -> tuple[Scenario, Path]:
-    """The body's faces with ``nets`` as one ``.3dm`` (patch ``p`` its face ``p``; the
-    refinement already done, so none asked again) and ``scenario`` on it: the faces named
-    by ``boundary.faces`` and by loads renumbered to the new file's."""
-    from ..export.body import write_body_3dm
+    """The body's faces with ``nets`` as one sewn STEP shell (patch ``p`` its face ``p``;
+    the refinement already done, so none asked again) and ``scenario`` on it: the faces
+    named by ``boundary.faces`` and by loads renumbered to the new file's."""
+    from ..export.body import write_body_step
 
-    patches = basis.patches
-    faces = list(getattr(basis.model.body, "faces", range(len(patches))))
-    write_body_3dm(path, patches, nets, [f"face {f}" for f in faces], basis.units)
+    faces = list(getattr(basis.model.body, "faces", range(len(basis.patches))))
+    write_body_step(path, basis.patches, nets, basis.units, shell=True)
     number = {face: patch for patch, face in enumerate(faces)}
     overrides: dict[str, Any] = {"surface": {"shape": "cad", "path": path.name, "faces": "all"}}
     named = scenario.raw.get("boundary", {}).get("faces")
