@@ -19,11 +19,11 @@ import pytest
 pytest.importorskip("rhino3dm", reason="the body's .3dm needs the extra 'cad'")
 pytest.importorskip("OCP", reason="the body's STEP shell needs OpenCASCADE (the extra 'step')")
 from body_patches import flat_patch  # noqa: E402
+from sculpt_body_files import BODY, two_faces  # noqa: E402
 from sculpt_client import serve_sheet  # noqa: E402 (skips without the extra)
 
 import splinedeform as sd  # noqa: E402
 from splinedeform.body import OnPatch  # noqa: E402
-from splinedeform.export.body import write_body_step  # noqa: E402
 from splinedeform.export.nets import read_control_net  # noqa: E402
 from splinedeform.scenario import build, parse_scenario  # noqa: E402
 from splinedeform.sculpt import Push  # noqa: E402
@@ -33,31 +33,6 @@ from splinedeform.sculpt.state import modal_history  # noqa: E402
 
 pytestmark = pytest.mark.filterwarnings("ignore:Using `httpx`")
 R = 6                                   # samples per direction of each face
-BODY = """
-title = "two faces"
-[surface]
-shape = "cad"
-path = "two.step"
-[material]
-damping = 2.0
-w10 = 1.0
-w01 = 1.0
-[boundary]
-u0 = "clamped"
-u1 = "clamped"
-v0 = "clamped"
-v1 = "clamped"
-[solve]
-kind = "modes"
-"""
-
-
-def two_faces(folder):
-    """The two faces as one shell of a STEP file (in millimetres) in ``folder``."""
-    faces = [flat_patch((0.0, 1.0), (0.0, 1.0), (3, 3)), flat_patch((1.0, 2.0), (0.0, 1.0), (3, 3))]
-    write_body_step(folder / "two.step", faces, [f.control_points for f in faces], "mm",
-                    shell=True)
-    return faces
 
 
 @pytest.fixture()
