@@ -200,3 +200,22 @@ def test_a_body_refuses_a_free_region_and_edge_by_edge_presets(served):
     reply = client.post("/api/resolve", json={"material": material, "boundary": same})
     assert reply.status_code == 200, reply.text
     assert reply.json()["boundary"] == same and session.version == 2
+
+
+def test_a_file_of_several_faces_loaded_from_the_page_opens_as_a_body(tmp_path):
+    """The built-in sheet's session (every edge clamped) loads the two faces' STEP file: the
+    modes are the body's (the same as a session opened on it, to 1e-9 relative: two
+    eigensolves of the same matrices)."""
+    sheet = BODY.replace('shape = "cad"\npath = "two.step"', 'shape = "plane"\ncells = 3')
+    client, session = serve_sheet(tmp_path, sheet, resolution=R)
+    source = tmp_path / "source"
+    source.mkdir()
+    two_faces(source)
+    reply = client.post("/api/load", content=(source / "two.step").read_bytes(),
+                        headers={"X-Sculpt-File-Name": "two.step",
+                                 "Content-Type": "application/octet-stream"})
+    assert reply.status_code == 200, reply.text
+    assert reply.json()["body"]["faces"] == [0, 1] and session.basis.is_body
+    _, direct = serve_sheet(source, BODY, resolution=R)
+    lam, expect = session.basis.lam, direct.basis.lam
+    assert np.abs(lam - expect).max() <= 1e-9 * expect.max()
