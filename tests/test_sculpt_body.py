@@ -219,3 +219,37 @@ def test_a_file_of_several_faces_loaded_from_the_page_opens_as_a_body(tmp_path):
     _, direct = serve_sheet(source, BODY, resolution=R)
     lam, expect = session.basis.lam, direct.basis.lam
     assert np.abs(lam - expect).max() <= 1e-9 * expect.max()
+
+
+def test_the_static_correction_of_a_truncated_body_basis_makes_a_held_push_exact(tmp_path):
+    """With 4 of the body's modes, the modal static part plus the correction column of the
+    grabbed sample (POST /api/correction) is the body's direct static solve at every
+    sample of both faces, to 1e-9 of the displacement (sparse LU against eigenvectors)."""
+    from sculpt_client import ORIGIN, TOKEN
+    from starlette.testclient import TestClient
+
+    from splinedeform.sculpt.guard import TOKEN_HEADER, Guard
+    from splinedeform.sculpt.server import create_app
+    from splinedeform.sculpt.session import Session
+
+    two_faces(tmp_path)
+    session = Session(parse_scenario(BODY, source="two.toml", directory=tmp_path),
+                      resolution=R, modes=4, save_path=tmp_path / "saved.toml")
+    client = TestClient(create_app(session, Guard.for_address("127.0.0.1", 8765, TOKEN)),
+                        base_url=ORIGIN, headers={"Origin": ORIGIN, TOKEN_HEADER: TOKEN})
+    basis, index = session.basis, index_of(1, 1, 2)
+    assert basis.lam.size == 4 < basis.model.n_free
+    reply = client.post("/api/correction", json={"version": 1, "index": index})
+    assert reply.status_code == 200, reply.text
+    column = decode(reply.json()["column"])                       # float32 on the wire
+    modal = basis.phi_samples @ (basis.phi_samples[index] / basis.lam)
+    patch, u, v = basis.sample_point(index)
+    static = basis.model.static(OnPatch(sd.Point(u, v, (0.0, 0.0, 1.0)), patch=patch))
+    expect = basis.sample_matrix() @ np.concatenate([n.reshape(-1, 3) for n in static.control_points()])
+    expect = expect[:, 2] - basis.rest_samples()[:, 2]
+    scale = np.abs(expect).max()
+    assert np.abs(modal + session.correction.column(index) - expect).max() <= 1e-9 * scale
+    # the page's copy in float32: each entry rounded by at most 2**-24 of itself, so
+    # 2**-23 of the column's largest bounds them all
+    exact = session.correction.column(index)
+    assert np.abs(column - exact).max() <= 2**-23 * np.abs(exact).max()
