@@ -46,6 +46,16 @@ def index_of(patch: int, i: int, j: int) -> int:
     return patch * R * R + i * R + j
 
 
+def rung_down(basis, index, force):
+    """``(q, nets, scale)``: the modal state long after a held push of ``force`` on sample
+    ``index`` (t = 1000: rung down under damping 2, e^-1000), its nets per face and their
+    largest displacement."""
+    patch, u, v = basis.sample_point(index)
+    q = modal_history(basis, [Push(u, v, force, 0.0, patch=patch)], [1e3])[0]
+    nets = baked_nets(basis, q)
+    return q, nets, max(np.abs(n - s.control_points).max() for n, s in zip(nets, basis.patches))
+
+
 def shared_edges(nets, n=21):
     """Face 0's edge u = 1 and face 1's edge u = 0 of the nets, sampled at ``n`` v's."""
     faces = [flat_patch((0.0, 1.0), (0.0, 1.0), (3, 3)), flat_patch((1.0, 2.0), (0.0, 1.0), (3, 3))]
@@ -94,10 +104,7 @@ def test_the_exported_body_keeps_every_face_and_the_closed_seam(served, tmp_path
 
     client, session = served
     basis = session.basis
-    patch, u, v = basis.sample_point(index_of(1, 1, 3))
-    q = modal_history(basis, [Push(u, v, (0.0, 0.2, 1.0), 0.0, patch=patch)], [1e3])[0]
-    nets = baked_nets(basis, q)
-    scale = max(np.abs(n - s.control_points).max() for n, s in zip(nets, basis.patches))
+    q, nets, scale = rung_down(basis, index_of(1, 1, 3), (0.0, 0.2, 1.0))
     reply = client.post("/api/export", json={"version": 1, "q": q.ravel().tolist(), "format": "3dm"})
     assert reply.status_code == 200, reply.text
     path = tmp_path / "got.3dm"
@@ -165,10 +172,7 @@ def test_save_names_the_faces_and_replays_with_run(served):
 @pytest.mark.filterwarnings("ignore:.*is trimmed; its whole underlying surface is used")
 def test_bake_makes_the_pushed_body_the_rest_shape(served, tmp_path):
     client, session = served
-    basis = session.basis
-    patch, u, v = basis.sample_point(index_of(0, 3, 3))
-    q = modal_history(basis, [Push(u, v, (0.0, 0.0, 2.0), 0.0, patch=patch)], [1e3])[0]
-    nets = baked_nets(basis, q)
+    q, nets, _ = rung_down(session.basis, index_of(0, 3, 3), (0.0, 0.0, 2.0))
     reply = client.post("/api/bake", json={"version": 1, "q": q.ravel().tolist()})
     assert reply.status_code == 200, reply.text
     assert reply.json()["version"] == 2 and len(reply.json()["faces"]) == 2

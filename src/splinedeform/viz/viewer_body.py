@@ -18,8 +18,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import InputError
-from ..export import check_frames, write_text
-from ..export.body import _check_body, welded_body
+from ..export import write_text
+from ..export.body import welded_motion
 from ..surface import Surface
 from .colour import COLORMAP, colormap_table
 from .viewer import _b64, viewer_html
@@ -36,18 +36,10 @@ def body_viewer_data(surfaces: Sequence[Surface], rest_nets: Sequence[ArrayLike]
     (``(F, Σ n_u n_v, 3)``) and ``netFaces`` the shape of each; the page opens at the frame
     of largest displacement ``argmax_f max |x_f - x_rest|`` over the welded points.
     """
-    rest = _check_body(surfaces, rest_nets, "rest net")
-    if len(nets) != len(surfaces):
-        raise InputError(f"a body of {len(surfaces)} face(s) needs as many frame sets, got "
-                         f"{len(nets)}")
-    checked = [check_frames(s, times, P) for s, P in zip(surfaces, nets)]
-    t = checked[0][0]
-    X, faces, owner = welded_body(
-        surfaces, [np.concatenate([r[None], P]) for r, (_, P) in zip(rest, checked)],
-        resolution)
+    t, X, faces, owner = welded_motion(surfaces, rest_nets, times, nets, resolution)
     X0, X = X[0], X[1:]
     largest = np.linalg.norm(X - X0, axis=-1).max(axis=-1)
-    frames = np.concatenate([P.reshape(P.shape[0], -1, 3) for _, P in checked], axis=1)
+    frames = np.concatenate([np.reshape(P, (t.size, -1, 3)) for P in nets], axis=1)
     return {"name": title, "title": title, "times": t.tolist(),
             "startFrame": int(np.argmax(largest)), "vertexCount": int(X.shape[1]),
             "frames": _b64(X, "<f4"), "rest": _b64(X0, "<f4"), "faces": _b64(faces, "<u4"),
