@@ -257,3 +257,13 @@ def test_the_static_correction_of_a_truncated_body_basis_makes_a_held_push_exact
     # 2**-23 of the column's largest bounds them all
     exact = session.correction.column(index)
     assert np.abs(column - exact).max() <= 2**-23 * np.abs(exact).max()
+
+
+def test_a_body_sampled_finer_than_the_page_draws_is_refused_naming_the_resolution(tmp_path):
+    from splinedeform.errors import InputError
+    from splinedeform.sculpt.session import Session
+
+    two_faces(tmp_path)
+    scenario = parse_scenario(BODY, source="two.toml", directory=tmp_path)
+    with pytest.raises(InputError, match=r"2 faces sampled 300x300 .* --resolution 282 or less"):
+        Session(scenario, resolution=300, modes=None, save_path=tmp_path / "saved.toml")

@@ -37,6 +37,8 @@ from ..model import Model
 from ..surface import Surface
 
 Array = NDArray[np.float64]
+MAX_PAGE_SAMPLES = 400 * 400
+"""Most sample points of every patch together: the finest grid one surface may have."""
 
 
 @dataclass(frozen=True)
@@ -189,6 +191,13 @@ def sculpt_basis(model: Model, resolution: int = 32, modes: int | None = None,
                  units: str | None = None) -> SculptBasis:
     """Modes of ``model`` (all, or the lowest ``modes``) sampled on a ``resolution²`` grid
     of each of its patches (one for a single surface)."""
+    patches = model_patches(model)
+    if len(patches) * resolution**2 > MAX_PAGE_SAMPLES:
+        finest = int(np.sqrt(MAX_PAGE_SAMPLES / len(patches)))
+        raise InputError(f"{len(patches)} faces sampled {resolution}x{resolution} each are "
+                         f"{len(patches) * resolution**2} sample points, more than the "
+                         f"{MAX_PAGE_SAMPLES} the page draws; choose --resolution {finest} "
+                         "or less")
     lam, phi = model.eigen(modes)
     if lam.size == 0:
         raise InputError("the model has no free control points to sculpt")
@@ -198,7 +207,6 @@ def sculpt_basis(model: Model, resolution: int = 32, modes: int | None = None,
     mat = model.material
     damping = mat.damping / mat.mass + mat.rayleigh * lam
     phi_net = np.asarray(model.constraints.T @ phi)
-    patches = model_patches(model)
     samples = tuple((np.asarray(u), np.asarray(v))
                     for u, v in (s.sample_parameters(resolution) for s in patches))
     E = sample_evaluation(patches, samples)
