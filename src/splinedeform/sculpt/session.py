@@ -31,12 +31,11 @@ from .export import _b64, payload
 from .history import BasisState, History, baked_nets, baked_scenario
 from .messages import BakeMessage, ExportMessage, ResolveMessage, SaveMessage
 from .modal import SculptBasis, sculpt_basis
-from .save import MAX_PROBES, check_index, face_numbers, net_words, portable, session_scenario
+from .save import check_index, face_numbers, net_words, portable, session_scenario
 from .wording import in_page_words, page_field  # noqa: F401  (page_field: re-exported)
 
 MATERIAL_FIELDS = ("mass", "damping", "rayleigh", "w10", "w01", "w20", "w11", "w02")
 EDGE_NAMES = ("u0", "u1", "v0", "v1")
-__all__ = ["Busy", "MAX_PROBES", "Session"]
 
 
 class Busy(RuntimeError):
