@@ -191,8 +191,6 @@ def refusal(folder, source, **kwargs) -> str:
 
 
 def test_what_a_body_does_not_take_is_refused_at_its_key(box_3dm, tmp_path):
-    message = refusal(tmp_path, box_3dm, formats='["viewer"]')
-    assert "output.formats: viewer is not written for a body of 6 faces yet" in message
     message = refusal(tmp_path, box_3dm, formats='["report"]',
                       loads='[[load]]\nkind = "point"\nat = [0.5, 0.5]\nforce = [0, 0, 1.0]\n')
     assert "load[1].face: a point load on a body names its face" in message

@@ -14,10 +14,9 @@
 * ``gif`` / ``mp4``: the whole body's motion, each frame one welded mesh
   (:func:`splinedeform.viz.write_body_animation`; for modes, the lowest mode);
 * ``report``: ``report.json`` / ``report.md`` naming the unit, the faces and the topology,
-  and for a shell the stresses per face.
-
-``viewer`` is refused for a body when the scenario is built
-(:func:`splinedeform.scenario.body.check_body_scenario`).
+  and for a shell the stresses per face;
+* ``viewer``: ``viewer.html``, every frame of the welded mesh and every face's net
+  (:func:`splinedeform.viz.viewer_body.write_body_viewer`).
 """
 
 from __future__ import annotations
@@ -59,6 +58,7 @@ def body_outputs(result: RunResult) -> list[str]:
         names += ["surfaces.png"] + (["probes.png"] if s.solve.kind == "dynamic" else [])
         names += ["stresses.png"] if is_shell(result.built.model) else []
     names += [f"{name}.{ext}" for ext in ("gif", "mp4") if ext in formats]
+    names += ["viewer.html"] if "viewer" in formats else []
     return names + (["report.json", "report.md"] if "report" in formats else [])
 
 
@@ -124,6 +124,13 @@ def write_body_files(result: RunResult, folder: Path, stages: Stages) -> None:
     for ext in ("gif", "mp4"):
         if ext in formats:
             _write_animation(result, folder / f"{name}.{ext}", stages)
+    if "viewer" in formats:
+        from .viz.viewer_body import write_body_viewer
+
+        with stages.stage("viewer"):
+            result.outputs.append(("viewer", write_body_viewer(
+                folder / "viewer.html", patches, rest, result.times, result.nets, res,
+                title=s.title or s.name)))
     if "report" in formats:
         from .outputs import write_report
 

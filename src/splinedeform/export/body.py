@@ -133,6 +133,25 @@ def write_body_mesh(path: str | os.PathLike, surfaces: Sequence[Surface],
     return write_mesh(path, X[1], faces, data)
 
 
+def welded_motion(surfaces: Sequence[Surface], rest_nets: Sequence[ArrayLike],
+                  times: ArrayLike, nets: Sequence[ArrayLike], resolution: int = 32
+                  ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64],
+                             NDArray[np.int64], NDArray[np.int64]]:
+    """``(times, points, faces, patch, keep)``: the body's welded mesh
+    (:func:`welded_body_points`) at rest (``points[0]``) and in the frames ``nets[k]``
+    ``(F, n_u, n_v, 3)`` of each patch ``k`` at ``times`` (``points[1:]``), checked;
+    ``keep`` indexes the welded points among the patches' grids side by side."""
+    rest = _check_body(surfaces, rest_nets, "rest net")
+    if len(nets) != len(surfaces):
+        raise InputError(f"a body of {len(surfaces)} patch(es) needs as many frame sets, "
+                         f"got {len(nets)}")
+    checked = [check_frames(s, times, P) for s, P in zip(surfaces, nets)]
+    X, faces, patch, keep = welded_body_points(
+        surfaces, [np.concatenate([r[None], P]) for r, (_, P) in zip(rest, checked)],
+        resolution)
+    return checked[0][0], X, faces, patch, keep
+
+
 def write_body_series(directory: str | os.PathLike, stem: str, surfaces: Sequence[Surface],
                       rest_nets: Sequence[ArrayLike], times: ArrayLike,
                       nets: Sequence[ArrayLike], resolution: int = 32,
@@ -143,15 +162,7 @@ def write_body_series(directory: str | os.PathLike, stem: str, surfaces: Sequenc
     row per point of the patches' grids side by side (a shell's stresses). Returns the
     ``.pvd`` file (written last)."""
     _check_stem(stem)
-    rest = _check_body(surfaces, rest_nets, "rest net")
-    if len(nets) != len(surfaces):
-        raise InputError(f"a body of {len(surfaces)} patch(es) needs as many frame sets, "
-                         f"got {len(nets)}")
-    checked = [check_frames(s, times, P) for s, P in zip(surfaces, nets)]
-    t = checked[0][0]
-    X, faces, patch, keep = welded_body_points(
-        surfaces, [np.concatenate([r[None], P]) for r, (_, P) in zip(rest, checked)],
-        resolution)
+    t, X, faces, patch, keep = welded_motion(surfaces, rest_nets, times, nets, resolution)
     folder = _output_folder(directory)
     names = frame_file_names(stem, t.size)
     for f, name in enumerate(names):

@@ -27,10 +27,9 @@ from ..body.body import Body
 from .schema_types import SHELL_EDGES
 from .spec import Scenario
 
-#: output formats written for a body (:mod:`splinedeform.outputs_body`): all but the
-#: viewer, whose page draws one surface
+#: output formats written for a body (:mod:`splinedeform.outputs_body`)
 BODY_FORMATS = ("vtu", "obj", "stl", "ply", "json", "npz", "3dm", "step", "iges", "images",
-                "gif", "mp4", "report")
+                "gif", "mp4", "viewer", "report")
 #: physics a body runs with
 BODY_PHYSICS = ("intrinsic", "parametric", "shell")
 

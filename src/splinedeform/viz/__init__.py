@@ -7,7 +7,7 @@
 * :mod:`.animation` — GIF / MP4, drawn and encoded frame by frame;
 * :mod:`.gif` — the GIF's one palette (the colour bar's ramp held exactly) and its writer;
 * :mod:`.warp` — the warp factor of the pictures (``output.warp``);
-* :mod:`.viewer` — ``viewer.html``.
+* :mod:`.viewer` — ``viewer.html``; :mod:`.viewer_body` — the one of a body.
 """
 
 from .animation import (ANIMATION_PIXELS, animation_frames, mp4_available, write_animation,
