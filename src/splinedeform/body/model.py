@@ -32,7 +32,7 @@ from ..model import Model, check_options
 from ..readout import BodyReadout
 from ..solvers.system import Reduction
 from ..surface import Surface
-from ..physics.coupling_model import c0_coupling, interface_coupling
+from ..physics.coupling_model import bends, c0_coupling, interface_coupling
 from .body import Body
 from .constraints import boundary_presets, build_body_constraints
 from .interface import EDGES
@@ -126,7 +126,7 @@ class BodyModel(Model):
         for surface in self.patches:
             check_bending(surface, material)
         self.constraints = build_body_constraints(
-            self.patches, topology, boundary_presets(boundary, topology))
+            self.patches, topology, boundary_presets(boundary, topology), bends(material))
         if self.constraints.n_free == 0:
             error = InputError(f"no free coordinate: the boundary fixes every control point of "
                                f"the {len(self.patches)} patches; free an edge or refine them")
@@ -138,10 +138,12 @@ class BodyModel(Model):
         M = sp.block_diag([m for _, m in blocks], format="csr")
         offsets = self.constraints.offsets
         size = int(offsets[-1])
+        ties = self.constraints.ties
         couplings = [interface_coupling(self.patches, topology.interfaces, material,
-                                        self.constraints.edges, offsets[:-1])]
+                                        self.constraints.edges, offsets[:-1], ties.interfaces)]
         couplings += [c0_coupling(s, material, {e: self.constraints.edges.get((p, e), "free")
-                                                for e in EDGES}, int(offsets[p]), size)
+                                                for e in EDGES}, int(offsets[p]), size,
+                                  {(d, k) for q, d, k in ties.lines if q == p})
                       for p, s in enumerate(self.patches)]
         for penalty in (c for c in couplings if c is not None):
             K = (K + penalty).tocsr()
