@@ -119,6 +119,35 @@ def test_the_exact_tie_is_the_c1_space_under_an_unsymmetric_load():
     assert slope_jump(c0.surface, net[..., 2:]) <= 1e-6
 
 
+def test_ties_where_four_patches_meet_are_the_c1_tensor_space():
+    # 2 × 2 quarters: the ties of the four interfaces share the control points around the
+    # centre (eliminated together by a pivoted QR). The body is the patch with u = 1/2 and
+    # v = 1/2 double knots: the same space, round-off (measured 6e-16), held to 1e-10
+    def quarter(x0: float, y0: float) -> sd.Surface:
+        patch = flat_patch(x0, 0.5, 4, 4)
+        basis = patch.basis_u
+        g = basis.greville()
+        P = np.stack(np.broadcast_arrays(x0 + g[:, None], y0 + g[None, :], 0 * g[:, None]), -1)
+        return sd.Surface(P, basis, basis)
+    model = sd.BodyModel([quarter(0, 0), quarter(0.5, 0), quarter(0, 0.5), quarter(0.5, 0.5)],
+                         PLATE, boundary="clamped")
+    assert model.constraints.ties.interfaces == {0, 1, 2, 3}
+    basis = c1_basis(3, 8)
+    g = basis.greville()
+    P = np.stack(np.broadcast_arrays(g[:, None], g[None, :], 0 * g[:, None]), -1)
+    reference = sd.Model(sd.Surface(P, basis, basis), PLATE, boundary="clamped")
+    assert model.n_free == reference.n_free
+    push = (0.0, 0.0, 1.0)
+    ref = reference.static(sd.Point(0.3, 0.2, push))
+    body = model.static(sd.body.OnPatch(sd.Point(0.3, 0.2, push), patch=0))
+    x = np.linspace(0.0, 0.5, 6)
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    scale = np.abs(ref.displacement(X, Y)).max()
+    for p, (x0, y0) in enumerate(((0, 0), (0.5, 0), (0, 0.5), (0.5, 0.5))):
+        np.testing.assert_allclose(body.displacement(X, Y, patch=p),
+                                   ref.displacement(X + x0, Y + y0), rtol=0, atol=1e-10 * scale)
+
+
 def test_a_creased_interface_keeps_its_rotation_penalty():
     # two flat halves folded by 90° along x = 1/2: the rest shape is not smooth there, so
     # the tangents are not tied (a tie would flatten the fold) and the penalty keeps the
