@@ -155,9 +155,13 @@ def test_a_creased_interface_keeps_its_rotation_penalty():
     left = flat_patch(0.0, 0.5, 4, 4)
     P = flat_patch(0.5, 0.5, 4, 4).control_points.copy()
     P[..., 2], P[..., 0] = P[..., 0] - 0.5, 0.5        # the right half stands up, x = 1/2
-    model = sd.BodyModel([left, sd.Surface(P, left.basis_u, left.basis_v)], PLATE,
-                         boundary="clamped")
+    folded = sd.Body([left, sd.Surface(P, left.basis_u, left.basis_v)])
+    assert folded.summary()["shared"] == 1 and folded.summary()["non_conforming"] == 0
+    model = sd.BodyModel(folded, PLATE, boundary="clamped")
     assert model.constraints.ties.interfaces == frozenset()
+    # the same halves unfolded are tied
+    flat = sd.BodyModel([left, flat_patch(0.5, 0.5, 4, 4)], PLATE, boundary="clamped")
+    assert flat.constraints.ties.interfaces == {0}
 
 
 def slope_jump(surface: sd.Surface, net: np.ndarray) -> float:

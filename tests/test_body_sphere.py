@@ -25,6 +25,8 @@ import splinedeform as sd
 from splinedeform.pipeline_body import body_static
 from splinedeform.refine import refine_surface
 
+import body_patches
+
 R, Q = 2.0, 1.0
 SAMPLES = 17
 
@@ -102,13 +104,8 @@ def test_one_periodic_face_with_a_seam_and_two_poles(step_sphere, material):
 
 
 def hemisphere(start: float) -> sd.Surface:
-    """Longitudes ``[start, start + π]`` (``u``) and polar angle ``v ∈ [0, π]`` (``v0`` at the
-    south pole, outward normal), interpolated by a bicubic patch of 8 × 8 cells."""
-    def f(u: np.ndarray, v: np.ndarray) -> np.ndarray:
-        phi = u + start
-        return R * np.stack([np.sin(v) * np.cos(phi), np.sin(v) * np.sin(phi), -np.cos(v)],
-                            axis=-1)
-    return sd.shapes.from_function(f, cells=(8, 8), domain=((0, pi), (0, pi)))
+    """:func:`body_patches.hemisphere` of radius ``R``, 8 × 8 cells."""
+    return body_patches.hemisphere(R, start)
 
 
 @pytest.mark.parametrize("material", [sd.Material(w10=1.0, w01=1.0),
