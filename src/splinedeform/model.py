@@ -28,7 +28,8 @@ from .errors import InputError, SingularSystemError
 from .loads import Load, as_load, static_time
 from .material import Material, check_scales
 from .physics import intrinsic
-from .physics.coupling_model import c0_coupling
+from .physics.coupling_model import bends, c0_coupling
+from .physics.coupling_ties import tie_c0_lines
 from . import modal_solve
 from .modal_solve import check_count as _check_count
 from .solution import ModalSolution, Readout, SampledSolution, StaticSolution
@@ -71,9 +72,11 @@ class Model:
         (:mod:`splinedeform.physics.intrinsic`), independent of the parametrisation.
         A trimmed surface (``surface.trim``) takes ``parametric`` over its trimmed region
         (:mod:`splinedeform.trim.model_matrices`), with ``boundary`` naming its loops
-        (``{"outer": "clamped", "hole1": "free"}``). With bending weights, the rotation
-        across each C0 knot line is tied by a penalty
-        (:mod:`splinedeform.physics.coupling_model`), which leaves no Kronecker factors.
+        (``{"outer": "clamped", "hole1": "free"}``). With bending weights, the tangent
+        continuity across each C0 knot line where the rest shape is smooth is imposed
+        exactly by the constraint map (:mod:`splinedeform.physics.coupling_ties`), the
+        rotation across any other by a penalty (:mod:`splinedeform.physics.coupling_model`);
+        either leaves no Kronecker factors.
 
     Examples
     --------
@@ -121,11 +124,16 @@ class Model:
             intrinsic.matrices(surface, material, lumped) if physics == "intrinsic"
             else (trimmed.stiffness, trimmed.mass) if trimmed
             else patch_matrices(surface, material, physics, lumped)[2:] if general else None)
-        kinks = c0_coupling(surface, material, self.constraints.edges)
-        if kinks is not None:                  # the slopes tied across each C0 line
+        tied: set[tuple[str, float]] = set()
+        if not trimmed and bends(material):    # smooth C0 lines: C1 in the constraint map
+            self.constraints, tied = tie_c0_lines(surface, self.constraints)
+        kinks = c0_coupling(surface, material, self.constraints.edges, exact=tied)
+        if kinks is not None or tied:          # the slopes tied across each C0 line
             K, M = self._full_matrices()
-            self._full, self.gram_u, self.gram_v = ((K + kinks).tocsr(), M), None, None
-        reduced = None if physics == "intrinsic" or trimmed or kinks is not None or general else \
+            K = K if kinks is None else K + kinks
+            self._full, self.gram_u, self.gram_v = (K.tocsr(), M), None, None
+        reduced = None if physics == "intrinsic" or trimmed or kinks is not None or tied \
+            or general else \
             reduced_matrices(self.gram_u, self.gram_v, material, lumped, self.constraints)
         if reduced is None:
             T = self.constraints.T
