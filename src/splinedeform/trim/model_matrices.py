@@ -48,7 +48,7 @@ from .cells import Grid, loop_pieces
 from .loops import TrimDomain
 from .quadrature import TrimQuadrature, trim_quadrature
 from .holed import holed_quadrature, with_edges
-from .surface_trim import holed_rectangle, trim_grid
+from .surface_trim import extension_knots, holed_rectangle, surface_degrees, trim_grid
 from .values import tensor_values
 from .web import web_basis
 
@@ -166,7 +166,7 @@ def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str
     if rectangle:
         T, free_index = with_edges(surface, edges, quad.classes)
     else:
-        web = web_basis(quad.classes, surface.basis_u.degree)
+        web = web_basis(quad.classes, surface_degrees(surface), knots=extension_knots(surface))
         T, free_index = web.extension.tocsr(), np.flatnonzero(web.inner.ravel())
     constraints = Constraints(T, None, None, free_index, {**edges, **loops}, False)
     # held loops or edges leave no motion without energy (Nitsche's penalty, the edges'

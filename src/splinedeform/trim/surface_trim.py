@@ -43,6 +43,21 @@ def trim_grid(surface: Any) -> Grid:
     return Grid((bases[0].cells, bases[1].cells), (bases[0].length, bases[1].length))
 
 
+def extension_knots(surface: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+    """The knot vectors Höllig's extension of ``surface`` needs
+    (:func:`~splinedeform.trim.web.web_basis`): None where both directions have uniform
+    knots (Lagrange interpolation in the index is then exact)."""
+    bases = (surface.basis_u, surface.basis_v)
+    if all(getattr(b, "kind", None) == "uniform" for b in bases):
+        return None
+    return bases[0].knots, bases[1].knots
+
+
+def surface_degrees(surface: Any) -> tuple[int, int]:
+    """``(n_u, n_v)`` of a surface."""
+    return surface.basis_u.degree, surface.basis_v.degree
+
+
 def whole_rectangle(surface: Any, loop: Loop) -> bool:
     """Whether ``loop`` is the parameter rectangle itself: a polygon through its four
     corners with every vertex on its sides (collinear midpoints of a CAD face's edges
