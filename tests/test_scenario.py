@@ -193,7 +193,10 @@ FILE_TEXTS = [file_scenario("net.json", "frame = 0"),
               file_scenario("box.3dm", 'faces = [0, 1, 2, 3, 4]').replace('"file"', '"cad"')
               + '[boundary.faces]\n0 = { v1 = "clamped" }\n',
               # a trimmed face on its trimmed region: run by tests/test_cad_trim_run.py
-              file_scenario("planes.3dm", 'trimmed = true').replace('"file"', '"cad"')]
+              file_scenario("planes.3dm", 'trimmed = true').replace('"file"', '"cad"'),
+              # a trimmed face's loops held: run by tests/test_cad_trim_loops.py
+              file_scenario("square.step", 'trimmed = true').replace('"file"', '"cad"')
+              + '[boundary.loops]\nouter = "pinned"\n']
 
 
 def all_test_texts() -> list[str]:

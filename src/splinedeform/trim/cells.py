@@ -44,7 +44,8 @@ class Pieces:
     ``kind`` 0 is a straight piece from ``start`` to ``end`` (``t ∈ [0, 1]``), 1 an arc of
     the circle ``centre, radius`` with angles ``t``, 2 a span of a spline loop, the
     polynomial ``Σ_e poly[e] t^e`` (``t ∈ [0, 1]``); ``cell`` the ``(i, j)`` of its cell;
-    ``loop`` the index of its loop in :attr:`TrimDomain.loops` (0 the outer loop).
+    ``loop`` the index of its loop in :attr:`TrimDomain.loops` (0 the outer loop);
+    ``span`` the polygon segment or spline span it lies on (0 on a circle).
     """
 
     kind: NDArray[np.int64]
@@ -57,6 +58,7 @@ class Pieces:
     cell: NDArray[np.int64]
     poly: NDArray[np.float64]
     loop: NDArray[np.int64] | None = None
+    span: NDArray[np.int64] | None = None
 
     def evaluate(self, t: NDArray[np.float64]
                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -95,7 +97,7 @@ def _polygon_pieces(loop: PolygonLoop, grid: Grid) -> tuple[NDArray, ...]:
     lo, hi = t[:, :-1], t[:, 1:]
     keep = np.isfinite(hi) & (hi > lo)
     seg = np.broadcast_to(np.arange(len(a))[:, None], lo.shape)[keep]
-    return a[seg], b[seg], lo[keep], hi[keep]
+    return a[seg], b[seg], lo[keep], hi[keep], seg
 
 
 def _circle_pieces(loop: CircleLoop, grid: Grid) -> tuple[NDArray, NDArray]:
@@ -139,10 +141,11 @@ def loop_pieces(domain: TrimDomain, grid: Grid, loops: tuple | None = None) -> P
     kinds, los, his, starts, ends, centres, radii = [], [], [], [], [], [], []
     q = 1 + max([loop.degree for loop in loops if isinstance(loop, SplineLoop)],
                 default=0)
-    polys = []
+    polys, spans = [], []
     for loop in loops:
         if isinstance(loop, SplineLoop):
             span, lo, hi = _spline_pieces(loop, grid)
+            spans.append(span)
             kinds.append(np.full(len(lo), 2))
             starts.append(np.zeros((len(lo), 2)))
             ends.append(np.zeros((len(lo), 2)))
@@ -156,7 +159,8 @@ def loop_pieces(domain: TrimDomain, grid: Grid, loops: tuple | None = None) -> P
             continue
         polys.append(None)
         if isinstance(loop, PolygonLoop):
-            a, b, lo, hi = _polygon_pieces(loop, grid)
+            a, b, lo, hi, seg = _polygon_pieces(loop, grid)
+            spans.append(seg)
             kinds.append(np.zeros(len(lo), int))
             starts.append(a)
             ends.append(b)
@@ -164,6 +168,7 @@ def loop_pieces(domain: TrimDomain, grid: Grid, loops: tuple | None = None) -> P
             radii.append(np.zeros(len(lo)))
         else:
             lo, hi = _circle_pieces(loop, grid)
+            spans.append(np.zeros(len(lo), int))
             kinds.append(np.ones(len(lo), int))
             starts.append(np.zeros((len(lo), 2)))
             ends.append(np.zeros((len(lo), 2)))
@@ -189,7 +194,7 @@ def loop_pieces(domain: TrimDomain, grid: Grid, loops: tuple | None = None) -> P
                          f"[0, {grid.lengths[0]:g}] × [0, {grid.lengths[1]:g}]")
     loop = np.repeat(np.arange(len(kinds)), [len(k) for k in kinds])
     return Pieces(pieces.kind, pieces.lo, pieces.hi, pieces.start, pieces.end, pieces.centre,
-                  pieces.radius, cell, pieces.poly, loop)
+                  pieces.radius, cell, pieces.poly, loop, np.concatenate(spans).astype(int))
 
 
 def classify_cells(domain: TrimDomain, grid: Grid, pieces: Pieces | None = None

@@ -137,8 +137,10 @@ def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str
     grid = trim_grid(surface)
     names = loop_names(domain)
     rectangle = holed_rectangle(surface)
-    edges, loops = trim_conditions(boundary, names, rectangle)
-    held = {k: loops[name] for k, name in enumerate(names) if loops[name] != "free"}
+    counts = {name: domain.edge_count(k) for k, name in enumerate(names)}
+    edges, loops = trim_conditions(boundary, names, rectangle, counts)
+    held = {k: v for k, v in enumerate(_loop_presets(loops, names, counts))
+            if set(np.atleast_1d(v)) != {"free"}}
     if held and rest == "none":
         raise InputError("rest = 'none' (the energy of the position itself) is not combined "
                          "with pinned or clamped trim loops yet: Nitsche's terms hold the "
@@ -176,11 +178,26 @@ def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str
     return TrimmedSystem(constraints, ((K + K.T) * 0.5).tocsr(), sp.csr_matrix(M), int(count))
 
 
+def _loop_presets(presets: Mapping[str, str], names: tuple[str, ...],
+                  counts: Mapping[str, int]) -> list[str | tuple[str, ...]]:
+    """Each loop's preset, or its trim edges' (``name.k``, else the loop's) where some
+    edge of it is named."""
+    out: list[str | tuple[str, ...]] = []
+    for name in names:
+        keys = [f"{name}.{k}" for k in range(counts[name])]
+        if any(key in presets for key in keys):
+            out.append(tuple(presets.get(key, presets[name]) for key in keys))
+        else:
+            out.append(presets[name])
+    return out
+
+
 def loop_quadrature(domain: TrimDomain, grid: Grid, order: int, loops: tuple | None = None
                     ) -> tuple[NDArray[np.float64], ...]:
     """Gauss points along every loop piece (of ``loops``, default all): points ``(P, 2)``,
     arc-length weights ``(P,)``, outward unit normals ``(P, 2)``, unit tangents ``(P, 2)``
-    (with ``Ω`` on their left) and the loop index ``(P,)`` among those split."""
+    (with ``Ω`` on their left), the loop index ``(P,)`` among those split and the trim edge
+    ``(P,)`` of each point in its loop (:attr:`TrimDomain.edges`; 0 where a loop is one)."""
     xi, om = np.polynomial.legendre.leggauss(order)
     pieces = loop_pieces(domain, grid, loops)
     half = 0.5 * (pieces.hi - pieces.lo)
@@ -191,19 +208,33 @@ def loop_quadrature(domain: TrimDomain, grid: Grid, order: int, loops: tuple | N
     ds = np.abs(half)[:, None] * om * speed
     normal = np.stack([run[..., 1], -run[..., 0]], axis=-1)
     loop = np.broadcast_to(pieces.loop[:, None], ds.shape)
+    labels = [None] * len(domain.loops) if loops is None else [
+        domain.edges[next(k for k, own in enumerate(domain.loops) if own is given)]
+        for given in loops]
+    edge = np.zeros(len(pieces.loop), int)
+    for k, own in enumerate(labels):          # a loop over the loops, not the points
+        if own is not None:
+            on = pieces.loop == k
+            edge[on] = np.asarray(own)[pieces.span[on]]
+    edge = np.broadcast_to(edge[:, None], ds.shape)
     return (point.reshape(-1, 2), ds.ravel(), normal.reshape(-1, 2), run.reshape(-1, 2),
-            loop.ravel())
+            loop.ravel(), edge.ravel())
 
 
-def nitsche_terms(surface: Any, material: Material, grid: Grid, held: Mapping[int, str]
-                  ) -> sp.csr_matrix:
-    """Nitsche's symmetric terms and penalties of the held loops (module docstring)."""
+def nitsche_terms(surface: Any, material: Material, grid: Grid,
+                  held: Mapping[int, str | tuple[str, ...]]) -> sp.csr_matrix:
+    """Nitsche's symmetric terms and penalties of the held loops (module docstring):
+    ``held[k]`` the preset of loop ``k``, or a tuple of the presets of its trim edges."""
     m = material
     domain = surface.trim
     first = 1 if holed_rectangle(surface) else 0       # the rectangle's edges are no loop
-    p, ds, n, s, loop = loop_quadrature(domain, grid, surface.basis_u.degree + 2,
-                                        domain.loops[first:])
+    p, ds, n, s, loop, edge = loop_quadrature(domain, grid, surface.basis_u.degree + 2,
+                                              domain.loops[first:])
     loop = loop + first
+    preset = np.full(len(loop), "free", dtype=object)
+    for k, value in held.items():             # a loop over the loops, not the points
+        on = loop == k
+        preset[on] = value if isinstance(value, str) else np.asarray(value, object)[edge[on]]
     (_, lu), (_, lv) = surface.domain
     p = np.clip(p, 0.0, [lu, lv])
     orders = [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2), (3, 0), (2, 1), (1, 2), (0, 3)]
@@ -224,13 +255,13 @@ def nitsche_terms(surface: Any, material: Material, grid: Grid, held: Mapping[in
     gamma0 = beta * (bending / h ** 3 + tension / h)
     gamma1 = beta * bending / h
     K = sp.csr_matrix((B[(0, 0)].shape[1],) * 2)
-    for preset in ("pinned", "clamped"):
-        on = np.isin(loop, [k for k, v in held.items() if v == preset])
+    for kind in ("pinned", "clamped"):
+        on = preset == kind
         if not on.any():
             continue
         w = sp.diags(np.where(on, ds, 0.0))
         b0, bu, bv = B[(0, 0)], B[(1, 0)], B[(0, 1)]
-        if preset == "clamped":
+        if kind == "clamped":
             term = b0.T @ w @ g0 + bu.T @ w @ gu + bv.T @ w @ gv
             penalty = gamma0 * (b0.T @ w @ b0) + gamma1 * (bu.T @ w @ bu + bv.T @ w @ bv)
         else:
