@@ -28,7 +28,8 @@ unchanged, and the displaced surface stays a B-spline surface.
 ``b_p = ∮ g_0(d) v + (g(d)·s)(∇v·s)``, ``s`` the tangent. Both are consistent (the exact
 solution satisfies the discrete equations) and symmetric;
 ``γ_0 = β (w_b / h³ + w_t / h)``, ``γ_1 = β w_b / h`` with ``w_b = max(w20, w11, w02)``,
-``w_t = max(w10, w01)``, ``h`` the smaller cell side and ``β =`` :func:`nitsche_penalty`.
+``w_t = max(w10, w01)``, ``h`` the smaller side of the knot cell at each point of the loop
+and ``β =`` :func:`nitsche_penalty` of the larger degree.
 """
 
 from __future__ import annotations
@@ -81,12 +82,14 @@ def loop_names(domain: TrimDomain) -> tuple[str, ...]:
 
 
 def quadrature_of(surface: Any) -> TrimQuadrature:
-    """The trimmed quadrature of a surface, ``n + 2`` Gauss points per direction (exact for
-    the ``2n`` per variable of the energies on inside cells); kept with the surface."""
+    """The trimmed quadrature of a surface, ``n + 2`` Gauss points per direction (``n`` the
+    larger degree; exact for the ``2n`` per variable of the energies on inside cells); kept
+    with the surface."""
     key = ("trim quadrature",)
     if key not in surface._cache:
         rule = holed_quadrature if holed_rectangle(surface) else trim_quadrature
-        surface._cache[key] = rule(surface.trim, trim_grid(surface), surface.basis_u.degree + 2)
+        surface._cache[key] = rule(surface.trim, trim_grid(surface),
+                                      max(surface_degrees(surface)) + 2)
     return surface._cache[key]
 
 
@@ -130,9 +133,6 @@ def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str
     if physics != "parametric":
         raise InputError(f"a trimmed surface takes physics 'parametric' (its energy over the "
                          f"trimmed region); {physics!r} is not trimmed yet")
-    if fixed is not None:
-        raise InputError("fixed control points are not combined with a trim yet: hold the "
-                         "trim loops instead (boundary = {'outer': 'clamped', ...})")
     domain: TrimDomain = surface.trim
     grid = trim_grid(surface)
     names = loop_names(domain)
@@ -146,10 +146,10 @@ def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str
                          "with pinned or clamped trim loops yet: Nitsche's terms hold the "
                          "displacement, not the position; use rest = 'initial'")
     bending = max(material.w20, material.w11, material.w02)
-    if held and bending and surface.basis_u.degree < 3:
+    if held and bending and min(surface_degrees(surface)) < 3:
         raise InputError("a pinned or clamped trim loop under bending weights needs degree "
                          f">= 3 (third derivatives in Nitsche's terms), got "
-                         f"{surface.basis_u.degree}")
+                         f"{surface_degrees(surface)}")
     bases = (surface.basis_u, surface.basis_v)
     quad = quadrature_of(surface)
     orders = [(0, 0)] + [ab for key, ab, _ in STIFFNESS_TERMS if getattr(material, key)]
@@ -165,15 +165,17 @@ def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str
         M = sp.diags(np.asarray(M.sum(axis=1)).ravel())
     if held:
         K = K + nitsche_terms(surface, material, grid, held)
-    if rectangle:
-        T, free_index = with_edges(surface, edges, quad.classes)
+    mask = None if fixed is None else np.asarray(fixed, dtype=bool)
+    if rectangle or mask is not None:
+        T, free_index = with_edges(surface, edges, quad.classes, mask)
     else:
         web = web_basis(quad.classes, surface_degrees(surface), knots=extension_knots(surface))
         T, free_index = web.extension.tocsr(), np.flatnonzero(web.inner.ravel())
-    constraints = Constraints(T, None, None, free_index, {**edges, **loops}, False)
-    # held loops or edges leave no motion without energy (Nitsche's penalty, the edges'
-    # constraints); else the energy's polynomials, which the extension reproduces
-    count = 0 if held or set(edges.values()) != {"free"} else rigid.rigid_count(
+    pinned_points = bool(mask is not None and mask.any())
+    constraints = Constraints(T, None, None, free_index, {**edges, **loops}, pinned_points)
+    # held loops, edges or fixed points leave no motion without energy (Nitsche's penalty,
+    # the constraints); else the energy's polynomials, which the extension reproduces
+    count = 0 if held or set(edges.values()) != {"free"} or pinned_points else rigid.rigid_count(
         rigid.parametric_terms(material), *bases, build_constraints(*bases, "free"))
     return TrimmedSystem(constraints, ((K + K.T) * 0.5).tocsr(), sp.csr_matrix(M), int(count))
 
@@ -228,7 +230,7 @@ def nitsche_terms(surface: Any, material: Material, grid: Grid,
     m = material
     domain = surface.trim
     first = 1 if holed_rectangle(surface) else 0       # the rectangle's edges are no loop
-    p, ds, n, s, loop, edge = loop_quadrature(domain, grid, surface.basis_u.degree + 2,
+    p, ds, n, s, loop, edge = loop_quadrature(domain, grid, max(surface_degrees(surface)) + 2,
                                               domain.loops[first:])
     loop = loop + first
     preset = np.full(len(loop), "free", dtype=object)
@@ -249,11 +251,11 @@ def nitsche_terms(surface: Any, material: Material, grid: Grid,
              + m.w02 * nv @ D((0, 3))))
     gu = m.w20 * nu @ D((2, 0)) + m.w11 * nv @ D((1, 1))
     gv = m.w02 * nv @ D((0, 2)) + m.w11 * nu @ D((1, 1))
-    h = min(grid.h)
+    h = _cell_size(grid, p)
     bending, tension = max(m.w20, m.w11, m.w02), max(m.w10, m.w01)
-    beta = nitsche_penalty(surface.basis_u.degree)
-    gamma0 = beta * (bending / h ** 3 + tension / h)
-    gamma1 = beta * bending / h
+    beta = nitsche_penalty(max(surface_degrees(surface)))
+    gamma0 = sp.diags(beta * (bending / h ** 3 + tension / h))
+    gamma1 = sp.diags(beta * bending / h)
     K = sp.csr_matrix((B[(0, 0)].shape[1],) * 2)
     for kind in ("pinned", "clamped"):
         on = preset == kind
@@ -263,10 +265,21 @@ def nitsche_terms(surface: Any, material: Material, grid: Grid,
         b0, bu, bv = B[(0, 0)], B[(1, 0)], B[(0, 1)]
         if kind == "clamped":
             term = b0.T @ w @ g0 + bu.T @ w @ gu + bv.T @ w @ gv
-            penalty = gamma0 * (b0.T @ w @ b0) + gamma1 * (bu.T @ w @ bu + bv.T @ w @ bv)
+            penalty = (b0.T @ w @ gamma0 @ b0
+                       + bu.T @ w @ gamma1 @ bu + bv.T @ w @ gamma1 @ bv)
         else:
             bs = su @ bu + sv @ bv
             term = b0.T @ w @ g0 + bs.T @ w @ (su @ gu + sv @ gv)
-            penalty = gamma0 * (b0.T @ w @ b0)
+            penalty = b0.T @ w @ gamma0 @ b0
         K = K - term - term.T + penalty
     return K.tocsr()
+
+
+def _cell_size(grid: Grid, p: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``h`` at each point ``(P, 2)``: the smaller side of the knot cell holding it."""
+    sides = []
+    for axis in (0, 1):
+        lines = grid.lines(axis)
+        cell = np.clip(grid.cell_of(p[:, axis], axis), 0, len(lines) - 2)
+        sides.append(np.diff(lines)[cell])
+    return np.minimum(*sides)

@@ -29,18 +29,47 @@ def loop_outside(surface: Any, loop: Loop) -> str | None:
 
 
 def trim_grid(surface: Any) -> Grid:
-    """The knot cells of a surface that can be trimmed: equal cells in both directions
-    (``uniform`` or ``open`` knots), one degree."""
+    """The knot cells of a surface that can be trimmed: ``uniform`` or ``open`` knots (equal
+    cells), or a general clamped knot vector with simple interior knots (cells between its
+    breakpoints), in each direction; the degrees may differ."""
+    from ..knots import KnotVectorBasis
+
     bases = (surface.basis_u, surface.basis_v)
+    equal = True
     for name, basis in zip("uv", bases):
-        if not isinstance(basis, BSplineBasis) or basis.kind not in ("uniform", "open"):
+        if isinstance(basis, KnotVectorBasis):
+            problem = _knot_problem(basis)
+            if problem:
+                raise InputError(f"a trimmed surface needs in {name} uniform or open knots or "
+                                 f"a clamped knot vector with simple interior knots: {problem}")
+            equal = False
+        elif not isinstance(basis, BSplineBasis) or basis.kind not in ("uniform", "open"):
             kind = getattr(basis, "kind", type(basis).__name__)
-            raise InputError(f"a trimmed surface needs equal knot cells ('uniform' or 'open' "
-                             f"knots) in {name}, got {kind!r}")
-    if bases[0].degree != bases[1].degree:
-        raise InputError(f"a trimmed surface needs one degree in u and v, got "
-                         f"{bases[0].degree} and {bases[1].degree}")
-    return Grid((bases[0].cells, bases[1].cells), (bases[0].length, bases[1].length))
+            raise InputError(f"a trimmed surface needs in {name} uniform or open knots or a "
+                             f"clamped knot vector with simple interior knots, got {kind!r}")
+    if equal:
+        return Grid((bases[0].cells, bases[1].cells), (bases[0].length, bases[1].length))
+    return Grid.of_breaks(*(_breaks(b) for b in bases))
+
+
+def _breaks(basis: Any) -> NDArray[np.float64]:
+    """The cells' lines of a basis: its breakpoints, or equal cells."""
+    if hasattr(basis, "breaks"):
+        return np.asarray(basis.breaks, dtype=float)
+    return np.arange(basis.cells + 1) * (basis.length / basis.cells)
+
+
+def _knot_problem(basis: Any) -> str | None:
+    """What keeps a general knot vector from a trim (None when it can take one): the
+    B-spline ``k`` must live on cells ``k - n .. k``, so the ends are clamped (``n + 1``
+    equal knots, the first 0) and interior knots simple."""
+    t, n = np.asarray(basis.knots, dtype=float), basis.degree
+    breaks = np.asarray(basis.breaks, dtype=float)
+    if breaks[0] != 0.0 or np.any(t[:n + 1] != t[0]) or np.any(t[-n - 1:] != t[-1]):
+        return f"its knots {t.tolist()} are not clamped from 0"
+    if len(t) != len(breaks) + 2 * n:
+        return f"its knots {t.tolist()} repeat an interior knot"
+    return None
 
 
 def extension_knots(surface: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
@@ -50,7 +79,7 @@ def extension_knots(surface: Any) -> tuple[NDArray[np.float64], NDArray[np.float
     bases = (surface.basis_u, surface.basis_v)
     if all(getattr(b, "kind", None) == "uniform" for b in bases):
         return None
-    return bases[0].knots, bases[1].knots
+    return tuple(np.asarray(b.knots, dtype=float) for b in bases)  # type: ignore[return-value]
 
 
 def surface_degrees(surface: Any) -> tuple[int, int]:
