@@ -5,7 +5,8 @@ its loops (:func:`splinedeform.cad_trims.read_trims`) are attached after ``eleva
 ``refine`` (the loops live in parameter space, refinement does not move them), so the
 model and every output use the trimmed region only. ``surface.trimmed`` switches this:
 by default the trim is taken where the trimmed model can hold the surface (physics
-``parametric``, one degree, equal knot cells, no weights, not periodic) and the whole face
+``parametric``, clamped knots with simple interior knots, no weights, not periodic;
+:func:`~splinedeform.trim.surface_trim.trim_grid`) and the whole face
 is used otherwise, with one warning line naming the face and the reason; ``trimmed =
 true`` refuses such a face, ``trimmed = false`` takes the whole face without a word.
 """
@@ -63,9 +64,6 @@ def why_untrimmable(scenario: Any, surface: Any) -> str | None:
     if surface.net_weights is not None or any(
             isinstance(b, RationalBasis) for b in (surface.basis_u, surface.basis_v)):
         return "it is rational (NURBS weights), which the trimmed model does not take"
-    if scenario.boundary.has_free_region:
-        return ("fixed control points (boundary.free_region, free_points) are not combined "
-                "with a trim")
     return None
 
 
