@@ -14,22 +14,21 @@ from typer.testing import CliRunner
 import splinedeform as sd
 from splinedeform import cli
 from splinedeform.errors import ScenarioError
+from trim_scenario import TAIL
 
 A = 0.5                                   # the disc's radius; its box is [0, 1]²
 LOAD = sd.Uniform([0.0, 0.0, 1.0])        # q = 1 per unit area
 
-#: the disc face, 12 × 12 cubic cells (degree 1 on one cell raised by 2, 11 knots inserted)
-DISC = """
-[surface]
-shape = "cad"
-path = "disc.3dm"
-face = 0
-elevate = [2, 2]
-refine = [11, 11]
-trimmed = true
-[boundary.loops]
-outer = "clamped"
-"""
+
+def face(path, refine):
+    """``[surface]`` of face 0 of ``path`` on its trimmed region, cubic on
+    ``(refine + 1)²`` cells (degree 1 on one cell raised by 2, ``refine`` knots inserted)."""
+    return (f'[surface]\nshape = "cad"\npath = "{path}"\nface = 0\nelevate = [2, 2]\n'
+            f"refine = [{refine}, {refine}]\ntrimmed = true\n")
+
+
+#: the disc face on 12 × 12 cubic cells, clamped on its rim
+DISC = face("disc.3dm", 11) + '[boundary.loops]\nouter = "clamped"\n'
 #: the same disc by hand: the same cells, degree and (open) knots, the exact circle
 HAND = """
 [surface]
@@ -42,37 +41,11 @@ knots = "open"
 circle = { centre = [0.5, 0.5], radius = 0.5 }
 edge = "clamped"
 """
-PLATE = """
-[material]
-w20 = 1.0
-w11 = 1.0
-w02 = 1.0
-[[load]]
-kind = "uniform"
-force = [0, 0, 1]
-[solve]
-kind = "static"
-"""
+#: the plate's material (D = 1), load (q = 1) and static solve
+PLATE = TAIL
 #: the turned square, a membrane on 6 × 6 cubic cells, its edges held as ``{loops}``
-SQUARE = """
-[surface]
-shape = "cad"
-path = "square.step"
-face = 0
-elevate = [2, 2]
-refine = [5, 5]
-trimmed = true
-[material]
-w10 = 1.0
-w01 = 1.0
-[boundary.loops]
-{loops}
-[[load]]
-kind = "uniform"
-force = [0, 0, 1]
-[solve]
-kind = "static"
-"""
+SQUARE = (face("square.step", 5) + "[boundary.loops]\n{loops}\n"
+          + TAIL.replace("w20 = 1.0\nw11 = 1.0\nw02 = 1.0\n", "w10 = 1.0\nw01 = 1.0\n"))
 #: the square's corners in the plane (x, y) = its parameters (u, v), counter-clockwise
 CORNERS = [(0.5, 0.0), (1.0, 0.5), (0.5, 1.0), (0.0, 0.5)]
 
