@@ -5,7 +5,7 @@ its loops (:func:`splinedeform.cad_trims.read_trims`) are attached after ``eleva
 ``refine`` (the loops live in parameter space, refinement does not move them), so the
 model and every output use the trimmed region only. ``surface.trimmed`` switches this:
 by default the trim is taken where the trimmed model can hold the surface (physics
-``parametric``, clamped knots with simple interior knots, no weights, not periodic;
+``parametric``, clamped knots with simple interior knots, not periodic;
 :func:`~splinedeform.trim.surface_trim.trim_grid`) and the whole face
 is used otherwise, with one warning line naming the face and the reason; ``trimmed =
 true`` refuses such a face, ``trimmed = false`` takes the whole face without a word.
@@ -18,7 +18,6 @@ from contextlib import contextmanager
 from typing import Any, Iterator
 
 from ..errors import InputError, InputWarning
-from ..knots import RationalBasis
 from ..surface import Surface
 from ..trim.model_matrices import loop_names
 from ..trim.surface_trim import equal_cell_form, holed_rectangle, whole_rectangle
@@ -61,9 +60,6 @@ def why_untrimmable(scenario: Any, surface: Any) -> str | None:
     if scenario.material.physics != "parametric":
         return (f"physics {scenario.material.physics!r} is not trimmed yet (a trimmed "
                 "surface takes \"parametric\")")
-    if surface.net_weights is not None or any(
-            isinstance(b, RationalBasis) for b in (surface.basis_u, surface.basis_v)):
-        return "it is rational (NURBS weights), which the trimmed model does not take"
     return None
 
 

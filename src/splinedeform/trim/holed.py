@@ -25,7 +25,7 @@ from ..errors import InputError
 from .cells import CUT, INSIDE, OUTSIDE, Grid
 from .loops import TrimDomain
 from .quadrature import TrimQuadrature, cell_gauss, trim_quadrature
-from .surface_trim import extension_knots, surface_degrees
+from .surface_trim import extension_knots, net_weights_of, surface_degrees
 from .web import web_basis
 
 
@@ -57,7 +57,7 @@ def with_edges(surface: Any, edges: dict[str, str], classes: np.ndarray,
     kept = np.zeros(surface.shape, bool)
     kept.ravel()[held.free_index] = True
     web = web_basis(classes, surface_degrees(surface), allowed=kept,
-                    knots=extension_knots(surface))
+                    knots=extension_knots(surface), weights=net_weights_of(surface))
     inner = np.flatnonzero(web.inner.ravel())
     free = kept.ravel()[inner]
     E = web.extension.tocsr()[held.free_index]

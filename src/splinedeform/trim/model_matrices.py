@@ -49,8 +49,9 @@ from .cells import Grid, loop_pieces
 from .loops import TrimDomain
 from .quadrature import TrimQuadrature, trim_quadrature
 from .holed import holed_quadrature, with_edges
-from .surface_trim import extension_knots, holed_rectangle, surface_degrees, trim_grid
-from .values import tensor_values
+from .surface_trim import (extension_knots, holed_rectangle, net_weights_of, surface_degrees,
+                           trim_grid)
+from .values import surface_values
 from .web import web_basis
 
 NITSCHE_FACTOR = 10.0
@@ -111,7 +112,7 @@ def project(surface: Any, values: Callable[[NDArray, NDArray], NDArray]
                          f"its parameter arrays {(len(p),)}, got {f.shape}")
     if not np.all(np.isfinite(f)):
         raise InputError("a load function returned non-finite values")
-    B = tensor_values((surface.basis_u, surface.basis_v), p, [(0, 0)])[(0, 0)]
+    B = surface_values(surface, p, [(0, 0)])[(0, 0)]
     return np.asarray(B.T @ (quad.weights[:, None] * f))
 
 
@@ -123,7 +124,7 @@ class TrimmedSystem:
     constraints: Constraints
     stiffness: sp.csr_matrix
     mass: sp.csr_matrix
-    rigid_modes: int
+    rigid_modes: int | None
 
 
 def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str, str],
@@ -150,10 +151,9 @@ def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str
         raise InputError("a pinned or clamped trim loop under bending weights needs degree "
                          f">= 3 (third derivatives in Nitsche's terms), got "
                          f"{surface_degrees(surface)}")
-    bases = (surface.basis_u, surface.basis_v)
     quad = quadrature_of(surface)
     orders = [(0, 0)] + [ab for key, ab, _ in STIFFNESS_TERMS if getattr(material, key)]
-    B = tensor_values(bases, _points(surface, quad), orders)
+    B = surface_values(surface, _points(surface, quad), orders)
     om = sp.diags(quad.weights)
     K = sp.csr_matrix((B[(0, 0)].shape[1],) * 2)
     for key, ab, factor in STIFFNESS_TERMS:
@@ -169,15 +169,28 @@ def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str
     if rectangle or mask is not None:
         T, free_index = with_edges(surface, edges, quad.classes, mask)
     else:
-        web = web_basis(quad.classes, surface_degrees(surface), knots=extension_knots(surface))
+        web = web_basis(quad.classes, surface_degrees(surface), knots=extension_knots(surface),
+                        weights=net_weights_of(surface))
         T, free_index = web.extension.tocsr(), np.flatnonzero(web.inner.ravel())
     pinned_points = bool(mask is not None and mask.any())
     constraints = Constraints(T, None, None, free_index, {**edges, **loops}, pinned_points)
-    # held loops, edges or fixed points leave no motion without energy (Nitsche's penalty,
-    # the constraints); else the energy's polynomials, which the extension reproduces
-    count = 0 if held or set(edges.values()) != {"free"} or pinned_points else rigid.rigid_count(
-        rigid.parametric_terms(material), *bases, build_constraints(*bases, "free"))
-    return TrimmedSystem(constraints, ((K + K.T) * 0.5).tocsr(), sp.csr_matrix(M), int(count))
+    return TrimmedSystem(constraints, ((K + K.T) * 0.5).tocsr(), sp.csr_matrix(M),
+                         _rigid_count(surface, material, bool(held) or pinned_points
+                                      or set(edges.values()) != {"free"}))
+
+
+def _rigid_count(surface: Any, material: Material, holds: bool) -> int | None:
+    """``dim null K_r``: 0 where loops, edges or fixed points hold the surface (Nitsche's
+    penalty, the constraints); else the energy's polynomials, which the extension
+    reproduces; on a rational net the constants alone under tension in u and v (``Σ R_k =
+    1``), and None (not known from the structure) without it."""
+    if holds:
+        return 0
+    if net_weights_of(surface) is not None:
+        return 1 if material.w10 and material.w01 else None
+    bases = (surface.basis_u, surface.basis_v)
+    return int(rigid.rigid_count(rigid.parametric_terms(material), *bases,
+                                 build_constraints(*bases, "free")))
 
 
 def _loop_presets(presets: Mapping[str, str], names: tuple[str, ...],
@@ -242,7 +255,7 @@ def nitsche_terms(surface: Any, material: Material, grid: Grid,
     orders = [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2), (3, 0), (2, 1), (1, 2), (0, 3)]
     if not (m.w20 or m.w11 or m.w02):
         orders = orders[:3]
-    B = tensor_values((surface.basis_u, surface.basis_v), p, orders)
+    B = surface_values(surface, p, orders)
     zero = sp.csr_matrix(B[(0, 0)].shape)
     D = lambda ab: B.get(ab, zero)  # noqa: E731
     nu, nv, su, sv = (sp.diags(x) for x in (n[:, 0], n[:, 1], s[:, 0], s[:, 1]))

@@ -34,7 +34,7 @@ def trim_grid(surface: Any) -> Grid:
     breakpoints), in each direction; the degrees may differ."""
     from ..knots import KnotVectorBasis
 
-    bases = (surface.basis_u, surface.basis_v)
+    bases = tuple(polynomial_basis(b) for b in (surface.basis_u, surface.basis_v))
     equal = True
     for name, basis in zip("uv", bases):
         if isinstance(basis, KnotVectorBasis):
@@ -50,6 +50,27 @@ def trim_grid(surface: Any) -> Grid:
     if equal:
         return Grid((bases[0].cells, bases[1].cells), (bases[0].length, bases[1].length))
     return Grid.of_breaks(*(_breaks(b) for b in bases))
+
+
+def polynomial_basis(basis: Any) -> Any:
+    """The B-splines under a per-direction rational basis (the basis itself otherwise)."""
+    from ..knots import RationalBasis
+
+    return basis.basis if isinstance(basis, RationalBasis) else basis
+
+
+def net_weights_of(surface: Any) -> NDArray[np.float64] | None:
+    """The NURBS weights of the net, flat (``a_k b_l`` of per-direction rational bases);
+    None for a polynomial surface."""
+    from ..knots import RationalBasis
+
+    if surface.net_weights is not None:
+        return np.asarray(surface.net_weights, dtype=float).ravel()
+    factors = [b.weights if isinstance(b, RationalBasis) else np.ones(b.size)
+               for b in (surface.basis_u, surface.basis_v)]
+    if not any(isinstance(b, RationalBasis) for b in (surface.basis_u, surface.basis_v)):
+        return None
+    return np.outer(*factors).ravel()
 
 
 def _breaks(basis: Any) -> NDArray[np.float64]:
@@ -76,7 +97,7 @@ def extension_knots(surface: Any) -> tuple[NDArray[np.float64], NDArray[np.float
     """The knot vectors Höllig's extension of ``surface`` needs
     (:func:`~splinedeform.trim.web.web_basis`): None where both directions have uniform
     knots (Lagrange interpolation in the index is then exact)."""
-    bases = (surface.basis_u, surface.basis_v)
+    bases = tuple(polynomial_basis(b) for b in (surface.basis_u, surface.basis_v))
     if all(getattr(b, "kind", None) == "uniform" for b in bases):
         return None
     return tuple(np.asarray(b.knots, dtype=float) for b in bases)  # type: ignore[return-value]

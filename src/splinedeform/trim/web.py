@@ -124,11 +124,15 @@ class WebBasis:
 
 def web_basis(classes: NDArray[np.int64], degree: int | Degrees,
               allowed: NDArray[np.bool_] | None = None,
-              knots: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None) -> WebBasis:
+              knots: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
+              weights: NDArray[np.float64] | None = None) -> WebBasis:
     """Inner and outer B-splines of a classified grid and Höllig's extension matrix.
 
     ``degree`` is one degree or ``(n_1, n_2)``; ``knots`` the two knot vectors (None:
-    uniform knots, where the polar form is Lagrange interpolation in the index).
+    uniform knots, where the polar form is Lagrange interpolation in the index);
+    ``weights`` the NURBS weights ``w_k`` of a rational net (flat): a rational field
+    ``Σ d_k w_k b_k / W`` is extended through its numerator's coefficients ``w_k d_k``, so
+    ``E`` becomes ``diag(1/w) E diag(w_I)`` (polynomials over ``W`` reproduced).
     ``allowed`` (a table over the B-spline indices) restricts the arrays the outer
     B-splines are tied to (e.g. to coefficients an edge condition keeps free). Raises
     :class:`InputError` when no such array of inner indices exists (the grid is too coarse
@@ -167,6 +171,9 @@ def web_basis(classes: NDArray[np.int64], degree: int | Degrees,
          (np.concatenate([in_rows, np.repeat(rows, (n[0] + 1) * (n[1] + 1))]),
           np.concatenate([np.arange(len(in_rows)), cols.ravel()]))),
         shape=(inner.size, len(in_rows)))
+    if weights is not None:
+        w = np.asarray(weights, dtype=float).ravel()
+        E = (sp.diags(1.0 / w) @ E @ sp.diags(w[in_rows])).tocsr()
     return WebBasis(degree, inner, outer, E)
 
 
