@@ -196,7 +196,10 @@ FILE_TEXTS = [file_scenario("net.json", "frame = 0"),
               file_scenario("roof.3dm", "").replace('"file"', '"cad"')
               + '[output]\nprobes = [[0.0, 25.0]]\nprobe_faces = [0]\n',
               # a trimmed face on its trimmed region: run by tests/test_cad_trim_run.py
-              file_scenario("planes.3dm", 'trimmed = true').replace('"file"', '"cad"')]
+              file_scenario("planes.3dm", 'trimmed = true').replace('"file"', '"cad"'),
+              # a trimmed face's loops held: run by tests/test_cad_trim_loops.py
+              file_scenario("square.step", 'trimmed = true').replace('"file"', '"cad"')
+              + '[boundary.loops]\nouter = "pinned"\n']
 
 
 def all_test_texts() -> list[str]:

@@ -60,3 +60,37 @@ def test_degenerate_loops_are_refused():
         PolygonLoop([[0, 0], [0.5, 0.5], [1, 1]])
     with pytest.raises(InputError, match="radius"):
         CircleLoop((0.5, 0.5), -1.0)
+
+
+def _midpoints(loop):
+    """Each span's midpoint: a polygon's segments', a Bézier-piece loop's at ``τ = 1/2``."""
+    from splinedeform.trim import PiecewiseLoop
+
+    if isinstance(loop, PiecewiseLoop):
+        n = loop.degree
+        from math import comb
+
+        weights = np.array([comb(n, a) for a in range(n + 1)]) / 2.0 ** n
+        return np.einsum("a,sak->sk", weights, loop.pieces)
+    a, b = loop.segments()
+    return 0.5 * (a + b)
+
+
+def test_trim_edges_stay_with_their_spans_when_a_loop_is_turned():
+    # clockwise outer loops are run the other way by TrimDomain; each span keeps the trim
+    # edge it was given, found again by its midpoint (exact: the same points reordered)
+    from splinedeform.trim import PiecewiseLoop
+
+    square = [[0.0, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, 0.0]]          # clockwise
+    polygon = PolygonLoop(square)
+    corners = np.array(square + square[:1])
+    pieces = np.stack([corners[:-1], 0.5 * (corners[:-1] + corners[1:]), corners[1:]], axis=1)
+    piecewise = PiecewiseLoop.from_pieces(pieces)
+    for loop, labels in ((polygon, (0, 0, 1, 2)), (piecewise, (0, 1, 1, 2))):
+        domain = TrimDomain(loop, edges=(labels,))
+        assert domain.outer is not loop and domain.edge_count(0) == 3
+        given, turned = _midpoints(loop), _midpoints(domain.outer)
+        for s, point in enumerate(turned):
+            source = int(np.argmin(np.hypot(*(given - point).T)))
+            assert np.allclose(given[source], point, rtol=0, atol=1e-15)
+            assert domain.edges[0][s] == labels[source]

@@ -89,3 +89,54 @@ def test_conditioning_under_refinement_grows_as_for_an_untrimmed_net():
                               for p in (assemble_plate(domain, m, 3, weight) for m in (10, 20))]
     assert k_f / k_c < 32
     assert max(m_c, m_f) < 2e6
+
+
+def _open_knots(breaks, degree):
+    return np.r_[[breaks[0]] * degree, breaks, [breaks[-1]] * degree]
+
+
+@pytest.mark.parametrize("degrees", [(3, 3), (2, 4)])
+def test_the_polar_form_extends_polynomials_on_general_knots(degrees):
+    # Marsden: a polynomial of degree (n_u, n_v) lies in the span of the B-splines of any
+    # knot vectors, with coefficients its polar forms; found here independently by
+    # collocation at the Greville abscissae, then the outer ones are compared with the
+    # extension of the inner ones. The knots are unequal (breaks drawn at random) and
+    # clamped; the classes of a 9 × 9 grid are index tables only, so any breaks with 9
+    # cells serve. 1e-9 of the largest coefficient: collocation and extrapolation over a
+    # few indices in floating point (measured ~1e-12)
+    from splinedeform.knots import KnotVectorBasis
+
+    rng = np.random.default_rng(7)
+    classes = classify_cells(TrimDomain(CircleLoop((0.5, 0.47), 0.36)), Grid((9, 9)))
+    knots, coeffs = [], []
+    for n in degrees:
+        breaks = np.r_[0.0, np.sort(rng.uniform(0.05, 0.95, 8)), 1.0]
+        t = _open_knots(breaks, n)
+        basis = KnotVectorBasis(n, t)
+        greville = np.array([t[k + 1:k + n + 1].mean() for k in range(len(t) - n - 1)])
+        knots.append(t)
+        coeffs.append((basis, greville))
+    (bu, gu), (bv, gv) = coeffs
+    x, y = np.meshgrid(gu, gv, indexing="ij")
+    n_u, n_v = degrees
+    values = (1 + 0.3 * x) ** n_u * (2 - y) ** n_v + x ** n_u - 2 * y ** (n_v - 1)
+    Au, Av = bu(gu), bv(gv)
+    coeff = np.linalg.solve(Au, np.linalg.solve(Av, values.T).T)
+    web = web_basis(classes, degrees, knots=tuple(knots))
+    extended = web.extension @ coeff[web.inner]
+    outer = web.outer.ravel()
+    assert outer.any()
+    scale = np.abs(coeff).max()
+    assert np.max(np.abs(extended[outer] - coeff.ravel()[outer])) < 1e-9 * scale
+
+
+def test_the_polar_form_on_uniform_knots_is_lagrange_in_the_index():
+    # the two formulas of the extension agree where both hold; 1e-10 absolute on
+    # coefficients of size up to ~1e2 (extrapolation a few indices out), round-off
+    from splinedeform.basis import BSplineBasis
+
+    classes = classify_cells(TrimDomain(CircleLoop((0.5, 0.5), 0.33)), Grid((8, 8)))
+    t = BSplineBasis(3, 8, 1.0, "uniform").knots
+    plain = web_basis(classes, 3).extension.toarray()
+    polar = web_basis(classes, 3, knots=(t, t)).extension.toarray()
+    assert np.abs(plain - polar).max() < 1e-10

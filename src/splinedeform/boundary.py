@@ -87,15 +87,20 @@ LOOP_PRESETS = ("free", "pinned", "clamped")
 
 
 def trim_conditions(boundary: str | Mapping[str, str], loops: tuple[str, ...],
-                    rectangle: bool = False) -> tuple[dict[str, str], dict[str, str]]:
+                    rectangle: bool = False, trim_edges: Mapping[str, int] | None = None
+                    ) -> tuple[dict[str, str], dict[str, str]]:
     """Presets of the rectangle's edges and of the trim loops of a trimmed surface.
 
-    A preset name holds every trim loop; a mapping names edges (``u0`` …) and loops
-    (``outer``, ``hole1`` …), missing ones free. The rectangle's edges bound the region
-    only when the outer loop is the rectangle itself (``rectangle``): then they take the
-    presets (a preset name holds them too) and the loop ``outer`` is theirs; otherwise
-    they lie outside the region and any preset but ``free`` there is refused.
+    A preset name holds every trim loop; a mapping names edges (``u0`` …), loops
+    (``outer``, ``hole1`` …) and, of a loop made of ``trim_edges[name] > 1`` trim edges, one
+    edge (``outer.0`` …, numbered from 0 in the loop's order), missing ones free (an edge
+    not named takes its loop's preset). The rectangle's edges bound the region only when
+    the outer loop is the rectangle itself (``rectangle``): then they take the presets (a
+    preset name holds them too) and the loop ``outer`` is theirs; otherwise they lie
+    outside the region and any preset but ``free`` there is refused. The loops' presets
+    come back under their names and the named trim edges under ``name.k``.
     """
+    counts = {name: (trim_edges or {}).get(name, 1) for name in loops}
     if isinstance(boundary, str):
         if boundary not in LOOP_PRESETS:
             raise InputError(f"a trim loop's preset must be one of {LOOP_PRESETS}, got "
@@ -107,12 +112,16 @@ def trim_conditions(boundary: str | Mapping[str, str], loops: tuple[str, ...],
     if not isinstance(boundary, Mapping):
         raise InputError(f"boundary must be a preset name or a mapping edge/loop -> preset, "
                          f"got {type(boundary).__name__}")
-    unknown = set(boundary) - set(EDGES) - set(loops)
+    split = {f"{name}.{k}" for name, count in counts.items() if count > 1 for k in range(count)}
+    unknown = set(boundary) - set(EDGES) - set(loops) - split
     if unknown:
+        edges_of = "".join(f", {name}.0 … {name}.{c - 1}" for name, c in counts.items() if c > 1)
         raise InputError(f"unknown boundary edge(s) or loop(s) {sorted(unknown)} of a trimmed "
-                         f"surface; its loops are {loops}, its edges {EDGES}")
+                         f"surface; its loops are {loops}{edges_of and ' (trim edges'}"
+                         f"{edges_of[1:]}{edges_of and ')'}, its edges {EDGES}")
     edges = {e: boundary.get(e, "free") for e in EDGES}
     presets = {name: boundary.get(name, "free") for name in loops}
+    presets.update({key: boundary[key] for key in sorted(split & set(boundary))})
     for name, preset in {**edges, **presets}.items():
         if preset not in LOOP_PRESETS:
             raise InputError(f"boundary.{name} must be one of {LOOP_PRESETS}, got {preset!r}")
@@ -121,8 +130,9 @@ def trim_conditions(boundary: str | Mapping[str, str], loops: tuple[str, ...],
         raise InputError(f"boundary.{held[0]} = {edges[held[0]]!r}: the trimmed region is "
                          f"bounded by its trim loops {loops}, not by the rectangle's edges "
                          "(make the outer loop the rectangle itself to hold them)")
-    if rectangle and presets["outer"] != "free":
-        raise InputError(f"boundary.outer = {presets['outer']!r}: the outer loop is the "
+    outer = [k for k in presets if k.split(".")[0] == "outer" and presets[k] != "free"]
+    if rectangle and outer:
+        raise InputError(f"boundary.{outer[0]} = {presets[outer[0]]!r}: the outer loop is the "
                          f"rectangle itself; hold its edges {EDGES} instead")
     return edges, presets
 

@@ -153,9 +153,22 @@ def faces_text(listing: dict[str, Any]) -> str:
              f"{listing['units'] or 'not declared'}",
              "  ".join(h.ljust(wd) for h, wd in zip(head, widths)).rstrip()]
     lines += ["  ".join(c.ljust(wd) for c, wd in zip(r, widths)).rstrip() for r in rows]
+    lines += [line for f in listing["faces"] if (line := loop_names_line(f))]
     if "topology" in listing:
         lines.append(topology_line(listing["topology"]))
     return "\n".join(lines) + "\n"
+
+
+def loop_names_line(face: dict[str, Any]) -> str | None:
+    """``face 3 loops: outer (4 trim edges, outer.0 … outer.3), hole1``: the names
+    ``boundary.loops`` holds a trimmed face's loops and trim edges by; None for a face that
+    is not trimmed or has no loops read."""
+    names = face.get("loop_names")
+    if not names or not face.get("trimmed"):
+        return None
+    parts = [name if count == 1 else f"{name} ({count} trim edges, {name}.0 … {name}.{count - 1})"
+             for name, count in names.items()]
+    return f"face {face['face']} loops: " + ", ".join(parts)
 
 
 def topology_line(topology: dict[str, Any]) -> str:

@@ -68,26 +68,30 @@ def read_trims(path: str | os.PathLike, face: int = 0) -> TrimDomain | None:
 
 def pieces_arrays(loops: list[list[NDArray[np.float64]]], box: NDArray[np.float64],
                   gap: float, source: str) -> dict[str, Any]:
-    """``{"box": (u0, u1, v0, v1), "loops": [(K, n + 1, 2), ...]}``: each loop's trims
-    joined (:func:`~splinedeform.trim.bezier.join_loop`), the outer loop first. Bézier
+    """``{"box": (u0, u1, v0, v1), "loops": [(K, n + 1, 2), ...], "edges": [(K,), ...]}``:
+    each loop's trims joined (:func:`~splinedeform.trim.bezier.join_loop`), the outer loop
+    first, and the trim (its number in the loop, from 0) each piece comes from. Bézier
     points outside the box by less than :data:`FIT_TOL` of its diagonal (round-off of the
     fit, where a loop touches a side) are moved onto it, so the loops stay in the box."""
     box = np.asarray(box, dtype=float)
     lo, hi = box[[0, 2]], box[[1, 3]]
     slack = FIT_TOL * float(np.hypot(*(hi - lo)))
-    joined = []
+    joined, edges = [], []
     for k, trims in enumerate(loops):
         pieces = join_loop(trims, gap, f"{source} loop {k}")
         near = (pieces > lo - slack) & (pieces < hi + slack)
         joined.append(np.where(near, np.clip(pieces, lo, hi), pieces))
-    return {"box": box, "loops": joined}
+        edges.append(np.repeat(np.arange(len(trims)), [len(t) for t in trims]))
+    return {"box": box, "loops": joined, "edges": edges}
 
 
 def domain_from_arrays(data: dict[str, Any], source: str) -> TrimDomain | None:
-    """The :class:`TrimDomain` of :func:`pieces_arrays`' result, moved to start at 0."""
+    """The :class:`TrimDomain` of :func:`pieces_arrays`' result, moved to start at 0, with
+    each loop's trim edges (:attr:`TrimDomain.edges`) where the result names them."""
     if data.get("loops") is None:
         return None
     origin = np.asarray(data["box"], dtype=float)[[0, 2]]
+    edges = tuple(tuple(int(x) for x in e) for e in data.get("edges") or ())
     loops: list[Loop] = []
     for number, pieces in enumerate(data["loops"]):
         pieces = np.asarray(pieces, dtype=float) - origin
@@ -99,7 +103,7 @@ def domain_from_arrays(data: dict[str, Any], source: str) -> TrimDomain | None:
         except InputError as exc:
             raise InputError(f"{source} loop {number}: {exc}") from None
     try:
-        return TrimDomain(loops[0], tuple(loops[1:]))
+        return TrimDomain(loops[0], tuple(loops[1:]), edges)
     except InputError as exc:
         raise InputError(f"{source}: {exc}") from None
 
@@ -138,20 +142,26 @@ def _moved(loops: tuple[Loop, ...], shift: NDArray[np.float64]) -> tuple[Loop, t
 
 
 def trim_summary(entry: dict[str, Any], source: str) -> dict[str, Any]:
-    """``loops`` (``[outer, inner]`` counts) and ``trimmed_fraction`` of a listed face
-    (:func:`listed`), None where it has no loops; ``trim_error`` where they cannot be read."""
+    """``loops`` (``[outer, inner]`` counts), ``loop_names`` (each loop's name, as
+    ``boundary.loops`` takes it, and its number of trim edges) and ``trimmed_fraction`` of a
+    listed face (:func:`listed`), None where it has no loops; ``trim_error`` where they
+    cannot be read."""
+    none = {"loops": None, "loop_names": None, "trimmed_fraction": None}
     if "trim_error" in entry:
-        return {"loops": None, "trimmed_fraction": None, "trim_error": entry["trim_error"]}
+        return {**none, "trim_error": entry["trim_error"]}
     data = entry.get("trim") or {"loops": None}
     try:
         domain = domain_from_arrays(data, source)
         if domain is None:
-            return {"loops": None, "trimmed_fraction": None}
+            return none
         box = np.asarray(data["box"], dtype=float)
         fraction = trimmed_fraction(domain, (box[1] - box[0], box[3] - box[2]))
     except InputError as exc:
-        return {"loops": None, "trimmed_fraction": None, "trim_error": str(exc)}
-    return {"loops": [1, len(domain.holes)], "trimmed_fraction": fraction}
+        return {**none, "trim_error": str(exc)}
+    from .trim.model_matrices import loop_names
+
+    names = {name: domain.edge_count(k) for k, name in enumerate(loop_names(domain))}
+    return {"loops": [1, len(domain.holes)], "loop_names": names, "trimmed_fraction": fraction}
 
 
 def _straight(pieces: NDArray[np.float64]) -> bool:

@@ -13,7 +13,7 @@ from .body import (body_model, check_single_surface_loads, describe_body, is_bod
                    refined_body)
 from .spec import Scenario, SurfaceSpec
 from ..trim.surface_trim import region_contains
-from .cad_trim import reader_warnings, with_face_trim
+from .cad_trim import face_loop_presets, reader_warnings, with_face_trim
 from .trim_build import loop_presets, trimmed
 
 
@@ -331,6 +331,7 @@ def _model_on(scenario: Scenario, surface: Any, units: str | None) -> Built:
     from ..material import Material
     from ..model import Model
 
+    loops = face_loop_presets(scenario, surface)
     if is_body(surface):
         return Built(surface=surface, model=body_model(scenario, surface), load=None,
                      units=units)
@@ -344,7 +345,8 @@ def _model_on(scenario: Scenario, surface: Any, units: str | None) -> Built:
         material = Material(**scenario.material.weights())
     with _located(scenario, "boundary"):
         model = Model(surface, material, boundary={**scenario.boundary.edges(),
-                                                   **loop_presets(scenario)}, fixed=fixed,
+                                                   **loop_presets(scenario), **loops},
+                      fixed=fixed,
                       mass_matrix=scenario.material.mass_matrix,
                       physics=scenario.material.physics)
     return Built(surface=surface, model=model, load=None, fixed=fixed, units=units)

@@ -5,7 +5,8 @@ its loops (:func:`splinedeform.cad_trims.read_trims`) are attached after ``eleva
 ``refine`` (the loops live in parameter space, refinement does not move them), so the
 model and every output use the trimmed region only. ``surface.trimmed`` switches this:
 by default the trim is taken where the trimmed model can hold the surface (physics
-``parametric``, one degree, equal knot cells, no weights, not periodic) and the whole face
+``parametric``, clamped knots with simple interior knots, not periodic;
+:func:`~splinedeform.trim.surface_trim.trim_grid`) and the whole face
 is used otherwise, with one warning line naming the face and the reason; ``trimmed =
 true`` refuses such a face, ``trimmed = false`` takes the whole face without a word.
 """
@@ -17,9 +18,9 @@ from contextlib import contextmanager
 from typing import Any, Iterator
 
 from ..errors import InputError, InputWarning
-from ..knots import RationalBasis
 from ..surface import Surface
-from ..trim.surface_trim import equal_cell_form, whole_rectangle
+from ..trim.model_matrices import loop_names
+from ..trim.surface_trim import equal_cell_form, holed_rectangle, whole_rectangle
 
 #: what the CAD readers say of a trimmed face read whole; replaced by this module's word
 WHOLE_SURFACE = "whole underlying surface is used"
@@ -59,12 +60,6 @@ def why_untrimmable(scenario: Any, surface: Any) -> str | None:
     if scenario.material.physics != "parametric":
         return (f"physics {scenario.material.physics!r} is not trimmed yet (a trimmed "
                 "surface takes \"parametric\")")
-    if surface.net_weights is not None or any(
-            isinstance(b, RationalBasis) for b in (surface.basis_u, surface.basis_v)):
-        return "it is rational (NURBS weights), which the trimmed model does not take"
-    if scenario.boundary.has_free_region:
-        return ("fixed control points (boundary.free_region, free_points) are not combined "
-                "with a trim")
     return None
 
 
@@ -106,3 +101,42 @@ def with_face_trim(scenario: Any, surface: Any, caught: list[warnings.WarningMes
         return surface
     _shown(caught, drop_whole=True)
     return trimmed
+
+
+def face_loop_presets(scenario: Any, surface: Any) -> dict[str, str]:
+    """``boundary.loops`` as the model's boundary keys (``outer``, ``hole1.0``, …), checked
+    against the loops of the trimmed CAD face ``surface``; a loop or trim edge the face has
+    not, or a face with no loops to hold, is refused at its key."""
+    named = scenario.raw.get("boundary", {}).get("loops")
+    if not named:
+        return {}
+    where = "boundary.loops"
+    spec = scenario.surface
+    if spec.shape != "cad" or spec.trim is not None:
+        raise scenario.error(where, "names the trim loops of a CAD face (surface.shape = "
+                             "\"cad\"); loops given by hand take their condition as `edge` "
+                             "in [[surface.trim.loops]]")
+    domain = getattr(surface, "trim", None)
+    if domain is None:
+        raise scenario.error(where, f"{spec.path} is simulated on its whole surface (a body "
+                             "of faces, a face without trim loops, or trimmed = false), so "
+                             "it has no trim loops to hold")
+    names = loop_names(domain)
+    out: dict[str, str] = {}
+    for name, value in named.items():
+        if name not in names:
+            raise scenario.error(f"{where}.{name}", f"the face has no loop {name!r}; its loops "
+                                 f"are {list(names)} (splinedeform faces lists them)")
+        if name == "outer" and holed_rectangle(surface):
+            raise scenario.error(f"{where}.outer", "the face's outer loop is its parameter "
+                                 "rectangle: hold its edges u0, u1, v0, v1 in [boundary]")
+        if isinstance(value, str):
+            out[name] = value
+            continue
+        count = domain.edge_count(names.index(name))
+        for key, preset in value.items():
+            if int(key) >= count:
+                raise scenario.error(f"{where}.{name}.{key}", f"loop {name!r} is made of "
+                                     f"{count} trim edge(s), numbered 0 to {count - 1}")
+            out[name if count == 1 else f"{name}.{int(key)}"] = preset
+    return out

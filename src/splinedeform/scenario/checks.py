@@ -10,6 +10,7 @@ Schema (:func:`allowed`), e.g. "an integer >= 1 and <= 7" or "an array of 3 numb
 
 from __future__ import annotations
 
+import re
 import types
 from dataclasses import dataclass
 from typing import Annotated, Any, Callable, Literal, Union, get_args, get_origin
@@ -154,6 +155,10 @@ def choice(*options: str) -> Callable[[Any], str]:
     return checker(Literal[options])
 
 
+#: a union member's type label in a pydantic error location (``dict[str, …]``)
+_UNION_MEMBER = re.compile(r"^[a-z][a-z-]*\[.*\]$")
+
+
 def located_checker(annotation: Any, title: str = "") -> Callable[[Any], Any]:
     """Checker of a nested table: a problem is located at its key path inside the value
     (``.loops[2].circle.radius``, arrays counted from 1) and says pydantic's reason."""
@@ -164,7 +169,12 @@ def located_checker(annotation: Any, title: str = "") -> Callable[[Any], Any]:
         try:
             return adapter.validate_python(value)
         except ValidationError as exc:
-            error = exc.errors()[0]
+            # a union's members are tried in turn: the error that went deepest into the
+            # value is the one meant (the first of those), located without the members'
+            # type labels (``literal['free', …]``) pydantic puts in its path
+            errors = [{**e, "loc": tuple(p for p in e["loc"] if not _UNION_MEMBER.match(str(p)))}
+                      for e in exc.errors()]
+            error = max(errors, key=lambda e: len(e["loc"]))
             sub = "".join(f"[{p + 1}]" if isinstance(p, int) else f".{p}"
                           for p in error["loc"])
             reason = error["msg"].removeprefix("Value error, ")

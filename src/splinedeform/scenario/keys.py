@@ -57,6 +57,8 @@ BOUNDARY_KEYS: dict[str, Key] = {
     **_keys(S.Boundary, ("free_points",)),
     "faces": Key(located_checker(dict[S.FaceKey, S.FaceEdges], "{k = {u0 = ...}}"), None,
                  _keys(S.Boundary, ("faces",))["faces"].doc, "none"),
+    "loops": Key(located_checker(dict[S.LoopKey, S.LoopPresets], '{outer = "clamped"}'), None,
+                 _keys(S.Boundary, ("loops",))["loops"].doc, "none (free)"),
 }
 
 _PROFILED = tuple(S._Profiled.model_fields)

@@ -99,6 +99,14 @@ FacePreset = Literal["free", "pinned", "clamped", "diaphragm", "symmetry"]
 FaceKey = Annotated[str, Field(pattern=r"^[0-9]+$")]
 
 
+#: a trim loop of a CAD face named in ``boundary.loops``, as ``splinedeform faces`` lists it
+LoopKey = Annotated[str, Field(pattern=r"^(outer|hole[1-9][0-9]*)$")]
+#: a trim edge of such a loop: its number in the loop, from 0
+TrimEdgeKey = Annotated[str, Field(pattern=r"^[0-9]+$")]
+#: a loop's condition: one preset, or one per trim edge named
+LoopPresets = Union[FacePreset, dict[TrimEdgeKey, FacePreset]]
+
+
 class FaceEdges(_Table):
     u0: Optional[FacePreset] = Field(None, description="edge `u = 0` of the face")
     u1: Optional[FacePreset] = Field(None, description="edge `u = L_u` of the face")
@@ -135,6 +143,14 @@ class Boundary(_Table):
             "`symmetry`; they replace the one preset `u0 = u1 = v0 = v1` "
             "on those edges; an edge another face meets (an interface) or a pole takes none"),
         json_schema_extra={"doc_default": "none"})
+    loops: Optional[dict[LoopKey, LoopPresets]] = Field(
+        None, title='{outer = "clamped", ...}', description=(
+            "trimmed CAD face only: edge conditions of the face's trim loops, named as "
+            "`splinedeform faces FILE` lists them (`outer`, `hole1`, …): `free`, `pinned` "
+            "or `clamped`, held by Nitsche's method; a loop made of several trim edges "
+            "takes one per edge instead (`outer.0 = \"clamped\"`, the edges numbered from "
+            "0 in the loop's order, those not named free); loops not named are free"),
+        json_schema_extra={"doc_default": "none (free)"})
 
 
 # -- [[load]] ----------------------------------------------------------------------------------

@@ -116,8 +116,7 @@ class _Fitted(_Refined):
             "a trimmed region in (u, v): `[[surface.trim.loops]]` tables, each a `polygon`, "
             "`circle` or `spline`, with a `name` and an `edge` condition (docs/trim.md); the "
             "model then lives on the region inside the outer loop and outside the holes "
-            "(physics `parametric`, equal knot cells; the rectangle's edges free unless "
-            "`rectangle`)"),
+            "(physics `parametric`; the rectangle's edges free unless `rectangle`)"),
         json_schema_extra={"doc_default": "none (the whole rectangle)"})
 
 
@@ -199,9 +198,9 @@ class FromCad(_Refined):
         None, description=(
             "simulate a trimmed face on the region inside its trim loops (loops `outer`, "
             "`hole1`, …; an outer loop that is the parameter rectangle keeps the `[boundary]` "
-            "edges): `true` refuses a face the trimmed model cannot take (physics other than "
-            "`parametric`, rational, periodic, unequal knot cells or degrees), `false` takes "
-            "the whole underlying surface"),
+            "edges; `[boundary.loops]` holds the loops): `true` refuses a face the trimmed "
+            "model cannot take (physics other than `parametric`, periodic, repeated interior "
+            "knots), `false` takes the whole underlying surface"),
         json_schema_extra={"doc_default": "the trim where the model can take it, else the "
                                           "whole surface with one warning"})
     faces: Optional[Union[Literal["all"], Annotated[list[FaceNumber], Field(min_length=1)],

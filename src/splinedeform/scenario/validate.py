@@ -206,6 +206,7 @@ def _validate_boundary(raw: Mapping[str, Any], problems: _Problems,
                                              f"only (material.physics = \"shell\"), not of "
                                              f"physics {physics!r}")
     values.pop("faces", None)           # a body's, read by scenario.body.face_presets
+    values.pop("loops", None)           # a CAD face's, read by scenario.cad_trim.face_loop_presets
     region = values.pop("free_region", None)
     box: dict[str, tuple[float, float] | None] = {"free_u": None, "free_v": None}
     if region is not None:

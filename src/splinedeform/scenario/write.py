@@ -99,6 +99,9 @@ def scenario_to_toml(scenario: Scenario) -> str:
         boundary.append(("free_region", region))
     if s.boundary.free_points is not None:
         boundary.append(("free_points", [list(p) for p in s.boundary.free_points]))
+    loops = s.raw.get("boundary", {}).get("loops")      # a CAD face's, read when built
+    if loops:
+        boundary.append(("loops", dict(loops)))
     out += _toml_table("[boundary]", boundary)
     for load in s.loads:
         out += _toml_table("[[load]]", _load_items(load))

@@ -1,6 +1,7 @@
 """Knot-grid cells against a trimmed region: inside, outside or cut by a trim loop.
 
-The grid has cells ``[i h_u, (i+1) h_u] × [j h_v, (j+1) h_v]``. Every trim loop is split
+The grid has cells ``[x_i, x_{i+1}] × [y_j, y_{j+1}]`` between its lines (the knots'
+breakpoints; ``x_i = i h_u`` for equal cells). Every trim loop is split
 at the grid lines into *pieces*, each inside one cell; a cell holding a piece is **cut**,
 any other cell is **inside** or **outside** as its centre is.
 """
@@ -24,17 +25,48 @@ SIDE_TOL = 1e-9
 
 @dataclass(frozen=True)
 class Grid:
-    """``cells = (m_u, m_v)`` equal cells on ``[0, L_u] × [0, L_v]``."""
+    """``cells = (m_u, m_v)`` cells on ``[0, L_u] × [0, L_v]``: equal ones, or those between
+    the ``breaks`` (two increasing arrays from 0 to ``L``, ``m + 1`` values each)."""
 
     cells: tuple[int, int]
     lengths: tuple[float, float] = (1.0, 1.0)
+    breaks: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+
+    @classmethod
+    def of_breaks(cls, breaks_u: NDArray[np.float64], breaks_v: NDArray[np.float64]) -> "Grid":
+        """The grid of the lines ``breaks_u``, ``breaks_v`` (each from 0)."""
+        b = tuple(np.asarray(x, dtype=float) for x in (breaks_u, breaks_v))
+        if any(x.ndim != 1 or len(x) < 2 or x[0] != 0.0 or np.any(np.diff(x) <= 0) for x in b):
+            raise InputError("a grid's lines must be increasing from 0")
+        return cls((len(b[0]) - 1, len(b[1]) - 1), (float(b[0][-1]), float(b[1][-1])), b)
 
     @property
     def h(self) -> tuple[float, float]:
+        """The cells' sides (equal cells; the smallest of each direction otherwise)."""
+        if self.breaks is not None:
+            return tuple(float(np.diff(x).min()) for x in self.breaks)  # type: ignore[return-value]
         return self.lengths[0] / self.cells[0], self.lengths[1] / self.cells[1]
 
     def lines(self, axis: int) -> NDArray[np.float64]:
-        return np.arange(self.cells[axis] + 1) * self.h[axis]
+        if self.breaks is not None:
+            return self.breaks[axis]
+        return np.arange(self.cells[axis] + 1) * (self.lengths[axis] / self.cells[axis])
+
+    def cell_of(self, x: NDArray[np.float64], axis: int) -> NDArray[np.int64]:
+        """The cell ``i`` with ``x_i <= x < x_{i+1}`` along ``axis`` (-1 before the first
+        line, ``m`` from the last on)."""
+        return np.searchsorted(self.lines(axis), x, side="right").astype(int) - 1
+
+    def centres(self) -> NDArray[np.float64]:
+        """Cell centres, shape ``(m_u, m_v, 2)``."""
+        cu, cv = (0.5 * (x[1:] + x[:-1]) for x in (self.lines(0), self.lines(1)))
+        return np.stack(np.meshgrid(cu, cv, indexing="ij"), axis=-1)
+
+    def sides(self, cells: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Lower corners and sides ``(C, 2)`` of the cells ``(C, 2)``."""
+        lo = np.stack([self.lines(a)[cells[:, a]] for a in (0, 1)], axis=-1)
+        hi = np.stack([self.lines(a)[cells[:, a] + 1] for a in (0, 1)], axis=-1)
+        return lo, hi - lo
 
 
 @dataclass(frozen=True)
@@ -44,7 +76,8 @@ class Pieces:
     ``kind`` 0 is a straight piece from ``start`` to ``end`` (``t ∈ [0, 1]``), 1 an arc of
     the circle ``centre, radius`` with angles ``t``, 2 a span of a spline loop, the
     polynomial ``Σ_e poly[e] t^e`` (``t ∈ [0, 1]``); ``cell`` the ``(i, j)`` of its cell;
-    ``loop`` the index of its loop in :attr:`TrimDomain.loops` (0 the outer loop).
+    ``loop`` the index of its loop in :attr:`TrimDomain.loops` (0 the outer loop);
+    ``span`` the polygon segment or spline span it lies on (0 on a circle).
     """
 
     kind: NDArray[np.int64]
@@ -57,6 +90,7 @@ class Pieces:
     cell: NDArray[np.int64]
     poly: NDArray[np.float64]
     loop: NDArray[np.int64] | None = None
+    span: NDArray[np.int64] | None = None
 
     def evaluate(self, t: NDArray[np.float64]
                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -95,7 +129,7 @@ def _polygon_pieces(loop: PolygonLoop, grid: Grid) -> tuple[NDArray, ...]:
     lo, hi = t[:, :-1], t[:, 1:]
     keep = np.isfinite(hi) & (hi > lo)
     seg = np.broadcast_to(np.arange(len(a))[:, None], lo.shape)[keep]
-    return a[seg], b[seg], lo[keep], hi[keep]
+    return a[seg], b[seg], lo[keep], hi[keep], seg
 
 
 def _circle_pieces(loop: CircleLoop, grid: Grid) -> tuple[NDArray, NDArray]:
@@ -139,10 +173,11 @@ def loop_pieces(domain: TrimDomain, grid: Grid, loops: tuple | None = None) -> P
     kinds, los, his, starts, ends, centres, radii = [], [], [], [], [], [], []
     q = 1 + max([loop.degree for loop in loops if isinstance(loop, SplineLoop)],
                 default=0)
-    polys = []
+    polys, spans = [], []
     for loop in loops:
         if isinstance(loop, SplineLoop):
             span, lo, hi = _spline_pieces(loop, grid)
+            spans.append(span)
             kinds.append(np.full(len(lo), 2))
             starts.append(np.zeros((len(lo), 2)))
             ends.append(np.zeros((len(lo), 2)))
@@ -156,7 +191,8 @@ def loop_pieces(domain: TrimDomain, grid: Grid, loops: tuple | None = None) -> P
             continue
         polys.append(None)
         if isinstance(loop, PolygonLoop):
-            a, b, lo, hi = _polygon_pieces(loop, grid)
+            a, b, lo, hi, seg = _polygon_pieces(loop, grid)
+            spans.append(seg)
             kinds.append(np.zeros(len(lo), int))
             starts.append(a)
             ends.append(b)
@@ -164,6 +200,7 @@ def loop_pieces(domain: TrimDomain, grid: Grid, loops: tuple | None = None) -> P
             radii.append(np.zeros(len(lo)))
         else:
             lo, hi = _circle_pieces(loop, grid)
+            spans.append(np.zeros(len(lo), int))
             kinds.append(np.ones(len(lo), int))
             starts.append(np.zeros((len(lo), 2)))
             ends.append(np.zeros((len(lo), 2)))
@@ -176,8 +213,8 @@ def loop_pieces(domain: TrimDomain, grid: Grid, loops: tuple | None = None) -> P
                     np.concatenate(starts), np.concatenate(ends), np.concatenate(centres),
                     np.concatenate(radii), np.zeros((0, 2), int), np.concatenate(polys))
     mid, _ = pieces.evaluate(0.5 * (pieces.lo + pieces.hi)[:, None])
-    h, cells = np.array(grid.h), np.array(grid.cells)
-    cell = np.floor(mid[:, 0] / h).astype(int)
+    cells = np.array(grid.cells)
+    cell = np.stack([grid.cell_of(mid[:, 0, a], a) for a in (0, 1)], axis=-1)
     # a piece along a side of the box (within SIDE_TOL) lies in the cell beside it: on
     # the far side u = L_u (or v = L_v) its midpoint's floor is one past the last cell
     slack = SIDE_TOL * float(np.hypot(*grid.lengths))
@@ -189,16 +226,14 @@ def loop_pieces(domain: TrimDomain, grid: Grid, loops: tuple | None = None) -> P
                          f"[0, {grid.lengths[0]:g}] × [0, {grid.lengths[1]:g}]")
     loop = np.repeat(np.arange(len(kinds)), [len(k) for k in kinds])
     return Pieces(pieces.kind, pieces.lo, pieces.hi, pieces.start, pieces.end, pieces.centre,
-                  pieces.radius, cell, pieces.poly, loop)
+                  pieces.radius, cell, pieces.poly, loop, np.concatenate(spans).astype(int))
 
 
 def classify_cells(domain: TrimDomain, grid: Grid, pieces: Pieces | None = None
                    ) -> NDArray[np.int64]:
     """``(m_u, m_v)`` table of :data:`INSIDE`, :data:`OUTSIDE` or :data:`CUT`."""
     pieces = loop_pieces(domain, grid) if pieces is None else pieces
-    h = np.array(grid.h)
-    i, j = np.meshgrid(np.arange(grid.cells[0]), np.arange(grid.cells[1]), indexing="ij")
-    centre = (np.stack([i, j], axis=-1) + 0.5) * h
+    centre = grid.centres()
     table = np.where(domain.contains(centre), INSIDE, OUTSIDE)
     table[pieces.cell[:, 0], pieces.cell[:, 1]] = CUT
     return table

@@ -9,7 +9,8 @@ every cell not inside a hole, less each hole's cut-cell rule
 ``u0 … v1`` keep the conditions of :mod:`splinedeform.boundary`: with ``T_e`` their map
 (identity on the kept coefficients ``K``) and ``E`` the extension (identity on the inner
 coefficients ``I``), the map is ``T = T_e E[K, F]`` over the free set ``F = I ∩ K``,
-with the holes' outer B-splines tied to arrays of kept coefficients only.
+with the holes' outer B-splines tied to arrays of kept coefficients only. Fixed control
+points (on any trimmed region) are left out of ``K`` the same way.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from ..errors import InputError
 from .cells import CUT, INSIDE, OUTSIDE, Grid
 from .loops import TrimDomain
 from .quadrature import TrimQuadrature, cell_gauss, trim_quadrature
+from .surface_trim import extension_knots, net_weights_of, surface_degrees
 from .web import web_basis
 
 
@@ -44,20 +46,24 @@ def holed_quadrature(domain: TrimDomain, grid: Grid, order: int) -> TrimQuadratu
                           np.concatenate([c, *cells]), classes)
 
 
-def with_edges(surface: Any, edges: dict[str, str], classes: np.ndarray
-               ) -> tuple[sp.csr_matrix, np.ndarray]:
+def with_edges(surface: Any, edges: dict[str, str], classes: np.ndarray,
+               fixed: np.ndarray | None = None) -> tuple[sp.csr_matrix, np.ndarray]:
     """``T = T_e E[K, F]`` and the free indices ``F`` (module docstring); the outer
     B-splines are tied to arrays of kept coefficients only, so ``E[K]`` never needs an
-    eliminated one."""
-    held = build_constraints(surface.basis_u, surface.basis_v, edges)
+    eliminated one. ``fixed`` (a mask of the net, True: at rest) takes the fixed control
+    points out of ``K`` as :func:`~splinedeform.boundary.build_constraints` does for an
+    untrimmed net: a fixed inner B-spline stays at rest, and so does a fixed outer one."""
+    held = build_constraints(surface.basis_u, surface.basis_v, edges, fixed)
     kept = np.zeros(surface.shape, bool)
     kept.ravel()[held.free_index] = True
-    web = web_basis(classes, surface.basis_u.degree, allowed=kept)
+    web = web_basis(classes, surface_degrees(surface), allowed=kept,
+                    knots=extension_knots(surface), weights=net_weights_of(surface))
     inner = np.flatnonzero(web.inner.ravel())
     free = kept.ravel()[inner]
     E = web.extension.tocsr()[held.free_index]
     if abs(E[:, ~free]).sum() != 0:            # an outer B-spline among the eliminated
-        raise InputError("a hole comes too close to a held edge of the rectangle: the edge "
-                         "condition and the extension of the hole's B-splines meet; move "
-                         "the hole away from the edge or refine the net")
+        raise InputError("a trim loop comes too close to a held edge of the rectangle or to "
+                         "fixed control points: they and the extension of the loop's "
+                         "B-splines meet; move the loop away, fix fewer points or refine "
+                         "the net")
     return (held.T @ E[:, free]).tocsr(), inner[free]

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
+from .piecewise_loop import PiecewiseLoop
 from .spline_loop import SplineLoop
 
 
@@ -216,6 +217,9 @@ class TrimDomain:
 
     outer: Loop
     holes: tuple[Loop, ...] = ()
+    #: per loop (outer first), the trim edge of each of its spans (polygon segments or
+    #: Bézier pieces, as given), or None where the loop is one edge; empty: all are one
+    edges: tuple[tuple[int, ...] | None, ...] = ()
 
     def __post_init__(self) -> None:
         for loop in (self.outer, *self.holes):
@@ -223,8 +227,12 @@ class TrimDomain:
                 raise InputError("trim loops must be polygons, circles or spline loops, got "
                                  f"{type(loop).__name__}")
         holes = tuple(self.holes)
+        given = (self.outer, *holes)
         object.__setattr__(self, "outer", self.outer.oriented(True))
         object.__setattr__(self, "holes", tuple(h.oriented(False) for h in holes))
+        object.__setattr__(self, "edges", tuple(
+            span_edges(before, after, labels) for before, after, labels in
+            zip(given, self.loops, tuple(self.edges) + (None,) * (len(given) - len(self.edges)))))
         loops = self.loops
         for i in range(len(loops)):
             for j in range(i + 1, len(loops)):
@@ -259,6 +267,35 @@ class TrimDomain:
 
     def bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         return self.outer.bounds()
+
+    def edge_count(self, k: int) -> int:
+        """How many trim edges loop ``k`` is made of (1 unless :attr:`edges` says more)."""
+        labels = self.edges[k] if k < len(self.edges) else None
+        return 1 if labels is None else max(labels) + 1
+
+
+def span_edges(given: Loop, oriented: Loop, labels: tuple[int, ...] | None
+               ) -> tuple[int, ...] | None:
+    """The trim edge of each span of ``oriented`` from ``labels``, those of the spans of
+    ``given`` (the same loop, perhaps run the other way). Reversed, span ``s`` of ``K``
+    Bézier pieces is piece ``K - 1 - s``, and segment ``s`` of a polygon of ``K``
+    vertices is segment ``K - 2 - s`` (mod ``K``) of the vertices as given."""
+    if labels is None:
+        return None
+    labels = tuple(int(x) for x in labels)
+    if not isinstance(given, (PolygonLoop, PiecewiseLoop)):
+        raise InputError(f"trim edges are named on polygon and Bézier-piece loops, not on a "
+                         f"{type(given).__name__}")
+    spans = len(given.vertices) if isinstance(given, PolygonLoop) else given.spans
+    if len(labels) != spans or min(labels) < 0:
+        raise InputError(f"a loop's trim edges name each of its spans: {spans} spans, got "
+                         f"{len(labels)} labels")
+    if oriented is given:
+        return labels
+    K = len(labels)
+    if isinstance(given, PolygonLoop):
+        return tuple(labels[(K - 2 - s) % K] for s in range(K))
+    return labels[::-1]
 
 
 def _name(k: int) -> str:

@@ -28,7 +28,8 @@ unchanged, and the displaced surface stays a B-spline surface.
 ``b_p = ∮ g_0(d) v + (g(d)·s)(∇v·s)``, ``s`` the tangent. Both are consistent (the exact
 solution satisfies the discrete equations) and symmetric;
 ``γ_0 = β (w_b / h³ + w_t / h)``, ``γ_1 = β w_b / h`` with ``w_b = max(w20, w11, w02)``,
-``w_t = max(w10, w01)``, ``h`` the smaller cell side and ``β =`` :func:`nitsche_penalty`.
+``w_t = max(w10, w01)``, ``h`` the smaller side of the knot cell at each point of the loop
+and ``β =`` :func:`nitsche_penalty` of the larger degree.
 """
 
 from __future__ import annotations
@@ -48,8 +49,9 @@ from .cells import Grid, loop_pieces
 from .loops import TrimDomain
 from .quadrature import TrimQuadrature, trim_quadrature
 from .holed import holed_quadrature, with_edges
-from .surface_trim import holed_rectangle, trim_grid
-from .values import tensor_values
+from .surface_trim import (extension_knots, holed_rectangle, net_weights_of, surface_degrees,
+                           trim_grid)
+from .values import surface_values
 from .web import web_basis
 
 NITSCHE_FACTOR = 10.0
@@ -81,12 +83,14 @@ def loop_names(domain: TrimDomain) -> tuple[str, ...]:
 
 
 def quadrature_of(surface: Any) -> TrimQuadrature:
-    """The trimmed quadrature of a surface, ``n + 2`` Gauss points per direction (exact for
-    the ``2n`` per variable of the energies on inside cells); kept with the surface."""
+    """The trimmed quadrature of a surface, ``n + 2`` Gauss points per direction (``n`` the
+    larger degree; exact for the ``2n`` per variable of the energies on inside cells); kept
+    with the surface."""
     key = ("trim quadrature",)
     if key not in surface._cache:
         rule = holed_quadrature if holed_rectangle(surface) else trim_quadrature
-        surface._cache[key] = rule(surface.trim, trim_grid(surface), surface.basis_u.degree + 2)
+        surface._cache[key] = rule(surface.trim, trim_grid(surface),
+                                      max(surface_degrees(surface)) + 2)
     return surface._cache[key]
 
 
@@ -108,7 +112,7 @@ def project(surface: Any, values: Callable[[NDArray, NDArray], NDArray]
                          f"its parameter arrays {(len(p),)}, got {f.shape}")
     if not np.all(np.isfinite(f)):
         raise InputError("a load function returned non-finite values")
-    B = tensor_values((surface.basis_u, surface.basis_v), p, [(0, 0)])[(0, 0)]
+    B = surface_values(surface, p, [(0, 0)])[(0, 0)]
     return np.asarray(B.T @ (quad.weights[:, None] * f))
 
 
@@ -120,7 +124,7 @@ class TrimmedSystem:
     constraints: Constraints
     stiffness: sp.csr_matrix
     mass: sp.csr_matrix
-    rigid_modes: int
+    rigid_modes: int | None
 
 
 def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str, str],
@@ -130,28 +134,26 @@ def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str
     if physics != "parametric":
         raise InputError(f"a trimmed surface takes physics 'parametric' (its energy over the "
                          f"trimmed region); {physics!r} is not trimmed yet")
-    if fixed is not None:
-        raise InputError("fixed control points are not combined with a trim yet: hold the "
-                         "trim loops instead (boundary = {'outer': 'clamped', ...})")
     domain: TrimDomain = surface.trim
     grid = trim_grid(surface)
     names = loop_names(domain)
     rectangle = holed_rectangle(surface)
-    edges, loops = trim_conditions(boundary, names, rectangle)
-    held = {k: loops[name] for k, name in enumerate(names) if loops[name] != "free"}
+    counts = {name: domain.edge_count(k) for k, name in enumerate(names)}
+    edges, loops = trim_conditions(boundary, names, rectangle, counts)
+    held = {k: v for k, v in enumerate(_loop_presets(loops, names, counts))
+            if set(np.atleast_1d(v)) != {"free"}}
     if held and rest == "none":
         raise InputError("rest = 'none' (the energy of the position itself) is not combined "
                          "with pinned or clamped trim loops yet: Nitsche's terms hold the "
                          "displacement, not the position; use rest = 'initial'")
     bending = max(material.w20, material.w11, material.w02)
-    if held and bending and surface.basis_u.degree < 3:
+    if held and bending and min(surface_degrees(surface)) < 3:
         raise InputError("a pinned or clamped trim loop under bending weights needs degree "
                          f">= 3 (third derivatives in Nitsche's terms), got "
-                         f"{surface.basis_u.degree}")
-    bases = (surface.basis_u, surface.basis_v)
+                         f"{surface_degrees(surface)}")
     quad = quadrature_of(surface)
     orders = [(0, 0)] + [ab for key, ab, _ in STIFFNESS_TERMS if getattr(material, key)]
-    B = tensor_values(bases, _points(surface, quad), orders)
+    B = surface_values(surface, _points(surface, quad), orders)
     om = sp.diags(quad.weights)
     K = sp.csr_matrix((B[(0, 0)].shape[1],) * 2)
     for key, ab, factor in STIFFNESS_TERMS:
@@ -163,24 +165,54 @@ def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str
         M = sp.diags(np.asarray(M.sum(axis=1)).ravel())
     if held:
         K = K + nitsche_terms(surface, material, grid, held)
-    if rectangle:
-        T, free_index = with_edges(surface, edges, quad.classes)
+    mask = None if fixed is None else np.asarray(fixed, dtype=bool)
+    if rectangle or mask is not None:
+        T, free_index = with_edges(surface, edges, quad.classes, mask)
     else:
-        web = web_basis(quad.classes, surface.basis_u.degree)
+        web = web_basis(quad.classes, surface_degrees(surface), knots=extension_knots(surface),
+                        weights=net_weights_of(surface))
         T, free_index = web.extension.tocsr(), np.flatnonzero(web.inner.ravel())
-    constraints = Constraints(T, None, None, free_index, {**edges, **loops}, False)
-    # held loops or edges leave no motion without energy (Nitsche's penalty, the edges'
-    # constraints); else the energy's polynomials, which the extension reproduces
-    count = 0 if held or set(edges.values()) != {"free"} else rigid.rigid_count(
-        rigid.parametric_terms(material), *bases, build_constraints(*bases, "free"))
-    return TrimmedSystem(constraints, ((K + K.T) * 0.5).tocsr(), sp.csr_matrix(M), int(count))
+    pinned_points = bool(mask is not None and mask.any())
+    constraints = Constraints(T, None, None, free_index, {**edges, **loops}, pinned_points)
+    return TrimmedSystem(constraints, ((K + K.T) * 0.5).tocsr(), sp.csr_matrix(M),
+                         _rigid_count(surface, material, bool(held) or pinned_points
+                                      or set(edges.values()) != {"free"}))
+
+
+def _rigid_count(surface: Any, material: Material, holds: bool) -> int | None:
+    """``dim null K_r``: 0 where loops, edges or fixed points hold the surface (Nitsche's
+    penalty, the constraints); else the energy's polynomials, which the extension
+    reproduces; on a rational net the constants alone under tension in u and v (``Σ R_k =
+    1``), and None (not known from the structure) without it."""
+    if holds:
+        return 0
+    if net_weights_of(surface) is not None:
+        return 1 if material.w10 and material.w01 else None
+    bases = (surface.basis_u, surface.basis_v)
+    return int(rigid.rigid_count(rigid.parametric_terms(material), *bases,
+                                 build_constraints(*bases, "free")))
+
+
+def _loop_presets(presets: Mapping[str, str], names: tuple[str, ...],
+                  counts: Mapping[str, int]) -> list[str | tuple[str, ...]]:
+    """Each loop's preset, or its trim edges' (``name.k``, else the loop's) where some
+    edge of it is named."""
+    out: list[str | tuple[str, ...]] = []
+    for name in names:
+        keys = [f"{name}.{k}" for k in range(counts[name])]
+        if any(key in presets for key in keys):
+            out.append(tuple(presets.get(key, presets[name]) for key in keys))
+        else:
+            out.append(presets[name])
+    return out
 
 
 def loop_quadrature(domain: TrimDomain, grid: Grid, order: int, loops: tuple | None = None
                     ) -> tuple[NDArray[np.float64], ...]:
     """Gauss points along every loop piece (of ``loops``, default all): points ``(P, 2)``,
     arc-length weights ``(P,)``, outward unit normals ``(P, 2)``, unit tangents ``(P, 2)``
-    (with ``Ω`` on their left) and the loop index ``(P,)`` among those split."""
+    (with ``Ω`` on their left), the loop index ``(P,)`` among those split and the trim edge
+    ``(P,)`` of each point in its loop (:attr:`TrimDomain.edges`; 0 where a loop is one)."""
     xi, om = np.polynomial.legendre.leggauss(order)
     pieces = loop_pieces(domain, grid, loops)
     half = 0.5 * (pieces.hi - pieces.lo)
@@ -191,25 +223,39 @@ def loop_quadrature(domain: TrimDomain, grid: Grid, order: int, loops: tuple | N
     ds = np.abs(half)[:, None] * om * speed
     normal = np.stack([run[..., 1], -run[..., 0]], axis=-1)
     loop = np.broadcast_to(pieces.loop[:, None], ds.shape)
+    labels = [None] * len(domain.loops) if loops is None else [
+        domain.edges[next(k for k, own in enumerate(domain.loops) if own is given)]
+        for given in loops]
+    edge = np.zeros(len(pieces.loop), int)
+    for k, own in enumerate(labels):          # a loop over the loops, not the points
+        if own is not None:
+            on = pieces.loop == k
+            edge[on] = np.asarray(own)[pieces.span[on]]
+    edge = np.broadcast_to(edge[:, None], ds.shape)
     return (point.reshape(-1, 2), ds.ravel(), normal.reshape(-1, 2), run.reshape(-1, 2),
-            loop.ravel())
+            loop.ravel(), edge.ravel())
 
 
-def nitsche_terms(surface: Any, material: Material, grid: Grid, held: Mapping[int, str]
-                  ) -> sp.csr_matrix:
-    """Nitsche's symmetric terms and penalties of the held loops (module docstring)."""
+def nitsche_terms(surface: Any, material: Material, grid: Grid,
+                  held: Mapping[int, str | tuple[str, ...]]) -> sp.csr_matrix:
+    """Nitsche's symmetric terms and penalties of the held loops (module docstring):
+    ``held[k]`` the preset of loop ``k``, or a tuple of the presets of its trim edges."""
     m = material
     domain = surface.trim
     first = 1 if holed_rectangle(surface) else 0       # the rectangle's edges are no loop
-    p, ds, n, s, loop = loop_quadrature(domain, grid, surface.basis_u.degree + 2,
-                                        domain.loops[first:])
+    p, ds, n, s, loop, edge = loop_quadrature(domain, grid, max(surface_degrees(surface)) + 2,
+                                              domain.loops[first:])
     loop = loop + first
+    preset = np.full(len(loop), "free", dtype=object)
+    for k, value in held.items():             # a loop over the loops, not the points
+        on = loop == k
+        preset[on] = value if isinstance(value, str) else np.asarray(value, object)[edge[on]]
     (_, lu), (_, lv) = surface.domain
     p = np.clip(p, 0.0, [lu, lv])
     orders = [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2), (3, 0), (2, 1), (1, 2), (0, 3)]
     if not (m.w20 or m.w11 or m.w02):
         orders = orders[:3]
-    B = tensor_values((surface.basis_u, surface.basis_v), p, orders)
+    B = surface_values(surface, p, orders)
     zero = sp.csr_matrix(B[(0, 0)].shape)
     D = lambda ab: B.get(ab, zero)  # noqa: E731
     nu, nv, su, sv = (sp.diags(x) for x in (n[:, 0], n[:, 1], s[:, 0], s[:, 1]))
@@ -218,24 +264,35 @@ def nitsche_terms(surface: Any, material: Material, grid: Grid, held: Mapping[in
              + m.w02 * nv @ D((0, 3))))
     gu = m.w20 * nu @ D((2, 0)) + m.w11 * nv @ D((1, 1))
     gv = m.w02 * nv @ D((0, 2)) + m.w11 * nu @ D((1, 1))
-    h = min(grid.h)
+    h = _cell_size(grid, p)
     bending, tension = max(m.w20, m.w11, m.w02), max(m.w10, m.w01)
-    beta = nitsche_penalty(surface.basis_u.degree)
-    gamma0 = beta * (bending / h ** 3 + tension / h)
-    gamma1 = beta * bending / h
+    beta = nitsche_penalty(max(surface_degrees(surface)))
+    gamma0 = sp.diags(beta * (bending / h ** 3 + tension / h))
+    gamma1 = sp.diags(beta * bending / h)
     K = sp.csr_matrix((B[(0, 0)].shape[1],) * 2)
-    for preset in ("pinned", "clamped"):
-        on = np.isin(loop, [k for k, v in held.items() if v == preset])
+    for kind in ("pinned", "clamped"):
+        on = preset == kind
         if not on.any():
             continue
         w = sp.diags(np.where(on, ds, 0.0))
         b0, bu, bv = B[(0, 0)], B[(1, 0)], B[(0, 1)]
-        if preset == "clamped":
+        if kind == "clamped":
             term = b0.T @ w @ g0 + bu.T @ w @ gu + bv.T @ w @ gv
-            penalty = gamma0 * (b0.T @ w @ b0) + gamma1 * (bu.T @ w @ bu + bv.T @ w @ bv)
+            penalty = (b0.T @ w @ gamma0 @ b0
+                       + bu.T @ w @ gamma1 @ bu + bv.T @ w @ gamma1 @ bv)
         else:
             bs = su @ bu + sv @ bv
             term = b0.T @ w @ g0 + bs.T @ w @ (su @ gu + sv @ gv)
-            penalty = gamma0 * (b0.T @ w @ b0)
+            penalty = b0.T @ w @ gamma0 @ b0
         K = K - term - term.T + penalty
     return K.tocsr()
+
+
+def _cell_size(grid: Grid, p: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``h`` at each point ``(P, 2)``: the smaller side of the knot cell holding it."""
+    sides = []
+    for axis in (0, 1):
+        lines = grid.lines(axis)
+        cell = np.clip(grid.cell_of(p[:, axis], axis), 0, len(lines) - 2)
+        sides.append(np.diff(lines)[cell])
+    return np.minimum(*sides)

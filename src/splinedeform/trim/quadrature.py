@@ -69,11 +69,12 @@ def cell_gauss(cells: NDArray[np.int64], grid: Grid, order: int
     """Tensor Gauss–Legendre, ``order × order`` points, on whole cells ``(C, 2)``: points
     ``(C order², 2)``, weights and the cell of each point."""
     xi, om = np.polynomial.legendre.leggauss(order)
-    h = np.array(grid.h)
+    lo, h = grid.sides(cells)
     ref = np.stack(np.meshgrid(xi, xi, indexing="ij"), axis=-1).reshape(-1, 2)
-    ref_w = np.outer(om, om).ravel() * 0.25 * h.prod()
-    points = ((cells[:, None, :] + 0.5 * (ref[None] + 1)) * h).reshape(-1, 2)
-    return points, np.tile(ref_w, len(cells)), np.repeat(cells, len(ref), axis=0)
+    ref_w = np.outer(om, om).ravel() * 0.25
+    points = (lo[:, None, :] + 0.5 * (ref[None] + 1) * h[:, None, :]).reshape(-1, 2)
+    weights = (ref_w[None] * h.prod(axis=1)[:, None]).ravel()
+    return points, weights, np.repeat(cells, len(ref), axis=0)
 
 
 def trim_quadrature(domain: TrimDomain, grid: Grid, order: int) -> TrimQuadrature:
@@ -89,7 +90,7 @@ def trim_quadrature(domain: TrimDomain, grid: Grid, order: int) -> TrimQuadratur
     if not isinstance(order, (int, np.integer)) or order < 1:
         raise InputError(f"quadrature order must be an integer >= 1, got {order!r}")
     xi, om = np.polynomial.legendre.leggauss(order)
-    h = np.array(grid.h)
+    x_lines = grid.lines(0)
     pieces = loop_pieces(domain, grid)
     classes = classify_cells(domain, grid, pieces)
 
@@ -105,12 +106,12 @@ def trim_quadrature(domain: TrimDomain, grid: Grid, order: int) -> TrimQuadratur
         bcell.reshape(-1, 2)]
     y_lines = grid.lines(1)
     for i in np.unique(np.argwhere(classes == CUT)[:, 0]):
-        x1 = (i + 1) * h[0]
+        x1 = x_lines[i + 1]
         cut_rows = np.flatnonzero(classes[i] == CUT)
         ys = np.unique(np.concatenate([y_lines, _vertical_crossings(domain, x1)]))
         lo, hi = ys[:-1], ys[1:]
         mid = 0.5 * (lo + hi)
-        row = np.minimum(np.floor(mid / h[1]).astype(int), grid.cells[1] - 1)
+        row = np.minimum(grid.cell_of(mid, 1), grid.cells[1] - 1)
         keep = domain.contains(np.stack([np.full_like(mid, x1), mid], axis=-1)) & np.isin(
             row, cut_rows) & (hi > lo)
         lo, hi, row = lo[keep], hi[keep], row[keep]
@@ -121,7 +122,7 @@ def trim_quadrature(domain: TrimDomain, grid: Grid, order: int) -> TrimQuadratur
         edges_c.append(np.stack([np.full(y.size, i), np.repeat(row, order)], axis=-1))
     bx, by = np.concatenate(edges_x), np.concatenate(edges_y)
     bw, bc = np.concatenate(edges_w), np.concatenate(edges_c)
-    x0 = bc[:, 0] * h[0]
+    x0 = x_lines[bc[:, 0]]
     half = 0.5 * (bx - x0)
     s = x0[:, None] + half[:, None] * (1 + xi)
     p_cut = np.stack([s, np.broadcast_to(by[:, None], s.shape)], axis=-1).reshape(-1, 2)

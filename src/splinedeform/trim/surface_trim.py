@@ -29,18 +29,83 @@ def loop_outside(surface: Any, loop: Loop) -> str | None:
 
 
 def trim_grid(surface: Any) -> Grid:
-    """The knot cells of a surface that can be trimmed: equal cells in both directions
-    (``uniform`` or ``open`` knots), one degree."""
-    bases = (surface.basis_u, surface.basis_v)
+    """The knot cells of a surface that can be trimmed: ``uniform`` or ``open`` knots (equal
+    cells), or a general clamped knot vector with simple interior knots (cells between its
+    breakpoints), in each direction; the degrees may differ."""
+    from ..knots import KnotVectorBasis
+
+    bases = tuple(polynomial_basis(b) for b in (surface.basis_u, surface.basis_v))
+    equal = True
     for name, basis in zip("uv", bases):
-        if not isinstance(basis, BSplineBasis) or basis.kind not in ("uniform", "open"):
+        if isinstance(basis, KnotVectorBasis):
+            problem = _knot_problem(basis)
+            if problem:
+                raise InputError(f"a trimmed surface needs in {name} uniform or open knots or "
+                                 f"a clamped knot vector with simple interior knots: {problem}")
+            equal = False
+        elif not isinstance(basis, BSplineBasis) or basis.kind not in ("uniform", "open"):
             kind = getattr(basis, "kind", type(basis).__name__)
-            raise InputError(f"a trimmed surface needs equal knot cells ('uniform' or 'open' "
-                             f"knots) in {name}, got {kind!r}")
-    if bases[0].degree != bases[1].degree:
-        raise InputError(f"a trimmed surface needs one degree in u and v, got "
-                         f"{bases[0].degree} and {bases[1].degree}")
-    return Grid((bases[0].cells, bases[1].cells), (bases[0].length, bases[1].length))
+            raise InputError(f"a trimmed surface needs in {name} uniform or open knots or a "
+                             f"clamped knot vector with simple interior knots, got {kind!r}")
+    if equal:
+        return Grid((bases[0].cells, bases[1].cells), (bases[0].length, bases[1].length))
+    return Grid.of_breaks(*(_breaks(b) for b in bases))
+
+
+def polynomial_basis(basis: Any) -> Any:
+    """The B-splines under a per-direction rational basis (the basis itself otherwise)."""
+    from ..knots import RationalBasis
+
+    return basis.basis if isinstance(basis, RationalBasis) else basis
+
+
+def net_weights_of(surface: Any) -> NDArray[np.float64] | None:
+    """The NURBS weights of the net, flat (``a_k b_l`` of per-direction rational bases);
+    None for a polynomial surface."""
+    from ..knots import RationalBasis
+
+    if surface.net_weights is not None:
+        return np.asarray(surface.net_weights, dtype=float).ravel()
+    factors = [b.weights if isinstance(b, RationalBasis) else np.ones(b.size)
+               for b in (surface.basis_u, surface.basis_v)]
+    if not any(isinstance(b, RationalBasis) for b in (surface.basis_u, surface.basis_v)):
+        return None
+    return np.outer(*factors).ravel()
+
+
+def _breaks(basis: Any) -> NDArray[np.float64]:
+    """The cells' lines of a basis: its breakpoints, or equal cells."""
+    if hasattr(basis, "breaks"):
+        return np.asarray(basis.breaks, dtype=float)
+    return np.arange(basis.cells + 1) * (basis.length / basis.cells)
+
+
+def _knot_problem(basis: Any) -> str | None:
+    """What keeps a general knot vector from a trim (None when it can take one): the
+    B-spline ``k`` must live on cells ``k - n .. k``, so the ends are clamped (``n + 1``
+    equal knots, the first 0) and interior knots simple."""
+    t, n = np.asarray(basis.knots, dtype=float), basis.degree
+    breaks = np.asarray(basis.breaks, dtype=float)
+    if breaks[0] != 0.0 or np.any(t[:n + 1] != t[0]) or np.any(t[-n - 1:] != t[-1]):
+        return f"its knots {t.tolist()} are not clamped from 0"
+    if len(t) != len(breaks) + 2 * n:
+        return f"its knots {t.tolist()} repeat an interior knot"
+    return None
+
+
+def extension_knots(surface: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+    """The knot vectors Höllig's extension of ``surface`` needs
+    (:func:`~splinedeform.trim.web.web_basis`): None where both directions have uniform
+    knots (Lagrange interpolation in the index is then exact)."""
+    bases = tuple(polynomial_basis(b) for b in (surface.basis_u, surface.basis_v))
+    if all(getattr(b, "kind", None) == "uniform" for b in bases):
+        return None
+    return tuple(np.asarray(b.knots, dtype=float) for b in bases)  # type: ignore[return-value]
+
+
+def surface_degrees(surface: Any) -> tuple[int, int]:
+    """``(n_u, n_v)`` of a surface."""
+    return surface.basis_u.degree, surface.basis_v.degree
 
 
 def whole_rectangle(surface: Any, loop: Loop) -> bool:

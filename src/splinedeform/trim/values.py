@@ -7,7 +7,7 @@ net), for the ``(n_u+1)(n_v+1)`` functions not vanishing at the point.
 
 from __future__ import annotations
 
-from typing import Iterable
+from typing import Any, Iterable
 
 import numpy as np
 import scipy.sparse as sp
@@ -36,3 +36,25 @@ def tensor_values(bases: tuple, p: NDArray[np.float64], orders: Iterable[Orders]
         vals = (du[a][:, :, None] * dv[b][:, None, :]).reshape(len(p), -1)
         out[(a, b)] = sp.csr_matrix((vals.ravel(), cols.ravel(), indptr), shape=shape)
     return out
+
+
+def surface_values(surface: Any, p: NDArray[np.float64], orders: Iterable[Orders]
+                   ) -> dict[Orders, sp.csr_matrix]:
+    """:func:`tensor_values` of the basis of ``surface``: its B-splines (or per-direction
+    rational bases), or with NURBS weights ``w_kl`` that do not factor the rational
+    ``R_kl = w_kl b_k b_l / W`` and its derivatives by Leibniz' rule
+    (:func:`splinedeform.rational.basis_derivatives`), in the same sparse layout."""
+    orders = list(orders)
+    bases = (surface.basis_u, surface.basis_v)
+    if surface.net_weights is None:
+        return tensor_values(bases, p, orders)
+    from ..rational import basis_derivatives
+
+    bu, bv = bases
+    iu, du = bu.nonzero_derivatives(p[:, 0], max(a for a, _ in orders))
+    iv, dv = bv.nonzero_derivatives(p[:, 1], max(b for _, b in orders))
+    cols, R = basis_derivatives(iu, du, iv, dv, np.asarray(surface.net_weights, float), orders)
+    indptr = np.arange(0, cols.size + 1, cols.shape[1])
+    shape = (len(p), bu.size * bv.size)
+    return {ab: sp.csr_matrix((R[ab].ravel(), cols.ravel(), indptr), shape=shape)
+            for ab in orders}
