@@ -95,15 +95,26 @@ class LowestModes:
 
     def columns(self, m: int) -> Array:
         """The lowest ``m`` modes ``V S[:, :m]`` (only these are formed: ``O(n p m)``)."""
-        return self.krylov @ self.ritz[:, :m]
+        return _gemm(1.0, self.krylov, self.ritz[:, :m])
 
     def project(self, F: Array) -> Array:
         """``Φᵀ F = Sᵀ (Vᵀ F)`` for ``F`` of shape ``(n, c)`` → ``(m, c)``."""
-        return self.ritz.T @ (self.krylov.T @ F)
+        return self.ritz.T @ _gemm(1.0, self.krylov, F, trans_a=1)
 
     def combine(self, Q: Array) -> Array:
         """``Φ[:, :r] Q = V (S[:, :r] Q)`` for ``Q`` of shape ``(r, c)``."""
-        return self.krylov @ (self.ritz[:, :Q.shape[0]] @ Q)
+        return _gemm(1.0, self.krylov, self.ritz[:, :Q.shape[0]] @ Q)
+
+
+def _gemm(alpha: float, a: Array, b: Array, beta: float = 0.0, c: Array | None = None,
+          trans_a: int = 0) -> Array:
+    """``alpha op(a) b + beta c`` by BLAS ``dgemm`` (``op(a) = aᵀ`` with ``trans_a``), ``c``
+    overwritten where it is Fortran-ordered. Called directly: for the tall Krylov basis
+    (``n × p``, column-major) times a block of ``b`` columns numpy's ``@`` took 2.5 times
+    as long at 128² (45 ms against 18 ms for ``p = 800``, one BLAS thread)."""
+    if c is None:
+        return sla.blas.dgemm(alpha, a, b, trans_a=trans_a)
+    return sla.blas.dgemm(alpha, a, b, beta, c, trans_a=trans_a, overwrite_c=1)
 
 
 def _m_orthonormal(W: Array, MW: Array) -> tuple[Array, Array, Array]:
@@ -114,8 +125,10 @@ def _m_orthonormal(W: Array, MW: Array) -> tuple[Array, Array, Array]:
     try:
         L = np.linalg.cholesky(G)
         if np.min(np.diag(L)) > 1e-7 * np.max(np.diag(L)):
-            Q = sla.solve_triangular(L, W.T, lower=True, check_finite=False).T
-            MQ = sla.solve_triangular(L, MW.T, lower=True, check_finite=False).T
+            # Q = W L⁻ᵀ by a triangular solve from the right (dtrsm), in Fortran order: the
+            # columns go into the column-major basis as they are
+            Q = sla.blas.dtrsm(1.0, L, W, side=1, lower=1, trans_a=1)
+            MQ = sla.blas.dtrsm(1.0, L, MW, side=1, lower=1, trans_a=1)
             return Q, MQ, L.T
     except np.linalg.LinAlgError:
         pass
@@ -197,13 +210,13 @@ class BlockLanczos:
         """
         p, lo = self.p, self.lo
         V, MV = self.V[:, :p], self.MV[:, :p]
-        W = self.lu.solve(self.MV[:, lo:p])
+        W = np.asfortranarray(self.lu.solve(self.MV[:, lo:p]))
         self.solves += p - lo
         near = max(0, lo - (p - lo))            # the last two blocks
-        C = MV[:, near:].T @ W
-        W -= V[:, near:] @ C
-        C2 = MV.T @ W
-        W -= V @ C2
+        C = _gemm(1.0, MV[:, near:], W, trans_a=1)
+        W = _gemm(-1.0, V[:, near:], C, 1.0, W)
+        C2 = _gemm(1.0, MV, W, trans_a=1)
+        W = _gemm(-1.0, V, C2, 1.0, W)
         C2[near:] += C
         self.H[:p, lo:p] = C2
         self.next = _m_orthonormal(W, self.M @ W)
