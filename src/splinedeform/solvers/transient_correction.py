@@ -42,6 +42,7 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from .mode_count import omitted_envelope
+from .products import gemm
 
 Array = NDArray[np.float64]
 DEGREE = 8
@@ -159,7 +160,9 @@ class TransientCorrection:
 
         def Z(v: Array) -> Array:               # 2X − I on the complement of Φ
             x = lam_next * np.asarray(solve(M @ v)).reshape(v.shape)
-            x -= phi @ (phi.T @ (M @ x))        # rounding and inexact modes stay out
+            # rounding and inexact modes stay out
+            x = gemm(-1.0, phi, gemm(1.0, phi, np.asarray(M @ x), trans_a=1), 1.0,
+                     np.asfortranarray(x))
             return 2.0 * x - v
 
         terms = [R, Z(R)] if degree >= 1 else [R]
