@@ -51,9 +51,13 @@ class Readout(_Energies):
 
     def nets(self, d_free: Array, rest: bool = True) -> Array:
         """``[p_rest +] T d_free``: ``(..., n_free, 3)`` → ``(..., n_u, n_v, 3)``."""
-        full = _expand(self.T, d_free)
-        net = full.reshape(d_free.shape[:-2] + self.surface.shape + (3,))
-        return self.surface.control_points + net if rest else net
+        net = _expand(self.T, d_free).reshape(d_free.shape[:-2] + self.surface.shape + (3,))
+        rest_points = self.surface.control_points
+        if rest and net.dtype == np.result_type(net, rest_points):
+            net += rest_points                          # a new array: added in place
+        elif rest:
+            net = rest_points + net
+        return net
 
 
 @dataclass(frozen=True)
@@ -100,7 +104,32 @@ class BodyReadout(_Energies):
 
 
 def _expand(T: sp.spmatrix, d_free: Array) -> Array:
-    """``T d_free`` for ``d_free`` of shape ``(..., n_free, 3)`` → ``(..., n_points, 3)``."""
+    """``T d_free`` for ``d_free`` of shape ``(..., n_free, 3)`` → ``(..., n_points, 3)``.
+
+    Where ``T`` only selects points (one entry 1 per column, as for clamped or fixed
+    control points) the product is a gather of rows of ``d_free``, with no transposed
+    copies of it."""
     lead = d_free.shape[:-2]
+    rows = _selected_rows(T)
+    if rows is not None:                # gather each point's free row, zero the others
+        source = np.zeros(T.shape[0], dtype=np.intp)
+        source[rows] = np.arange(rows.size)
+        fixed = np.ones(T.shape[0], dtype=bool)
+        fixed[rows] = False
+        full = np.take(d_free, source, axis=-2)
+        full[..., fixed, :] = 0.0
+        return full
     flat = np.moveaxis(d_free, -2, 0).reshape(T.shape[1], -1)
     return np.moveaxis((T @ flat).reshape((T.shape[0],) + lead + (3,)), 0, -2)
+
+
+def _selected_rows(T: sp.spmatrix) -> NDArray[np.int64] | None:
+    """The row of each column of ``T`` when ``T`` is a selection (one entry 1 per column,
+    distinct rows), else ``None``."""
+    if not sp.issparse(T) or T.nnz != T.shape[1]:
+        return None
+    C = T.tocsc()
+    if not (np.all(np.diff(C.indptr) == 1) and np.all(C.data == 1.0)):
+        return None
+    rows = np.asarray(C.indices)
+    return rows if np.unique(rows).size == rows.size else None

@@ -26,6 +26,7 @@ from math import pi
 import numpy as np
 from numpy.typing import NDArray
 
+from .basis import BSplineBasis
 from .errors import InputError
 from .fit import (  # noqa: F401 (FIT_METHODS, POINT_METHODS and the fitting functions: public here)
     CLOSED_CELLS, DEFAULT_CELLS, FIT_METHODS, POINT_METHODS, Domain, Map, _bases, _check_method,
@@ -93,17 +94,35 @@ def plane(size: float | tuple[float, float] = (1.0, 1.0),
     size : float or (L_u, L_v)
         Side lengths; the parameter domain is the rectangle itself.
 
-    Every method reproduces it exactly for any degree ``n >= 1`` (linear precision);
-    ``x_u × x_v = (0, 0, 1)``.
+    Every method reproduces it exactly for any degree ``n >= 1`` (linear precision), so
+    on open and uniform knots no fit is made: the net is the knot averages
+    ``P_ij = (ξ_i, η_j, 0)``, ``ξ_i = (t_{i+1} + … + t_{i+n}) / n``, for which
+    ``Σ_i ξ_i B_i(u) = u`` on ``[0, L_u]`` (Marsden's identity), and ``fit_error`` is 0
+    (rounding of the averages aside). ``x_u × x_v = (0, 0, 1)``.
     """
     L_u, L_v = (_positive(s, "plane size") for s in _pair(size, "size"))
     kinds = _knot_kinds(knots)
     bu, bv = _bases(cells, degree, kinds, (L_u, L_v))
+    method = _check_method(method)
+    if not (bu.periodic or bv.periodic):
+        xi, eta = _knot_averages(bu), _knot_averages(bv)
+        P = np.zeros((xi.size, eta.size, 3))
+        P[:, :, 0], P[:, :, 1] = xi[:, None], eta[None, :]
+        return Surface(P, bu, bv, fit_error=0.0, name="plane")
 
     def f(u: NDArray[np.float64], v: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.stack([u, v, np.zeros_like(u)], axis=-1)
 
-    return _fitted(f, bu, bv, _check_method(method), "plane")
+    return _fitted(f, bu, bv, method, "plane")       # periodic: refused as not closed
+
+
+def _knot_averages(basis: BSplineBasis) -> NDArray[np.float64]:
+    """``ξ_i = (t_{i+1} + … + t_{i+n}) / n`` of each function of a non-periodic basis (for
+    uniform knots some lie outside ``[0, L]``: the true averages, not the clamped Greville
+    points of :meth:`~splinedeform.basis.BSplineBasis.greville`)."""
+    n = basis.degree
+    window = np.lib.stride_tricks.sliding_window_view(basis.knots[1:-1], n)[:basis.size]
+    return window.mean(axis=1)
 
 
 def saddle(size: float | tuple[float, float] = (1.0, 1.0), height: float = 0.25,

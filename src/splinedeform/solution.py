@@ -328,7 +328,11 @@ class ModalSolution(Solution):
                 if v is not None:
                     v[span, :, active] = self.basis.expand(V)
             if self.correction is not None:
-                d[span] += self.correction(part)
+                add = getattr(self.correction, "add_to", None)     # in place, if it can
+                if add is not None:
+                    add(part, d[span])
+                else:
+                    d[span] += self.correction(part)
             i += part.size
         return d, v
 

@@ -76,19 +76,23 @@ class BlockCholesky:
         self.coupling: list[Array] = []         # C_i = L_{i+1,i}
         previous: Array | None = None
         for i, (lo, hi) in enumerate(zip(self.edges[:-1], self.edges[1:])):
-            block = A[lo:hi, lo:hi].toarray()
-            if previous is not None:
-                block -= previous @ previous.T
-            L = np.linalg.cholesky(block)
+            block = np.asfortranarray(A[lo:hi, lo:hi].toarray())
+            if previous is not None:        # the lower triangle of A_ii − C Cᵀ (dsyrk)
+                block = sla.blas.dsyrk(-1.0, previous, 1.0, block, lower=1, overwrite_c=1)
+            L, info = sla.lapack.dpotrf(block, lower=1, clean=1, overwrite_a=1)
+            if info:
+                raise np.linalg.LinAlgError("a diagonal block of the factor is not positive "
+                                            "definite")
             inverse, info = sla.lapack.dtrtri(L, lower=1)
             if info:
                 raise np.linalg.LinAlgError("a diagonal block of the factor is singular")
             self.inverse.append(np.asfortranarray(np.tril(inverse)))
             if hi < n:
-                below = A[hi:self.edges[i + 2], lo:hi].toarray()
+                below = np.asfortranarray(A[hi:self.edges[i + 2], lo:hi].toarray())
                 # C_i = A_{i+1,i} L_ii^{-T}: upper triangular (trapezoidal for a short last
-                # block) since A_{i+1,i} is, with w ≥ b
-                previous = below @ self.inverse[-1].T
+                # block) since A_{i+1,i} is, with w ≥ b; a triangular product (dtrmm)
+                previous = sla.blas.dtrmm(1.0, self.inverse[-1], below, side=1, lower=1,
+                                          trans_a=1)
                 self.coupling.append(np.asfortranarray(np.triu(previous)))
 
     def solve(self, rhs: Array) -> Array:

@@ -44,6 +44,16 @@ class StaticCorrection:
             out += np.where(t >= 0, np.sin(omega * t + phase), 0.0)[:, None, None] * part
         return out
 
+    def add_to(self, t: Array, out: Array) -> None:
+        """``out += `` the correction at times ``t`` (``out`` of shape ``(F, n_free, 3)``),
+        in place; of the jumps only the coordinates some ``R_j`` moves are touched."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        on = (t[:, None] > self.jump_times[None, :]).astype(float)
+        for c in np.flatnonzero(np.any(self.jump_parts != 0, axis=(0, 1))):
+            out[:, :, c] += on @ self.jump_parts[:, :, c]
+        for omega, phase, part in self.harmonics:
+            out += np.where(t >= 0, np.sin(omega * t + phase), 0.0)[:, None, None] * part
+
     def coordinate(self, t: Array, p: int, c: int) -> Array:
         """The correction of coordinate ``c`` of unknown ``p`` at times ``t`` → ``(F,)``."""
         t = np.atleast_1d(np.asarray(t, dtype=float))

@@ -46,20 +46,28 @@ DECADES = 12.0
 
 
 def decay_bound(lam: Array, c: Array, tau: Array) -> Array:
-    """Upper bound of ``|P_11(λ, c, τ)|`` (see the module docstring), broadcast."""
-    lam, c, tau = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (lam, c, tau)))
+    """Upper bound of ``|P_11(λ, c, τ)|`` (see the module docstring), broadcast.
+
+    Both branches are one form, ``min(1, e^{−sτ} min(A, 1 + a·min(τ, τ₀)))``: under-damped
+    ``s = a``, ``A = ∞``, ``τ₀ = 1/ω_d``; over-damped ``s = r``, ``A = (a + κ)/(2κ)``,
+    ``τ₀ = ∞``. ``s``, ``A`` and ``τ₀`` depend on ``(λ, c)`` only and are formed on their
+    broadcast shape; the ``τ`` axis costs one exponential per entry.
+    """
+    lam, c = np.broadcast_arrays(np.asarray(lam, dtype=float), np.asarray(c, dtype=float))
+    tau = np.asarray(tau, dtype=float)
     a = 0.5 * c
     d = a * a - lam
-    out = np.ones(lam.shape)
     under = d < 0
     wd = np.sqrt(np.where(under, -d, 1.0))
-    b_under = np.exp(-a * tau) * (1.0 + a * np.minimum(tau, 1.0 / wd))
     kappa = np.sqrt(np.where(under, 0.0, d))
     rate = lam / np.where(a + kappa > 0, a + kappa, 1.0)     # used where over-damped
     ratio = np.where(kappa > 0, (a + kappa) / (2.0 * np.where(kappa > 0, kappa, 1.0)), np.inf)
-    b_over = np.exp(-rate * tau) * np.minimum(ratio, 1.0 + a * tau)
-    out = np.minimum(out, np.where(under, b_under, b_over))
-    return np.where(tau > 0, out, 1.0)
+    s = np.where(under, a, rate)
+    cap = np.where(under, np.inf, ratio)
+    until = np.where(under, 1.0 / wd, np.inf)
+    later = np.maximum(tau, 0.0)                            # τ ≤ 0 reads 1 below
+    out = np.exp(-s * later) * np.minimum(cap, 1.0 + a * np.minimum(later, until))
+    return np.where(tau > 0, np.minimum(out, 1.0), 1.0)
 
 
 def omitted_envelope(lam_first: float, gamma: float, beta: float, tau: Array) -> Array:

@@ -42,6 +42,7 @@ from numpy.typing import NDArray
 from ..errors import SingularSystemError
 from .block_cholesky import block_cholesky
 from .factor import band_cholesky
+from .products import gemm as _gemm
 
 Array = NDArray[np.float64]
 TOLERANCE = 1e-10
@@ -95,15 +96,15 @@ class LowestModes:
 
     def columns(self, m: int) -> Array:
         """The lowest ``m`` modes ``V S[:, :m]`` (only these are formed: ``O(n p m)``)."""
-        return self.krylov @ self.ritz[:, :m]
+        return _gemm(1.0, self.krylov, self.ritz[:, :m])
 
     def project(self, F: Array) -> Array:
         """``Φᵀ F = Sᵀ (Vᵀ F)`` for ``F`` of shape ``(n, c)`` → ``(m, c)``."""
-        return self.ritz.T @ (self.krylov.T @ F)
+        return self.ritz.T @ _gemm(1.0, self.krylov, F, trans_a=1)
 
     def combine(self, Q: Array) -> Array:
         """``Φ[:, :r] Q = V (S[:, :r] Q)`` for ``Q`` of shape ``(r, c)``."""
-        return self.krylov @ (self.ritz[:, :Q.shape[0]] @ Q)
+        return _gemm(1.0, self.krylov, self.ritz[:, :Q.shape[0]] @ Q)
 
 
 def _m_orthonormal(W: Array, MW: Array) -> tuple[Array, Array, Array]:
@@ -114,8 +115,10 @@ def _m_orthonormal(W: Array, MW: Array) -> tuple[Array, Array, Array]:
     try:
         L = np.linalg.cholesky(G)
         if np.min(np.diag(L)) > 1e-7 * np.max(np.diag(L)):
-            Q = sla.solve_triangular(L, W.T, lower=True, check_finite=False).T
-            MQ = sla.solve_triangular(L, MW.T, lower=True, check_finite=False).T
+            # Q = W L⁻ᵀ by a triangular solve from the right (dtrsm), in Fortran order: the
+            # columns go into the column-major basis as they are
+            Q = sla.blas.dtrsm(1.0, L, W, side=1, lower=1, trans_a=1)
+            MQ = sla.blas.dtrsm(1.0, L, MW, side=1, lower=1, trans_a=1)
             return Q, MQ, L.T
     except np.linalg.LinAlgError:
         pass
@@ -164,12 +167,15 @@ class BlockLanczos:
         self._append(Q, MQ)
 
     def _reserve(self, size: int) -> None:
-        """Room for ``size`` basis vectors, at least twice the room before (copies add up
-        to at most the final size). Column-major: the vectors in use are one contiguous
-        prefix, and the memory of the columns not yet written is never touched."""
+        """Room for ``size`` basis vectors: twice ``size`` and at least twice the room
+        before (copies add up to at most the final size; a later call asking up to twice
+        as many modes copies nothing). Column-major: the vectors in use are one contiguous
+        prefix, and the memory of the columns not yet written is never touched, so the
+        room costs address space, not memory (at 128² a copy of 688 columns of ``V`` and
+        ``MV`` cost 0.36 s of processor time when the mode count grew from 256 to 322)."""
         if size <= self.V.shape[1]:
             return
-        size = min(self.n, max(size, 2 * self.V.shape[1]))
+        size = min(self.n, 2 * max(size, self.V.shape[1]))
         for name in ("V", "MV"):
             old = getattr(self, name)
             new = np.empty((self.n, size), order="F")
@@ -197,13 +203,13 @@ class BlockLanczos:
         """
         p, lo = self.p, self.lo
         V, MV = self.V[:, :p], self.MV[:, :p]
-        W = self.lu.solve(self.MV[:, lo:p])
+        W = np.asfortranarray(self.lu.solve(self.MV[:, lo:p]))
         self.solves += p - lo
         near = max(0, lo - (p - lo))            # the last two blocks
-        C = MV[:, near:].T @ W
-        W -= V[:, near:] @ C
-        C2 = MV.T @ W
-        W -= V @ C2
+        C = _gemm(1.0, MV[:, near:], W, trans_a=1)
+        W = _gemm(-1.0, V[:, near:], C, 1.0, W)
+        C2 = _gemm(1.0, MV, W, trans_a=1)
+        W = _gemm(-1.0, V, C2, 1.0, W)
         C2[near:] += C
         self.H[:p, lo:p] = C2
         self.next = _m_orthonormal(W, self.M @ W)

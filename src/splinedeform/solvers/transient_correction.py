@@ -42,6 +42,7 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from .mode_count import omitted_envelope
+from .products import gemm
 
 Array = NDArray[np.float64]
 DEGREE = 8
@@ -141,6 +142,9 @@ class TransientCorrection:
     M : mass matrix; ``phi`` the kept modes (``Φᵀ M Φ = I``), ``lam_next = λ_{m+1}``.
     jump_times, jump_parts : ``t_j`` and ``R_j`` of shape ``(J, n, c)`` (the static
         correction's parts, :class:`~.mode_acceleration.StaticCorrection`).
+
+    Only the coordinates ``c`` in which some ``R_j`` is non-zero (the loaded ones) are
+    solved and kept: ``T_k(2X − I)`` maps a zero column to zero.
     """
 
     def __init__(self, solve: Callable[[Array], Array], M: sp.spmatrix, phi: Array,
@@ -149,18 +153,24 @@ class TransientCorrection:
         self.lam_next, self.gamma, self.beta, self.degree = lam_next, gamma, beta, degree
         self.jump_times = np.asarray(jump_times, dtype=float)
         self.jump_parts = np.asarray(jump_parts, dtype=float)
-        J, n, w = self.jump_parts.shape
-        R = self.jump_parts.transpose(1, 0, 2).reshape(n, J * w)
+        self.moving = np.flatnonzero(np.any(self.jump_parts != 0, axis=(0, 1)))
+        J, n, _ = self.jump_parts.shape
+        w = self.moving.size
+        R = self.jump_parts[:, :, self.moving].transpose(1, 0, 2).reshape(n, J * w)
 
         def Z(v: Array) -> Array:               # 2X − I on the complement of Φ
             x = lam_next * np.asarray(solve(M @ v)).reshape(v.shape)
-            x -= phi @ (phi.T @ (M @ x))        # rounding and inexact modes stay out
+            # rounding and inexact modes stay out
+            x = gemm(-1.0, phi, gemm(1.0, phi, np.asarray(M @ x), trans_a=1), 1.0,
+                     np.asfortranarray(x))
             return 2.0 * x - v
 
         terms = [R, Z(R)] if degree >= 1 else [R]
         while len(terms) <= degree:
             terms.append(2.0 * Z(terms[-1]) - terms[-2])
-        self.terms = np.array(terms).reshape(degree + 1, n, J, w)   # T_k(2X − I) R_j
+        # T_k(2X − I) R_j as (J, w, d + 1, n): each jump's and coordinate's terms contiguous
+        self.terms = np.ascontiguousarray(
+            np.array(terms).reshape(degree + 1, n, J, w).transpose(2, 3, 0, 1))
 
     def bound_factor(self, tau: Array) -> Array:
         """``E_d(λ_{m+1}, τ)`` at ``tau`` (``‖e‖_M ≤ Σ_j ‖R_j‖_M E_d(τ_j)``)."""
@@ -168,25 +178,42 @@ class TransientCorrection:
 
     def __call__(self, t: Array) -> Array:
         """The correction at times ``t`` (F,) → ``(F, n, c)``."""
-        return self._at(t, slice(None), slice(None))
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        out = np.zeros((t.size,) + self.jump_parts.shape[1:])
+        self.add_to(t, out)
+        return out
+
+    def add_to(self, t: Array, out: Array) -> None:
+        """``out += `` the correction at times ``t`` (``out`` of shape ``(F, n, c)``), in
+        place and in the moving coordinates only."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        for c, column in enumerate(self.moving):
+            out[:, :, column] += self._at(t, slice(None), c)
 
     def coordinate(self, t: Array, p: int, c: int) -> Array:
         """The correction of coordinate ``c`` of unknown ``p`` at times ``t`` → ``(F,)``."""
-        return self._at(t, slice(p, p + 1), slice(c, c + 1))[:, 0, 0]
-
-    def _at(self, t: Array, rows: slice, columns: slice) -> Array:
         t = np.atleast_1d(np.asarray(t, dtype=float))
-        parts = self.jump_parts[:, rows, columns]                   # (J, r, w)
-        terms = self.terms[:, rows, :, columns]                     # (d + 1, r, J, w)
-        J, r, w = parts.shape
-        out = np.zeros((t.size, r, w))
+        where = np.flatnonzero(self.moving == c)
+        if not where.size:
+            return np.zeros(t.size)
+        return self._at(t, slice(p, p + 1), int(where[0]))[:, 0]
+
+    def _at(self, t: Array, rows: slice, c: int) -> Array:
+        """The correction in moving coordinate number ``c`` at ``t`` → ``(F, r)``."""
+        parts = self.jump_parts[:, rows, self.moving[c]]           # (J, r)
+        J, r = parts.shape
+        out = np.zeros((t.size, r))
         for j in range(J):                      # a few jumps; vectorised over times
             tau = t - self.jump_times[j]
             on = np.flatnonzero(tau > 0)
             if not on.size:
                 continue
-            c, _ = fitted(self.lam_next, self.gamma, self.beta, tau[on], self.degree)
+            coef, _ = fitted(self.lam_next, self.gamma, self.beta, tau[on], self.degree)
             # Σ_k c_k(τ) T_k(2X − I) R_j as one matrix product over the degrees
-            transient = (c.T @ terms[:, :, j, :].reshape(self.degree + 1, r * w))
-            out[on] += parts[j][None] - transient.reshape(on.size, r, w)
+            transient = coef.T @ self.terms[j, c, :, rows]          # (on, r)
+            transient -= parts[j]
+            if on.size == t.size:
+                out -= transient
+            else:
+                out[on] -= transient
         return out
