@@ -22,7 +22,7 @@ import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
 from .assembly import (_largest, check_bending, full_matrices, gram_matrices,
-                       patch_matrices, reduced_matrices)
+                       patch_matrices, reduced_factors, reduced_matrices)
 from .boundary import Constraints, build_constraints
 from .errors import InputError, SingularSystemError
 from .loads import Load, as_load, static_time
@@ -84,6 +84,11 @@ class Model:
     9
     """
 
+    #: the reduced 1-D Gram matrices and the constructor's boundary and fixed points, for
+    #: :meth:`with_material` (None on a model built otherwise, as a body of patches)
+    _factors: tuple[list[sp.csr_matrix], list[sp.csr_matrix]] | None = None
+    _arguments: dict[str, Any] | None = None
+
     def __init__(self, surface: Surface, material: Material,
                  boundary: str | Mapping[str, str] = "free", fixed: ArrayLike | None = None,
                  mass_matrix: str = "consistent", rest: str = "initial",
@@ -125,8 +130,12 @@ class Model:
         if kinks is not None:                  # the slopes tied across each C0 line
             K, M = self._full_matrices()
             self._full, self.gram_u, self.gram_v = ((K + kinks).tocsr(), M), None, None
-        reduced = None if physics == "intrinsic" or trimmed or kinks is not None or general else \
-            reduced_matrices(self.gram_u, self.gram_v, material, lumped, self.constraints)
+        # the reduced 1-D Gram matrices, kept for models of other materials (with_material)
+        self._factors = None if physics == "intrinsic" or trimmed or kinks is not None or \
+            general else reduced_factors(self.gram_u, self.gram_v, self.constraints)
+        self._arguments = {"boundary": boundary, "fixed": fixed}
+        reduced = None if self._factors is None else reduced_matrices(
+            self.gram_u, self.gram_v, material, lumped, self.constraints, self._factors)
         if reduced is None:
             T = self.constraints.T
             K, M = self._full_matrices()
@@ -137,6 +146,39 @@ class Model:
         self._finish(start)
         if trimmed:
             self._rigid = (trimmed.rigid_modes,)
+
+    def with_material(self, material: Material) -> Model:
+        """This model's surface, boundary, mass matrix and physics with another material.
+
+        ``K_r = Σ w_ab (T_uᵀ G_a^u T_u) ⊗ (T_vᵀ G_b^v T_v)`` and
+        ``M_r = μ (T_uᵀ G_0^u T_u) ⊗ (T_vᵀ G_0^v T_v)`` (module docstring): the material
+        enters only through the weights. A model with these Kronecker factors shares its
+        surface, constraints and reduced 1-D Gram matrices with the new one, whose own
+        assembly is the weighted sums; any other (trimmed, intrinsic, rational weights,
+        coupled C0 lines, fixed points that leave no rectangle) is built anew.
+        """
+        start = time.perf_counter()
+        surface = self.surface
+        if self._arguments is None:
+            raise InputError(f"with_material applies to a Model of one patch, not to a "
+                             f"{type(self).__name__}: build it with the new material")
+        if self._factors is None or c0_coupling(surface, material,
+                                                self.constraints.edges) is not None:
+            return Model(surface, material, mass_matrix=self.mass_matrix, rest=self.rest,
+                         physics=self.physics, **self._arguments)
+        check_options(material, self.mass_matrix, self.rest, self.physics)
+        check_bending(surface, material)
+        model = Model.__new__(Model)
+        model.surface, model.material = surface, material
+        model.mass_matrix, model.rest, model.physics = self.mass_matrix, self.rest, self.physics
+        model.constraints, model.gram_u, model.gram_v = self.constraints, self.gram_u, self.gram_v
+        model._factors, model._arguments, model._full = self._factors, self._arguments, None
+        reduced = reduced_matrices(self.gram_u, self.gram_v, material,
+                                   self.mass_matrix == "lumped", self.constraints, self._factors)
+        assert reduced is not None                  # the factors are those of T_u and T_v
+        model._K, model._M, model._C = reduced
+        model._finish(start)
+        return model
 
     def _finish(self, start: float) -> None:
         """Damping ``C_r = (γ/μ) M_r + β K_r`` (unless made with K_r), the checks of scale
