@@ -107,6 +107,19 @@ def expected_workers(client: Any) -> int:
     return max(1, len(client.scheduler_info().get("workers", {})))
 
 
+def spare_core(client: Any) -> bool:
+    """Whether this machine has a core that the cluster's workers here leave idle (a local
+    cluster's requested workers, else the threads of the workers on the loopback address)."""
+    requested = getattr(getattr(client, "cluster", None), "requested", None)
+    if requested is not None:
+        here = len(requested)
+    else:
+        workers = client.scheduler_info().get("workers", {})
+        here = sum(int(w.get("nthreads", 1)) for address, w in workers.items()
+                   if "127.0.0.1" in address or "localhost" in address)
+    return here < (os.cpu_count() or 1)
+
+
 def close_in_background(stack: ExitStack) -> Callable[[], None]:
     """Close ``stack`` (a cluster and its client) in a thread; returns the function that
     waits for it and raises what the close raised."""

@@ -25,7 +25,8 @@ from typing import Any, Callable
 
 from ..errors import InputError
 from .cases import Case, plan_cases
-from .cluster import close_in_background, dashboard, dask_client, expected_workers
+from .cluster import (close_in_background, dashboard, dask_client, expected_workers,
+                      spare_core)
 from .read import Sweep, load_sweep
 from .solve import solve_groups
 from .store import case_file, remove_partial, stored, write_tables
@@ -157,6 +158,10 @@ def _run_groups(client: Any, spec: Sweep, folder: Path, cases: list[Case],
                for i, task in enumerate(tasks(groups, workers), start=1)}
     result.workers = workers
     result.dashboard = dashboard(client)
+    if spare_core(client):      # else the imports would take a core from the workers
+        from .report import import_writers_in_background
+
+        import_writers_in_background()
     failed = sum(c.scenario is None for c in cases)
     try:
         remaining = set(futures)
