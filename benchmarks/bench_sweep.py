@@ -11,13 +11,18 @@ Two ratios, each measured in one run (no timing is asserted anywhere):
    ``splinedeform run`` command (a process each, as a hand-written loop runs them).
    Goal ≥ ×20.
 2. **Workers.** 200 independent cases (200 tension values, one model each, 10 × 10 cells):
-   the sweep on 2 worker processes against the same sweep on 1 (each on a local cluster
-   started for it, its start and stop included). Goal ≥ ×1.7 the throughput; it needs two
-   idle cores, so the load average is printed beside it. Also printed: the cases'
-   throughput while the workers run, ``cases / (last task's end − first task's start)``
-   from Dask's task stream, without the cluster's start and stop and the report.
+   ``splinedeform.sweep(workers=2)`` against ``splinedeform.sweep(workers=1)``, each on the
+   local cluster it starts and stops, alternated ``--repeats`` times (the machine's other
+   load drifts), their medians compared. Goal ≥ ×1.7 the throughput; it needs two idle
+   cores, so the load average is printed beside it. Also printed: the seconds of the cases
+   themselves on the busiest worker (their rows' ``wall_s`` summed per worker), without
+   the cluster's start and stop, the workers' imports and the report. The same for 200
+   cases of 32 × 32 cells (``--large``), where a case is a realistic size (its
+   case a few tenths of a second, mostly its eigen-solution, against about 10 ms at
+   10 × 10).
 
-Run ``python benchmarks/bench_sweep.py [--cells 32] [--separate 100] [--commands 10]``;
+Run ``python benchmarks/bench_sweep.py [--cells 32] [--separate 100] [--commands 10]
+[--repeats 3] [--large 200] [--workers-only]``;
 ``--separate k`` and ``--commands k`` time only ``k`` of the separate runs and say so (the
 ratio then uses their mean).
 """
@@ -156,8 +161,10 @@ def main() -> None:
     parser.add_argument("--independent", type=int, default=200)
     parser.add_argument("--repeats", type=int, default=3,
                         help="1-worker and 2-worker sweeps alternated this many times")
-    parser.add_argument("--large", type=int, default=40,
+    parser.add_argument("--large", type=int, default=200,
                         help="independent 32² cases timed the same way (0: none)")
+    parser.add_argument("--large-repeats", type=int, default=1,
+                        help="alternations of the 32² sweeps (each pair about 80 s quiet)")
     parser.add_argument("--workers-only", action="store_true",
                         help="only part 2, the 1-worker and 2-worker sweeps")
     args = parser.parse_args()
@@ -170,7 +177,7 @@ def main() -> None:
             shared_model(folder, args.cells, args.load_cases, separate, commands)
         spreads = [workers(folder, args.independent, 10, args.repeats)]
         if args.large:
-            spreads.append(workers(folder, args.large, 32, args.repeats))
+            spreads.append(workers(folder, args.large, 32, args.large_repeats))
         load_after = os.getloadavg()
     print(f"# Sweep benchmark ({os.cpu_count()} cores; load average "
           f"{load_before[0]:.1f} before, {load_after[0]:.1f} after)\n")
