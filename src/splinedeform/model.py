@@ -147,6 +147,11 @@ class Model:
         if trimmed:
             self._rigid = (trimmed.rigid_modes,)
 
+    @property
+    def shares_geometry(self) -> bool:
+        """Whether :meth:`with_material` shares this model's geometry (else it builds anew)."""
+        return self._arguments is not None and self._factors is not None
+
     def with_material(self, material: Material) -> Model:
         """This model's surface, boundary, mass matrix and physics with another material.
 

@@ -4,10 +4,12 @@
 (T_vᵀ G_0^v T_v)`` (DESIGN.md §1.5): the surface, the constraints and the reduced 1-D Gram
 matrices depend on ``[surface]``, ``[boundary]`` and the material's other keys (mass
 matrix, physics), not on the weights ``mass``, ``damping``, ``rayleigh``, ``w10`` … ``w02``.
-Each worker keeps the model last built for each geometry (:attr:`.cases.Case.geometry`,
-the :data:`GEOMETRIES` most recent), and the model of a case of a geometry already seen is
-:meth:`~splinedeform.Model.with_material` of it: the case's own work is the weighted sums
-and its eigen-solution.
+Each worker keeps a model of each geometry it has built (:attr:`.cases.Case.geometry`,
+the :data:`GEOMETRIES` most recent; a copy without modal basis), and the model of a case
+of a geometry already seen is :meth:`~splinedeform.Model.with_material` of it: the case's
+own work is the weighted sums and its eigen-solution. Models whose geometry is not shared
+(:attr:`~splinedeform.Model.shares_geometry` false: trimmed, intrinsic, rational weights,
+coupled C0 lines, shells, bodies) are built anew.
 """
 
 from __future__ import annotations
@@ -34,7 +36,7 @@ def model_of(case: Case) -> Built:
     scenario = case.scenario
     assert scenario is not None
     seen = _seen.get(case.geometry) if case.geometry else None
-    if seen is None or type(seen.model) is not Model:   # a shell or a body: built anew
+    if seen is None:
         built = build_model(scenario)
     else:
         check_single_surface_loads(scenario, scenario.surface.parameters.get("face")
@@ -45,8 +47,15 @@ def model_of(case: Case) -> Built:
             model = seen.model.with_material(material)
         built = Built(surface=seen.surface, model=model, load=None, fixed=seen.fixed,
                       units=seen.units)
-    if case.geometry:
-        _seen[case.geometry] = built
+    model = built.model
+    if seen is not None:
+        _seen.move_to_end(case.geometry)
+    elif case.geometry and type(model) is Model and model.shares_geometry:
+        # kept: a copy without the case's modal basis and other caches (a few sparse
+        # matrices), not the case's model, whose eigenvectors may be large
+        _seen[case.geometry] = Built(surface=built.surface,
+                                     model=model.with_material(model.material), load=None,
+                                     fixed=built.fixed, units=built.units)
         _seen.move_to_end(case.geometry)
         while len(_seen) > GEOMETRIES:
             _seen.popitem(last=False)
