@@ -9,8 +9,8 @@ A local cluster's fixed cost is kept off the cases' path:
 
 - its workers import the task code as they start (Dask's worker ``preload`` of
   :data:`PRELOAD`), not on their first task, and they start in the background: the
-  client is returned once the scheduler is up, so the caller plans and submits while the
-  workers start;
+  client is returned once the scheduler is up, so the caller submits while the workers
+  start;
 - :func:`close_in_background` stops the cluster (its nannies wait for their worker
   processes to exit) while the caller writes its results.
 """
@@ -98,10 +98,15 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
         cluster.close()
 
 
+def _requested(client: Any) -> set | None:
+    """The workers a local cluster of ``client`` has or is starting, or None."""
+    return getattr(getattr(client, "cluster", None), "requested", None)
+
+
 def expected_workers(client: Any) -> int:
     """The workers a client's cluster has or is starting (a local cluster's requested
     count, else those connected to the scheduler; at least 1)."""
-    requested = getattr(getattr(client, "cluster", None), "requested", None)
+    requested = _requested(client)
     if requested:
         return len(requested)
     return max(1, len(client.scheduler_info().get("workers", {})))
@@ -110,7 +115,7 @@ def expected_workers(client: Any) -> int:
 def spare_core(client: Any) -> bool:
     """Whether this machine has a core that the cluster's workers here leave idle (a local
     cluster's requested workers, else the threads of the workers on the loopback address)."""
-    requested = getattr(getattr(client, "cluster", None), "requested", None)
+    requested = _requested(client)
     if requested is not None:
         here = len(requested)
     else:
