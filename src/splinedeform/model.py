@@ -21,8 +21,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
-from .assembly import (_largest, check_bending, full_matrices, gram_matrices,
-                       patch_matrices, reduced_factors, reduced_matrices)
+from .assembly import (ReducedFactors, _largest, check_bending, full_matrices,
+                       gram_matrices, patch_matrices, reduced_factors, reduced_matrices)
 from .boundary import Constraints, build_constraints
 from .errors import InputError, SingularSystemError
 from .loads import Load, as_load, static_time
@@ -86,7 +86,7 @@ class Model:
 
     #: the reduced 1-D Gram matrices and the constructor's boundary and fixed points, for
     #: :meth:`with_material` (None on a model built otherwise, as a body of patches)
-    _factors: tuple[list[sp.csr_matrix], list[sp.csr_matrix]] | None = None
+    _factors: ReducedFactors | None = None
     _arguments: dict[str, Any] | None = None
 
     def __init__(self, surface: Surface, material: Material,
@@ -153,37 +153,11 @@ class Model:
         return self._arguments is not None and self._factors is not None
 
     def with_material(self, material: Material) -> Model:
-        """This model's surface, boundary, mass matrix and physics with another material.
+        """This model's surface, boundary, mass matrix and physics with another material,
+        sharing what does not depend on it (:func:`splinedeform.same_geometry.with_material`)."""
+        from .same_geometry import with_material
 
-        ``K_r = Σ w_ab (T_uᵀ G_a^u T_u) ⊗ (T_vᵀ G_b^v T_v)`` and
-        ``M_r = μ (T_uᵀ G_0^u T_u) ⊗ (T_vᵀ G_0^v T_v)`` (module docstring): the material
-        enters only through the weights. A model with these Kronecker factors shares its
-        surface, constraints and reduced 1-D Gram matrices with the new one, whose own
-        assembly is the weighted sums; any other (trimmed, intrinsic, rational weights,
-        coupled C0 lines, fixed points that leave no rectangle) is built anew.
-        """
-        start = time.perf_counter()
-        surface = self.surface
-        if self._arguments is None:
-            raise InputError(f"with_material applies to a Model of one patch, not to a "
-                             f"{type(self).__name__}: build it with the new material")
-        if self._factors is None or c0_coupling(surface, material,
-                                                self.constraints.edges) is not None:
-            return Model(surface, material, mass_matrix=self.mass_matrix, rest=self.rest,
-                         physics=self.physics, **self._arguments)
-        check_options(material, self.mass_matrix, self.rest, self.physics)
-        check_bending(surface, material)
-        model = Model.__new__(Model)
-        model.surface, model.material = surface, material
-        model.mass_matrix, model.rest, model.physics = self.mass_matrix, self.rest, self.physics
-        model.constraints, model.gram_u, model.gram_v = self.constraints, self.gram_u, self.gram_v
-        model._factors, model._arguments, model._full = self._factors, self._arguments, None
-        reduced = reduced_matrices(self.gram_u, self.gram_v, material,
-                                   self.mass_matrix == "lumped", self.constraints, self._factors)
-        assert reduced is not None                  # the factors are those of T_u and T_v
-        model._K, model._M, model._C = reduced
-        model._finish(start)
-        return model
+        return with_material(self, material)
 
     def _finish(self, start: float) -> None:
         """Damping ``C_r = (γ/μ) M_r + β K_r`` (unless made with K_r), the checks of scale
