@@ -11,13 +11,18 @@ Two ratios, each measured in one run (no timing is asserted anywhere):
    ``splinedeform run`` command (a process each, as a hand-written loop runs them).
    Goal ≥ ×20.
 2. **Workers.** 200 independent cases (200 tension values, one model each, 10 × 10 cells):
-   the sweep on 2 worker processes against the same sweep on 1 (each on a local cluster
-   started for it, its start and stop included). Goal ≥ ×1.7 the throughput; it needs two
-   idle cores, so the load average is printed beside it. Also printed: the cases'
-   throughput while the workers run, ``cases / (last task's end − first task's start)``
-   from Dask's task stream, without the cluster's start and stop and the report.
+   ``splinedeform.sweep(workers=2)`` against ``splinedeform.sweep(workers=1)``, each on the
+   local cluster it starts and stops, alternated ``--repeats`` times (the machine's other
+   load drifts), their medians compared. Goal ≥ ×1.7 the throughput; it needs two idle
+   cores, so the load average is printed beside it. Also printed: the seconds of the cases
+   themselves on the busiest worker (their rows' ``wall_s`` summed per worker), without
+   the cluster's start and stop, the workers' imports and the report. The same for 200
+   cases of 32 × 32 cells (``--large``), where a case is a realistic size (its
+   case a few tenths of a second, mostly its eigen-solution, against about 10 ms at
+   10 × 10).
 
-Run ``python benchmarks/bench_sweep.py [--cells 32] [--separate 100] [--commands 10]``;
+Run ``python benchmarks/bench_sweep.py [--cells 32] [--separate 100] [--commands 10]
+[--repeats 3] [--large 200] [--workers-only]``;
 ``--separate k`` and ``--commands k`` time only ``k`` of the separate runs and say so (the
 ratio then uses their mean).
 """
@@ -110,32 +115,39 @@ def shared_model(folder: Path, cells: int, cases: int, separate: int, commands: 
             "models": result.models, "cases": len(result.rows)}
 
 
-def workers(folder: Path, cases: int) -> dict[str, float]:
-    from distributed import get_task_stream
+def workers(folder: Path, cases: int, cells: int = 10, repeats: int = 3
+            ) -> dict[str, float]:
+    """``cases`` tension values, one model each: ``sd.sweep(workers=1)`` and
+    ``sd.sweep(workers=2)`` alternated ``repeats`` times (the machine's other load drifts
+    between them), the medians compared. Also the seconds of the cases themselves on the
+    busiest worker (their rows' ``wall_s`` summed per worker)."""
+    import statistics
 
     import splinedeform as sd
-    from splinedeform.study.cluster import dask_client
 
-    (folder / "small.toml").write_text(PLATE.format(cells=10, w10=1.0, u=0.5, v=0.5))
-    (folder / "tension.toml").write_text(
-        'scenario = "small.toml"\n[[axis]]\nkey = "material.w10"\nrange = [0.5, 5.0]\n'
-        f"count = {cases}\n")
-    seconds, running = {}, {}
-    for n in (1, 2):
-        out = folder / f"out-{n}"
-        start = time.perf_counter()
-        with dask_client(n) as client:          # the cluster sd.sweep(workers=n) starts
-            with get_task_stream(client) as stream:
-                result = sd.sweep(folder / "tension.toml", out, client=client)
-        seconds[n] = time.perf_counter() - start
-        spans = [(s["start"], s["stop"]) for task in stream.data
-                 for s in task["startstops"] if s["action"] == "compute"]
-        running[n] = max(b for _, b in spans) - min(a for a, _ in spans)
-        assert result.failed == 0 and result.computed == cases
-        shutil.rmtree(out)
-    return {"one_s": seconds[1], "two_s": seconds[2], "ratio": seconds[1] / seconds[2],
-            "one_run_s": running[1], "two_run_s": running[2],
-            "run_ratio": running[1] / running[2]}
+    (folder / f"small{cells}.toml").write_text(PLATE.format(cells=cells, w10=1.0, u=0.5, v=0.5))
+    (folder / f"tension{cells}.toml").write_text(
+        f'scenario = "small{cells}.toml"\n[[axis]]\nkey = "material.w10"\n'
+        f"range = [0.5, 5.0]\ncount = {cases}\n")
+    seconds: dict[int, list[float]] = {1: [], 2: []}
+    busiest: dict[int, list[float]] = {1: [], 2: []}
+    for _ in range(repeats):
+        for n in (1, 2):
+            out = folder / f"out-{cells}-{n}"
+            start = time.perf_counter()
+            result = sd.sweep(folder / f"tension{cells}.toml", out, workers=n)
+            seconds[n].append(time.perf_counter() - start)
+            assert result.failed == 0 and result.computed == cases
+            per_worker: dict[str, float] = {}
+            for row in result.rows:
+                per_worker[row["worker"]] = per_worker.get(row["worker"], 0.0) + row["wall_s"]
+            busiest[n].append(max(per_worker.values()))
+            shutil.rmtree(out)
+    one, two = statistics.median(seconds[1]), statistics.median(seconds[2])
+    one_run, two_run = statistics.median(busiest[1]), statistics.median(busiest[2])
+    return {"one_s": one, "two_s": two, "ratio": one / two, "one_run_s": one_run,
+            "two_run_s": two_run, "run_ratio": one_run / two_run,
+            "runs": repeats, "cells": cells, "cases": cases}
 
 
 def main() -> None:
@@ -147,29 +159,44 @@ def main() -> None:
     parser.add_argument("--commands", type=int, default=10,
                         help="separate `splinedeform run` commands timed (default 10)")
     parser.add_argument("--independent", type=int, default=200)
+    parser.add_argument("--repeats", type=int, default=3,
+                        help="1-worker and 2-worker sweeps alternated this many times")
+    parser.add_argument("--large", type=int, default=200,
+                        help="independent 32² cases timed the same way (0: none)")
+    parser.add_argument("--large-repeats", type=int, default=1,
+                        help="alternations of the 32² sweeps (each pair about 80 s quiet)")
+    parser.add_argument("--workers-only", action="store_true",
+                        help="only part 2, the 1-worker and 2-worker sweeps")
     args = parser.parse_args()
     separate = args.separate or args.load_cases
     commands = min(args.commands, args.load_cases)
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         load_before = os.getloadavg()
-        shared = shared_model(folder, args.cells, args.load_cases, separate, commands)
-        spread = workers(folder, args.independent)
+        shared = None if args.workers_only else \
+            shared_model(folder, args.cells, args.load_cases, separate, commands)
+        spreads = [workers(folder, args.independent, 10, args.repeats)]
+        if args.large:
+            spreads.append(workers(folder, args.large, 32, args.large_repeats))
         load_after = os.getloadavg()
     print(f"# Sweep benchmark ({os.cpu_count()} cores; load average "
           f"{load_before[0]:.1f} before, {load_after[0]:.1f} after)\n")
-    timed = "" if separate == args.load_cases else \
-        f" ({separate} of them timed, their mean × {args.load_cases})"
-    print(f"- {shared['cases']} load cases on one {args.cells}² model: sweep "
-          f"{shared['sweep_s']:.1f} s ({shared['models']} model); separate runs in this "
-          f"process {shared['separate_s']:.1f} s{timed}: ×{shared['ratio']:.1f}; separate "
-          f"`splinedeform run` commands {shared['command_s']:.1f} s ({commands} of them "
-          f"timed, their mean × {args.load_cases}): ×{shared['command_ratio']:.1f} "
-          "(goal ≥ ×20)")
-    print(f"- {args.independent} independent cases: 1 worker {spread['one_s']:.1f} s, 2 workers "
-          f"{spread['two_s']:.1f} s: ×{spread['ratio']:.2f} the throughput (goal ≥ ×1.7); "
-          f"while the workers run (task stream) {spread['one_run_s']:.1f} s and "
-          f"{spread['two_run_s']:.1f} s: ×{spread['run_ratio']:.2f}")
+    if shared is not None:
+        timed = "" if separate == args.load_cases else \
+            f" ({separate} of them timed, their mean × {args.load_cases})"
+        print(f"- {shared['cases']} load cases on one {args.cells}² model: sweep "
+              f"{shared['sweep_s']:.1f} s ({shared['models']} model); separate runs in this "
+              f"process {shared['separate_s']:.1f} s{timed}: ×{shared['ratio']:.1f}; separate "
+              f"`splinedeform run` commands {shared['command_s']:.1f} s ({commands} of them "
+              f"timed, their mean × {args.load_cases}): ×{shared['command_ratio']:.1f} "
+              "(goal ≥ ×20)")
+    for spread in spreads:
+        goal = " (goal ≥ ×1.7)" if spread["cells"] == 10 else ""
+        print(f"- {spread['cases']} independent {spread['cells']}² cases (medians of "
+              f"{spread['runs']} alternations): 1 worker {spread['one_s']:.2f} s, 2 workers "
+              f"{spread['two_s']:.2f} s: ×{spread['ratio']:.2f} the throughput{goal}; the "
+              f"cases themselves on the busiest worker {spread['one_run_s']:.2f} s and "
+              f"{spread['two_run_s']:.2f} s: ×{spread['run_ratio']:.2f}")
 
 
 if __name__ == "__main__":

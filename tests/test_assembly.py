@@ -76,3 +76,43 @@ def test_the_whole_net_matrices_wait_until_asked_for_and_equal_the_kronecker_sum
     expected = (PLATE.damping / PLATE.mass) * M_r + PLATE.rayleigh * K_r
     np.testing.assert_allclose(C_r.toarray(), expected.toarray(), rtol=0,
                                atol=1e-15 * abs(expected).max())
+
+
+OTHER = sd.Material(mass=0.7, damping=0.1, rayleigh=2e-3, w10=3.0, w01=0.0, w20=0.5,
+                    w11=0.0, w02=4.0)
+
+
+@pytest.mark.parametrize("boundary", BOUNDARIES)
+@pytest.mark.parametrize("mass_matrix", ["consistent", "lumped"])
+def test_a_model_with_another_material_shares_its_factors_and_equals_one_built_anew(
+        boundary, mass_matrix):
+    """``with_material`` re-weights the shared reduced 1-D Gram matrices (a weight set to 0
+    drops its term): the same products of the same factors as a model built with that
+    material, so equal to a few roundings of O(max |entry|) (1e-12 relative)."""
+    surface = sd.shapes.plane(cells=(7, 5))
+    first = sd.Model(surface, PLATE, boundary=boundary, mass_matrix=mass_matrix)
+    shared = first.with_material(OTHER)
+    anew = sd.Model(surface, OTHER, boundary=boundary, mass_matrix=mass_matrix)
+    assert shared.constraints is first.constraints and shared.gram_u is first.gram_u
+    for A, B in zip(shared.matrices(), anew.matrices()):
+        np.testing.assert_allclose(A.toarray(), B.toarray(), rtol=0,
+                                   atol=1e-12 * np.abs(B.toarray()).max())
+    # and the first model's own matrices are left as they were
+    np.testing.assert_allclose(first.matrices()[2].toarray(),
+                               sd.Model(surface, PLATE, boundary=boundary,
+                                        mass_matrix=mass_matrix).matrices()[2].toarray(),
+                               rtol=0, atol=1e-12 * np.abs(first.matrices()[2].toarray()).max())
+
+
+def test_a_model_without_kronecker_factors_is_built_anew_with_the_other_material():
+    """Fixed control points that leave no rectangle (no T_u, T_v): a new Model, equal."""
+    surface = sd.shapes.plane(cells=(5, 5))
+    fixed = np.zeros(surface.shape, dtype=bool)
+    fixed[2, 3] = fixed[0, 0] = True
+    first = sd.Model(surface, PLATE, boundary="free", fixed=fixed)
+    assert first.constraints.T_u is None
+    shared = first.with_material(OTHER)
+    anew = sd.Model(surface, OTHER, boundary="free", fixed=fixed)
+    for A, B in zip(shared.matrices(), anew.matrices()):   # one code path: a few roundings
+        np.testing.assert_allclose(A.toarray(), B.toarray(), rtol=0,
+                                   atol=1e-12 * np.abs(B.toarray()).max())

@@ -29,9 +29,14 @@ from .surface import Surface
 def stiffness_terms(gram_u: Sequence[sp.spmatrix], gram_v: Sequence[sp.spmatrix],
                     material: Material) -> list[tuple[float, sp.spmatrix, sp.spmatrix]]:
     """The non-zero terms ``(w_ab, G_a^u, G_b^v)`` of ``K`` (the twist weight doubled)."""
-    terms = [(material.w10, 1, 0), (material.w01, 0, 1), (material.w20, 2, 0),
-             (2 * material.w11, 1, 1), (material.w02, 0, 2)]
-    return [(weight, gram_u[a], gram_v[b]) for weight, a, b in terms if weight]
+    return [(weight, gram_u[a], gram_v[b]) for weight, a, b in _weighted_orders(material)
+            if weight]
+
+
+def _weighted_orders(material: Material) -> list[tuple[float, int, int]]:
+    """``(w_ab, a, b)`` of the five terms of ``K`` (the twist weight doubled)."""
+    return [(material.w10, 1, 0), (material.w01, 0, 1), (material.w20, 2, 0),
+            (2 * material.w11, 1, 1), (material.w02, 0, 2)]
 
 
 def stiffness(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], material: Material
@@ -51,8 +56,39 @@ def mass(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], density: float,
     return kronecker_sum([(density, gram_u[0], gram_v[0])])
 
 
+class ReducedFactors:
+    """The reduced 1-D Gram matrices ``T_uᵀ G_a^u T_u`` (``u``) and ``T_vᵀ G_b^v T_v``
+    (``v``) of one geometry, and the compressed layouts of their sums
+    (:class:`KroneckerLayout`) by the orders ``(a, b)`` they sum: what models of several
+    materials on that geometry share."""
+
+    def __init__(self, u: list[sp.csr_matrix], v: list[sp.csr_matrix]) -> None:
+        self.u, self.v = u, v
+        self._layouts: dict[tuple[tuple[int, int], ...], KroneckerLayout] = {}
+
+    def layout(self, orders: Sequence[tuple[int, int]]) -> KroneckerLayout:
+        """The CSC layout of sums of ``u[a] ⊗ v[b]`` over ``orders``, made once."""
+        key = tuple(orders)
+        if key not in self._layouts:
+            self._layouts[key] = KroneckerLayout([(self.u[a], self.v[b]) for a, b in key],
+                                                 "csc")
+        return self._layouts[key]
+
+
+def reduced_factors(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], constraints: Any
+                    ) -> ReducedFactors | None:
+    """The reduced 1-D Gram matrices ``(T_uᵀ G_a^u T_u, T_vᵀ G_b^v T_v)``, independent of
+    the material; ``None`` unless the constraints are of tensor-product form."""
+    T_u, T_v = constraints.T_u, constraints.T_v
+    if T_u is None or T_v is None:
+        return None
+    return ReducedFactors([(T_u.T @ G @ T_u).tocsr() for G in gram_u],
+                          [(T_v.T @ G @ T_v).tocsr() for G in gram_v])
+
+
 def reduced_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix],
-                     material: Material, lumped: bool, constraints: Any
+                     material: Material, lumped: bool, constraints: Any,
+                     factors: ReducedFactors | None = None
                      ) -> tuple[sp.csc_matrix, sp.csc_matrix, sp.csc_matrix] | None:
     """``(K_r, M_r, C_r) = (Tᵀ K T, Tᵀ M T, Tᵀ C T)`` from the reduced 1-D factors, in CSC.
 
@@ -60,24 +96,27 @@ def reduced_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix],
     are of tensor-product form (``T_u``, ``T_v`` known). A lumped (diagonal) mass is
     reduced as it is, ``Tᵀ M T``. The consistent ``K_r``, ``M_r`` and ``C_r`` share one
     compressed layout: three sums of Kronecker products of the same 1-D factors.
+    ``factors``: those of :func:`reduced_factors` when already at hand (models of one
+    geometry and several materials share them and their layouts).
     """
-    T_u, T_v = constraints.T_u, constraints.T_v
-    if T_u is None or T_v is None:
+    if factors is None:
+        factors = reduced_factors(gram_u, gram_v, constraints)
+    if factors is None:
         return None
-    reduced_u = [(T_u.T @ G @ T_u).tocsr() for G in gram_u]
-    reduced_v = [(T_v.T @ G @ T_v).tocsr() for G in gram_v]
-    shape = (T_u.shape[1] * T_v.shape[1],) * 2
-    stiff = stiffness_terms(reduced_u, reduced_v, material)
+    shape = (factors.u[0].shape[0] * factors.v[0].shape[0],) * 2
     viscous = material.damping / material.mass
     if lumped:
         T = constraints.T
-        K = kronecker_sum(stiff, shape, "csc")
+        K = kronecker_sum(stiffness_terms(factors.u, factors.v, material), shape, "csc")
         M = (T.T @ mass(gram_u, gram_v, material.mass, True) @ T).tocsc()
         return K, M, (viscous * M + material.rayleigh * K).tocsc()
-    mass_term = [(material.mass, reduced_u[0], reduced_v[0])]
-    damping = [(viscous * material.mass, reduced_u[0], reduced_v[0])] + [
-        (material.rayleigh * w, A, B) for w, A, B in stiff]
-    K, M, C = kronecker_sums([stiff, mass_term, damping], shape, "csc")
+    stiff = [(w, a, b) for w, a, b in _weighted_orders(material) if w]
+    # the orders summed: the mass's (0, 0) first, then the stiffness's
+    layout = factors.layout([(0, 0)] + [(a, b) for _, a, b in stiff])
+    stiff_terms = [(w, i) for i, (w, _, _) in enumerate(stiff, start=1)]
+    K, M, C = layout.sums([stiff_terms, [(material.mass, 0)],
+                           [(viscous * material.mass, 0)] +
+                           [(material.rayleigh * w, i) for w, i in stiff_terms]], shape)
     return K, M, C
 
 
@@ -101,7 +140,22 @@ def kronecker_sum(terms: Sequence[tuple[float, sp.spmatrix, sp.spmatrix]],
 def kronecker_sums(sums: Sequence[Sequence[tuple[float, sp.spmatrix, sp.spmatrix]]],
                    shape: tuple[int, int] | None = None, format: str = "csr"
                    ) -> list[sp.spmatrix]:
-    """Several sums ``Σ_t w_t A_t ⊗ B_t`` on one shared compressed layout.
+    """Several sums ``Σ_t w_t A_t ⊗ B_t`` on one shared compressed layout
+    (:class:`KroneckerLayout` of all their terms' factors)."""
+    cls = sp.csr_matrix if format == "csr" else sp.csc_matrix
+    if not any(sums):
+        return [cls(shape) for _ in sums]
+    pairs = [(A, B) for terms in sums for _, A, B in terms]
+    layout = KroneckerLayout(pairs, format)
+    index, out = 0, []
+    for terms in sums:
+        out.append([(w, index + i) for i, (w, _, _) in enumerate(terms)])
+        index += len(terms)
+    return layout.sums(out, shape)
+
+
+class KroneckerLayout:
+    """The compressed layout of sums ``Σ_t w_t A_t ⊗ B_t`` over fixed factor pairs.
 
     On the union patterns of all the ``A_t`` and of all the ``B_t``, each stored as a
     padded table ``(line, slot)`` of its compressed lines (rows for CSR, columns for
@@ -110,44 +164,56 @@ def kronecker_sums(sums: Sequence[Sequence[tuple[float, sp.spmatrix, sp.spmatrix
     (``W = diag w``). Line ``(i, k)`` of ``P_A ⊗ P_B`` (``i n_B + k``) holds the entries
     of line ``i`` of ``P_A`` times those of line ``k`` of ``P_B``, ``e``-major, which is
     also the order of their other indices ``j m_B + l``: the product read in the order
-    ``(i, k, e, f)``, less the padding, is the compressed data. The layout is computed
-    once for all the sums.
+    ``(i, k, e, f)``, less the padding, is the compressed data. The layout and the
+    factors' tables are computed once; a sum of other weights is one product.
     """
-    cls = sp.csr_matrix if format == "csr" else sp.csc_matrix
-    if not any(sums):
-        return [cls(shape) for _ in sums]
-    sums = [[(w, cls(A), cls(B)) for w, A, B in terms] for terms in sums]
-    PA = _union_pattern([A for terms in sums for _, A, _ in terms])
-    PB = _union_pattern([B for terms in sums for _, _, B in terms])
-    other_a, slot_a = _table(PA, PA.indices)
-    other_b, slot_b = _table(PB, PB.indices)
-    stored = (other_a >= 0)[:, None, :, None] & (other_b >= 0)[None, :, None, :]  # (i, k, e, f)
-    indptr = np.zeros(stored.shape[0] * stored.shape[1] + 1, dtype=np.int64)
-    np.cumsum(np.outer(np.diff(PA.indptr), np.diff(PB.indptr)).ravel(), out=indptr[1:])
-    width_b = PB.shape[1] if format == "csr" else PB.shape[0]
-    indices = (other_a[:, None, :, None] * width_b + other_b[None, :, None, :])[stored]
-    la, ca = other_a.shape
-    lb, cb = other_b.shape
-    # where each stored (i, k, e, f) sits in the product's (i e, k f) layout
-    i, k, e, f = np.nonzero(stored)
-    positions = ((i * ca + e) * lb + k) * cb + f
-    full_shape = (PA.shape[0] * PB.shape[0], PA.shape[1] * PB.shape[1])
-    out = []
-    for terms in sums:
-        if terms:
-            weights = np.array([w for w, _, _ in terms], dtype=float)
-            values_a = np.stack([_table(PA, _values_on(A, PA))[0] for _, A, _ in terms])
-            values_b = np.stack([_table(PB, _values_on(B, PB))[0] for _, _, B in terms])
-            with np.errstate(over="ignore", invalid="ignore"):   # scales are checked later
-                product = ((values_a * weights[:, None, None]).reshape(len(terms), -1).T
-                           @ values_b.reshape(len(terms), -1))          # (i e, k f)
-            data = np.take(product.ravel(), positions)
-        else:
-            data = np.zeros(indices.size)
-        matrix = cls((data, indices, indptr), shape=full_shape if shape is None else shape)
-        matrix.has_sorted_indices = True
-        out.append(matrix)
-    return out
+
+    def __init__(self, pairs: Sequence[tuple[sp.spmatrix, sp.spmatrix]],
+                 format: str = "csr") -> None:
+        self.cls = sp.csr_matrix if format == "csr" else sp.csc_matrix
+        pairs = [(self.cls(A), self.cls(B)) for A, B in pairs]
+        PA = _union_pattern([A for A, _ in pairs])
+        PB = _union_pattern([B for _, B in pairs])
+        other_a, _ = _table(PA, PA.indices)
+        other_b, _ = _table(PB, PB.indices)
+        stored = (other_a >= 0)[:, None, :, None] & (other_b >= 0)[None, :, None, :]
+        self.indptr = np.zeros(stored.shape[0] * stored.shape[1] + 1, dtype=np.int64)
+        np.cumsum(np.outer(np.diff(PA.indptr), np.diff(PB.indptr)).ravel(),
+                  out=self.indptr[1:])
+        width_b = PB.shape[1] if format == "csr" else PB.shape[0]
+        self.indices = (other_a[:, None, :, None] * width_b
+                        + other_b[None, :, None, :])[stored]
+        la, ca = other_a.shape
+        lb, cb = other_b.shape
+        # where each stored (i, k, e, f) sits in the product's (i e, k f) layout
+        i, k, e, f = np.nonzero(stored)
+        self.positions = ((i * ca + e) * lb + k) * cb + f
+        self.full_shape = (PA.shape[0] * PB.shape[0], PA.shape[1] * PB.shape[1])
+        self.values_a = np.stack([_table(PA, _values_on(A, PA))[0] for A, _ in pairs])
+        self.values_b = np.stack([_table(PB, _values_on(B, PB))[0] for _, B in pairs])
+
+    def sums(self, sums: Sequence[Sequence[tuple[float, int]]],
+             shape: tuple[int, int] | None = None) -> list[sp.spmatrix]:
+        """``Σ_t w_t A_t ⊗ B_t`` for each list of ``(w_t, t)`` (``t``: a pair's index), on
+        one copy of the layout's index arrays (theirs, not the layout's, to keep)."""
+        indices, indptr = self.indices.copy(), self.indptr.copy()
+        out = []
+        for terms in sums:
+            if terms:
+                weights = np.array([w for w, _ in terms], dtype=float)
+                index = [t for _, t in terms]
+                values_a, values_b = self.values_a[index], self.values_b[index]
+                with np.errstate(over="ignore", invalid="ignore"):  # scales are checked later
+                    product = ((values_a * weights[:, None, None]).reshape(len(terms), -1).T
+                               @ values_b.reshape(len(terms), -1))          # (i e, k f)
+                data = np.take(product.ravel(), self.positions)
+            else:
+                data = np.zeros(indices.size)
+            matrix = self.cls((data, indices, indptr),
+                              shape=self.full_shape if shape is None else shape)
+            matrix.has_sorted_indices = True
+            out.append(matrix)
+        return out
 
 
 def check_bending(surface: Surface, material: Material) -> None:

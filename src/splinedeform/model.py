@@ -21,8 +21,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
-from .assembly import (_largest, check_bending, full_matrices, gram_matrices,
-                       patch_matrices, reduced_matrices)
+from .assembly import (ReducedFactors, _largest, check_bending, full_matrices,
+                       gram_matrices, patch_matrices, reduced_factors, reduced_matrices)
 from .boundary import Constraints, build_constraints
 from .errors import InputError, SingularSystemError
 from .loads import Load, as_load, static_time
@@ -87,6 +87,11 @@ class Model:
     9
     """
 
+    #: the reduced 1-D Gram matrices and the constructor's boundary and fixed points, for
+    #: :meth:`with_material` (None on a model built otherwise, as a body of patches)
+    _factors: ReducedFactors | None = None
+    _arguments: dict[str, Any] | None = None
+
     def __init__(self, surface: Surface, material: Material,
                  boundary: str | Mapping[str, str] = "free", fixed: ArrayLike | None = None,
                  mass_matrix: str = "consistent", rest: str = "initial",
@@ -132,9 +137,12 @@ class Model:
             K, M = self._full_matrices()
             K = K if kinks is None else K + kinks
             self._full, self.gram_u, self.gram_v = (K.tocsr(), M), None, None
-        reduced = None if physics == "intrinsic" or trimmed or kinks is not None or tied \
-            or general else \
-            reduced_matrices(self.gram_u, self.gram_v, material, lumped, self.constraints)
+        # the reduced 1-D Gram matrices, kept for models of other materials (with_material)
+        self._factors = None if physics == "intrinsic" or trimmed or kinks is not None or \
+            tied or general else reduced_factors(self.gram_u, self.gram_v, self.constraints)
+        self._arguments = {"boundary": boundary, "fixed": fixed}
+        reduced = None if self._factors is None else reduced_matrices(
+            self.gram_u, self.gram_v, material, lumped, self.constraints, self._factors)
         if reduced is None:
             T = self.constraints.T
             K, M = self._full_matrices()
@@ -145,6 +153,18 @@ class Model:
         self._finish(start)
         if trimmed:
             self._rigid = (trimmed.rigid_modes,)
+
+    @property
+    def shares_geometry(self) -> bool:
+        """Whether :meth:`with_material` shares this model's geometry (else it builds anew)."""
+        return self._arguments is not None and self._factors is not None
+
+    def with_material(self, material: Material) -> Model:
+        """This model's surface, boundary, mass matrix and physics with another material,
+        sharing what does not depend on it (:func:`splinedeform.same_geometry.with_material`)."""
+        from .same_geometry import with_material
+
+        return with_material(self, material)
 
     def _finish(self, start: float) -> None:
         """Damping ``C_r = (γ/μ) M_r + β K_r`` (unless made with K_r), the checks of scale

@@ -81,8 +81,12 @@ def kronecker_factors(model: Model) -> KroneckerFactors:
 
     orders_u = [a for w, a in ((m.w10, 1), (m.w20, 2)) if w]
     orders_v = [a for w, a in ((m.w01, 1), (m.w02, 2)) if w]
+    shared = model._factors          # the same reductions, made with the model's matrices
     return KroneckerFactors(
-        tuple(reduce(c.T_u, G) for G in model.gram_u), tuple(reduce(c.T_v, G) for G in model.gram_v),
+        tuple(G.toarray() for G in shared.u) if shared is not None else
+        tuple(reduce(c.T_u, G) for G in model.gram_u),
+        tuple(G.toarray() for G in shared.v) if shared is not None else
+        tuple(reduce(c.T_v, G) for G in model.gram_v),
         (m.w10, m.w01, m.w20, m.w11, m.w02), m.mass,
         rigid.direction_rigid(model.surface.basis_u, c.T_u, orders_u),
         rigid.direction_rigid(model.surface.basis_v, c.T_v, orders_v))

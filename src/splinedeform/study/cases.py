@@ -13,7 +13,10 @@ Two hashes name a case:
 - ``model``: SHA-256 of what its :class:`~splinedeform.Model` is built from (``[surface]``,
   ``[material]``, ``[boundary]`` and the files they read): cases with equal ``model``
   differ only in loads, solve or output keys and share one model, its modal basis
-  computed once.
+  computed once;
+- ``geometry``: SHA-256 of the same less the material's weights (``mass``, ``damping``,
+  ``rayleigh``, ``w10`` … ``w02``): models of equal ``geometry`` share their surface,
+  constraints and 1-D Gram matrices on a worker (:mod:`.geometries`).
 """
 
 from __future__ import annotations
@@ -34,6 +37,8 @@ from .read import Sweep
 
 #: the scenario tables a model is built from
 MODEL_TABLES = ("surface", "material", "boundary")
+#: the keys of ``[material]`` that weight the 1-D Gram matrices (and nothing else)
+WEIGHT_KEYS = ("mass", "damping", "rayleigh", "w10", "w01", "w20", "w11", "w02")
 
 
 @dataclass(frozen=True)
@@ -46,6 +51,7 @@ class Case:
     model: str
     scenario: Scenario | None
     error: str | None = None        # the reader's message when the values are refused
+    geometry: str = ""              # the model's hash less the material's weights
 
 
 def plan_cases(sweep: Sweep) -> list[Case]:
@@ -62,15 +68,20 @@ def plan_cases(sweep: Sweep) -> list[Case]:
             for where in _reported_at(paths[key], len(base.loads)):
                 origins[where] = origin
         content = {"version": __version__, "directory": str(base.directory), "files": files}
-        model = _digest({**content, **{t: raw.get(t) for t in MODEL_TABLES}})
+        tables = {t: raw.get(t) for t in MODEL_TABLES}
+        model = _digest({**content, **tables})
+        material = tables["material"]
+        geometry = _digest({**content, **tables, "material": {
+            k: v for k, v in material.items() if k not in WEIGHT_KEYS}
+            if isinstance(material, dict) else material})
         digest = _digest({**content, "scenario": raw})
         try:
             scenario = _validate(raw, base.source, base.lines, origins, base.directory,
                                  base.allow_outside_paths)
         except ScenarioError as exc:
-            cases.append(Case(index, point, digest, model, None, str(exc)))
+            cases.append(Case(index, point, digest, model, None, str(exc), geometry))
             continue
-        cases.append(Case(index, point, digest, model, scenario))
+        cases.append(Case(index, point, digest, model, scenario, geometry=geometry))
     return cases
 
 

@@ -4,16 +4,29 @@ A local cluster listens on the loopback address only (``127.0.0.1``), one worker
 per core by default, one thread each (the workers' BLAS threads are limited to one by
 Dask's nanny), each with a memory limit (``"2GiB"``; Dask's default is the machine's memory
 shared among the workers).
+
+A local cluster's fixed cost is kept off the cases' path:
+
+- its workers import the task code as they start (Dask's worker ``preload`` of
+  :data:`PRELOAD`), not on their first task, and they start in the background: the
+  client is returned once the scheduler is up, so the caller submits while the workers
+  start;
+- :func:`close_in_background` stops the cluster (its nannies wait for their worker
+  processes to exit) while the caller writes its results.
 """
 
 from __future__ import annotations
 
 import os
+import threading
 from pathlib import Path
-from contextlib import contextmanager
-from typing import Any, Iterator
+from contextlib import ExitStack, contextmanager
+from typing import Any, Callable, Iterator
 
 from ..errors import InputError
+
+#: the module a sweep's tasks run, imported by each local worker as it starts
+PRELOAD = "splinedeform.study.solve"
 
 
 @contextmanager
@@ -63,18 +76,75 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
             raise InputError(f"--memory-limit takes a size such as 2GiB or 500MB, got "
                              f"{memory_limit!r}") from None
     try:
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+        # no worker yet: the client connects to the scheduler at once, the workers are
+        # started by scale() below while the caller goes on
+        cluster = LocalCluster(n_workers=0, threads_per_worker=1, processes=True,
                                host="127.0.0.1", dashboard_address="127.0.0.1:0",
                                memory_limit=memory_limit if memory_limit is not None
-                               else "auto")
+                               else "auto", preload=[PRELOAD])
     except (ValueError, TypeError) as exc:
         raise InputError(f"cannot start the local Dask cluster ({exc}); --memory-limit "
                          "takes a size such as 2GiB") from None
     try:
-        with Client(cluster) as client:
+        # not ``with Client(...)``: its context is entered and left in one thread, and
+        # close_in_background closes the client in another
+        client = Client(cluster)
+        try:
+            cluster.scale(n)
             yield client
+        finally:
+            client.close()
     finally:
         cluster.close()
+
+
+def _requested(client: Any) -> set | None:
+    """The workers a local cluster of ``client`` has or is starting, or None."""
+    return getattr(getattr(client, "cluster", None), "requested", None)
+
+
+def expected_workers(client: Any) -> int:
+    """The workers a client's cluster has or is starting (a local cluster's requested
+    count, else those connected to the scheduler; at least 1)."""
+    requested = _requested(client)
+    if requested:
+        return len(requested)
+    return max(1, len(client.scheduler_info().get("workers", {})))
+
+
+def spare_core(client: Any) -> bool:
+    """Whether this machine has a core that the cluster's workers here leave idle (a local
+    cluster's requested workers, else the threads of the workers on the loopback address)."""
+    requested = _requested(client)
+    if requested is not None:
+        here = len(requested)
+    else:
+        workers = client.scheduler_info().get("workers", {})
+        here = sum(int(w.get("nthreads", 1)) for address, w in workers.items()
+                   if "127.0.0.1" in address or "localhost" in address)
+    return here < (os.cpu_count() or 1)
+
+
+def close_in_background(stack: ExitStack) -> Callable[[], None]:
+    """Close ``stack`` (a cluster and its client) in a thread; returns the function that
+    waits for it and raises what the close raised."""
+    raised: list[BaseException] = []
+
+    def close() -> None:
+        try:
+            stack.close()
+        except BaseException as exc:  # noqa: BLE001  (raised again by join)
+            raised.append(exc)
+
+    thread = threading.Thread(target=close, name="splinedeform-cluster-close", daemon=True)
+    thread.start()
+
+    def join() -> None:
+        thread.join()
+        if raised:
+            raise raised[0]
+
+    return join
 
 
 def dashboard(client: Any) -> str | None:

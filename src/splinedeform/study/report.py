@@ -9,8 +9,10 @@ equally spaced positions labelled with the values.
 
 from __future__ import annotations
 
+import importlib
 import math
 import re
+import threading
 from pathlib import Path
 from typing import Any
 
@@ -19,6 +21,23 @@ from .store import columns, flat
 
 #: the results plotted, those present in the rows
 PLOTTED = ("max_displacement", "omega_1", "strain_energy", "strain_energy_max", "p1_max")
+
+
+#: what writing the tables and the plots imports (the Agg canvas: savefig's first use)
+WRITERS = ("pyarrow.parquet", "matplotlib.figure", "matplotlib.backends.backend_agg")
+
+
+def import_writers_in_background() -> None:
+    """Import :data:`WRITERS` in a thread, for a sweep whose cases leave a core idle: the
+    tables and plots are then written without waiting for the imports."""
+    def load() -> None:
+        for name in WRITERS:
+            try:
+                importlib.import_module(name)
+            except ImportError:            # the writer says so when it runs
+                return
+
+    threading.Thread(target=load, name="splinedeform-report-imports", daemon=True).start()
 
 
 def write_report(result: Any) -> dict[str, Path]:

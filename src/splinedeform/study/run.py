@@ -10,20 +10,23 @@
    cases together (:func:`tasks`: about :data:`TASKS_PER_WORKER` tasks a worker, so that
    the scheduler's cost per task stays small beside the cases' work); Dask reschedules
    the task of a worker that dies, and the task skips the cases its first attempt stored;
-4. write ``results.parquet``, ``results.csv`` and ``report.md`` (:mod:`.report`).
+4. write ``results.parquet``, ``results.csv`` and ``report.md`` (:mod:`.report`), while a
+   local cluster started for the sweep stops (:func:`.cluster.close_in_background`).
 """
 
 from __future__ import annotations
 
 import time
 import uuid
+from contextlib import ExitStack
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
 from ..errors import InputError
 from .cases import Case, plan_cases
-from .cluster import dashboard, dask_client
+from .cluster import (close_in_background, dashboard, dask_client, expected_workers,
+                      spare_core)
 from .read import Sweep, load_sweep
 from .solve import solve_groups
 from .store import case_file, remove_partial, stored, write_tables
@@ -93,19 +96,24 @@ def sweep(sweep_file_or_spec: str | Path | Sweep, out: str | Path, client: Any =
     result = SweepResult(sweep=spec, folder=folder, rows=[], computed=len(pending),
                          reused=sum(c.scenario is not None for c in cases) - len(pending),
                          models=len(groups))
+    closed = lambda: None  # noqa: E731  (no cluster of our own to wait for)
     if groups:
         if client is not None:
             _run_groups(client, spec, folder, cases, list(groups.values()), progress, result)
         else:
-            with dask_client(workers, scheduler, memory_limit) as own:
+            with ExitStack() as stack:
+                own = stack.enter_context(dask_client(workers, scheduler, memory_limit))
                 _run_groups(own, spec, folder, cases, list(groups.values()), progress, result)
-    result.rows = [_row(case, folder) for case in cases]
-    from .report import write_report
+                closed = close_in_background(stack.pop_all())
+    try:
+        result.rows = [_row(case, folder) for case in cases]
+        from .report import write_report
 
-    csv_path, parquet_path = write_tables(folder, result.rows)
+        csv_path, parquet_path = write_tables(folder, result.rows)
+        result.files = {"csv": csv_path, "parquet": parquet_path, **write_report(result)}
+    finally:
+        closed()
     result.wall_s = time.perf_counter() - start
-    result.files = {"csv": csv_path, "parquet": parquet_path,
-                    **write_report(result)}
     return result
 
 
@@ -143,13 +151,17 @@ def _run_groups(client: Any, spec: Sweep, folder: Path, cases: list[Case],
     from distributed import wait
 
     run_id = uuid.uuid4().hex[:8]
-    workers = len(client.scheduler_info().get("workers", {}))
+    workers = expected_workers(client)
     futures = {client.submit(solve_groups, task, str(folder.resolve()), spec.cases_output,
                              key=f"splinedeform-sweep-{run_id}-{i}", pure=False):
                [case for group in task for case in group]
                for i, task in enumerate(tasks(groups, workers), start=1)}
     result.workers = workers
     result.dashboard = dashboard(client)
+    if spare_core(client):      # else the imports would take a core from the workers
+        from .report import import_writers_in_background
+
+        import_writers_in_background()
     failed = sum(c.scenario is None for c in cases)
     try:
         remaining = set(futures)

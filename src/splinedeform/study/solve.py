@@ -19,8 +19,9 @@ from ..budget import check as check_budget
 from ..errors import InputError
 from ..pipeline import _prepare_outdir, _solve, _Stages, write_outputs
 from ..scenario import Built, build_load
-from ..scenario.build import _located, build_model, check_parameters
+from ..scenario.build import _located, check_parameters
 from .cases import Case
+from .geometries import model_of
 from .measure import figures
 from .modal_cases import ModalReadout, prepare
 from .store import CASES, store, stored
@@ -84,7 +85,7 @@ def solve_groups(groups: list[list[Case]], folder: str, case_outputs: bool = Fal
 def _build(case: Case) -> tuple[Built | None, str | None]:
     """The model of a group, or the message of the error that stopped its build."""
     try:
-        return build_model(case.scenario), None
+        return model_of(case), None
     except InputError as exc:
         return None, str(exc)
     except Exception as exc:  # noqa: BLE001  (the row says it; the sweep goes on)
