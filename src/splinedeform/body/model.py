@@ -17,6 +17,7 @@ conforming interfaces and poles and applies the edge conditions of boundary edge
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from typing import Any, Mapping, Sequence
 
 import numpy as np
@@ -32,11 +33,14 @@ from ..model import Model, check_options
 from ..readout import BodyReadout
 from ..solvers.system import Reduction
 from ..surface import Surface
+from ..physics.coupling_curves import curve_penalty
 from ..physics.coupling_model import c0_coupling, interface_coupling
+from ..trim.model_matrices import trimmed_system
 from .body import Body
 from .constraints import boundary_presets, build_body_constraints
 from .interface import EDGES
 from .loads import OnPatch
+from .trimmed import edge_boundary, face_boundary, loop_presets, with_trimmed_faces
 
 Array = NDArray[np.float64]
 
@@ -125,21 +129,40 @@ class BodyModel(Model):
                                                                     rest, physics)
         for surface in self.patches:
             check_bending(surface, material)
+        trims = body.trim_interfaces
+        faces = {p for p, s in enumerate(self.patches) if s.trim is not None}
+        if faces and physics != "parametric":
+            raise InputError(f"a body with trimmed faces ({sorted(faces)}) takes physics "
+                             f"'parametric' (each face's energy over its trimmed region); "
+                             f"{physics!r} is not trimmed yet")
+        loops = loop_presets(self.patches, trims, boundary)
+        presets = boundary_presets(edge_boundary(boundary, loops), topology)
         self.constraints = build_body_constraints(
-            self.patches, topology, boundary_presets(boundary, topology))
+            self.patches, topology, {k: "free" if k[0] in faces else v
+                                     for k, v in presets.items()})
+        systems = {p: trimmed_system(self.patches[p], material,
+                                     face_boundary(p, self.patches[p], presets, loops),
+                                     mass_matrix == "lumped", physics, rest=rest)
+                   for p in sorted(faces)}
+        if systems:
+            self.constraints = replace(with_trimmed_faces(
+                self.constraints, self.patches, {p: s.constraints for p, s in systems.items()},
+                loops), edges={**presets, **loops})
         if self.constraints.n_free == 0:
             error = InputError(f"no free coordinate: the boundary fixes every control point of "
                                f"the {len(self.patches)} patches; free an edge or refine them")
             error.key = "boundary"  # type: ignore[attr-defined]
             raise error
-        blocks = [patch_matrices(s, material, physics, mass_matrix == "lumped")[2:]
-                  for s in self.patches]
+        blocks = [(systems[p].stiffness, systems[p].mass) if p in systems
+                  else patch_matrices(s, material, physics, mass_matrix == "lumped")[2:]
+                  for p, s in enumerate(self.patches)]
         K = sp.block_diag([k for k, _ in blocks], format="csr")
         M = sp.block_diag([m for _, m in blocks], format="csr")
         offsets = self.constraints.offsets
         size = int(offsets[-1])
         couplings = [interface_coupling(self.patches, topology.interfaces, material,
                                         self.constraints.edges, offsets[:-1])]
+        couplings += [curve_penalty(self.patches, i, material, offsets[:-1]) for i in trims]
         couplings += [c0_coupling(s, material, {e: self.constraints.edges.get((p, e), "free")
                                                 for e in EDGES}, int(offsets[p]), size)
                       for p, s in enumerate(self.patches)]
@@ -218,7 +241,8 @@ class BodyModel(Model):
         else:
             return None
         n = len(self.patches)
-        links = [(i.a, i.b) for i in self.body.topology.interfaces] or [(0, 0)]
+        links = [(i.a, i.b) for i in self.body.topology.interfaces + self.body.trim_interfaces
+                 ] or [(0, 0)]
         graph = sp.coo_matrix((np.ones(len(links)), np.array(links).T), shape=(n, n))
         parts, label = connected_components(graph, directed=False)
         held = np.zeros(parts, dtype=bool)
