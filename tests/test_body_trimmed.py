@@ -102,3 +102,22 @@ def test_an_iso_edge_is_a_straight_trim_curve():
     assert abs(along.slopes - across.slopes).max() < 1e-12 * abs(across.slopes).max()
     assert np.abs(along.conormal - across.conormal).max() < 1e-12
     assert np.abs(along.speed - scale * across.speed).max() < 1e-12 * scale
+
+
+def test_the_body_mesh_covers_each_face_on_its_region_only():
+    # the welded mesh of the rest body (a flat square, x = (u, v, 0)): the disc's points
+    # lie in the disc and the ring's outside it, to the loops' bisection round-off (1e-9),
+    # and together their triangles cover the square once: both faces are sampled on one
+    # grid, so the disc's chords of the circle are the ring's and the areas add up to 1
+    # (to 1e-12, round-off of some 2000 triangles)
+    from splinedeform.export.body import welded_body
+
+    body = split_square(8, 12, degree=3)
+    frames = [s.control_points[None] for s in body.patches]
+    X, faces, patch = welded_body(body.patches, frames, 33)
+    radius = np.hypot(X[0, :, 0] - CENTRE[0], X[0, :, 1] - CENTRE[1])
+    assert radius[patch == 0].max() < RADIUS + 1e-9
+    assert radius[patch == 1].min() > RADIUS - 1e-9
+    a, b, c = (X[0, faces[:, k]] for k in range(3))
+    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum()
+    assert abs(area - 1.0) < 1e-12

@@ -74,7 +74,9 @@ class BodyModel(Model):
     boundary : str or mapping, default "free"
         ``"free" | "pinned" | "clamped"`` for every boundary edge (an edge no other edge
         meets), or ``{(patch, edge): preset}`` (missing boundary edges are free). Interface
-        and pole edges have no preset: they are merged or coupled (Notes).
+        and pole edges have no preset: they are merged or coupled (Notes). A trimmed face's
+        loops are keyed ``(patch, "outer")``, ``(patch, "hole1")`` …; a loop it shares with
+        another face (:attr:`.Body.trim_interfaces`) has no preset either.
     mass_matrix : {"consistent", "lumped"}
     rest : {"initial", "none"}
     physics : {"intrinsic", "parametric"}, default "intrinsic"
@@ -98,7 +100,10 @@ class BodyModel(Model):
     edge's splines (a penalised mortar condition); with bending weights, every interface
     and C0 knot line also by a penalty on the slope jump across it. The factors come from
     the material and the mesh (:mod:`splinedeform.physics.coupling_model`); the mass is
-    the patches' own.
+    the patches' own. A trimmed face (``physics = "parametric"`` only) brings the matrices
+    and the extension map of :func:`~splinedeform.trim.model_matrices.trimmed_system`,
+    and the faces sharing a trim curve are coupled along it by the same penalties
+    (:func:`~splinedeform.physics.coupling_curves.curve_penalty`).
 
     Examples
     --------
