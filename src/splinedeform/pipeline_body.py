@@ -84,8 +84,31 @@ def _frames(scenario: Scenario, patches: Any, solution: Any, times: Any, mode_ne
     return [r + phase * m[0] for r, m in zip(rests, mode_nets)]
 
 
+PROBE_GRID = 33
+"""Samples per direction among which a trimmed face's probe is chosen."""
+
+
+def probe_parameters(surface: Any) -> tuple[float, float, str]:
+    """Where a face's probe reads it: the centre of its parameter rectangle, or, for a
+    trimmed face whose region does not hold the centre, the sample of a
+    :data:`PROBE_GRID` ² grid inside its region nearest to it (``"inside"``)."""
+    (_, lu), (_, lv) = surface.domain
+    centre = np.array([0.5 * lu, 0.5 * lv])
+    if surface.trim is None:
+        return float(centre[0]), float(centre[1]), "centre"
+    from .trim.surface_trim import region_contains
+
+    if region_contains(surface, centre[None])[0]:
+        return float(centre[0]), float(centre[1]), "centre"
+    U, V = np.meshgrid(np.linspace(0.0, lu, PROBE_GRID), np.linspace(0.0, lv, PROBE_GRID))
+    grid = np.stack([U.ravel(), V.ravel()], axis=1)
+    inside = grid[region_contains(surface, grid)]
+    best = inside[np.argmin(np.sum((inside - centre) ** 2, axis=1))]
+    return float(best[0]), float(best[1]), "inside"
+
+
 def _measure(result: Any) -> None:
-    """Each face's centre displacement per frame (the probes), the largest displacement on
+    """Each face's centre displacement per frame (the probes; :func:`probe_parameters`), the largest displacement on
     the patches' output grids per frame, and the energies."""
     from .run_measures import displacement_per_frame, energies
 
@@ -94,13 +117,13 @@ def _measure(result: Any) -> None:
     per_frame = np.zeros(F)
     for k, (surface, nets) in enumerate(zip(body.patches, result.nets)):
         D = nets - surface.control_points
-        (_, lu), (_, lv) = surface.domain
-        E = surface.evaluation_matrix(np.array([0.5 * lu]), np.array([0.5 * lv]))
+        u, v, where = probe_parameters(surface)
+        E = surface.evaluation_matrix(np.array([u]), np.array([v]))
         face = body.faces[k] if hasattr(body, "faces") else k
-        name = f"face {face} centre"
+        name = f"face {face} {where}"
         result.probes[name] = np.asarray(E @ np.moveaxis(D.reshape(F, -1, 3), 0, 1)
                                          .reshape(E.shape[1], F * 3)).reshape(F, 3)
-        result.probe_points[name] = (0.5 * lu, 0.5 * lv)
+        result.probe_points[name] = (u, v)
         per_frame = np.maximum(per_frame, displacement_per_frame(
             surface, D, scenario.output.resolution))
     result.displacement_per_frame = per_frame
