@@ -41,12 +41,13 @@ from ..errors import InputError
 from ..material import Material
 from ..rational import rational_operators
 from ..surface import Surface
-from ..trim.cells import _circle_pieces
+from ..trim.cells import Grid, _circle_pieces
 from ..trim.loops import CircleLoop, PolygonLoop
 from ..trim.spline_loop import SplineLoop
 from ..trim.values import tensor_values
 from .coupling import line_penalty, penalty_factors
-from .coupling_traces import EXTRA_POINTS, GAP_TOLERANCE, Line, Trace, gauss, union
+from .coupling_traces import (EXTRA_POINTS, Line, Trace, check_meet, gauss, trace_of,
+                              union)
 
 Array = NDArray[np.float64]
 NEWTON_STEPS = 30
@@ -92,7 +93,6 @@ def curve_breaks(loop: Any, lengths: tuple[float, float], cells: tuple[int, int]
     lines = [np.arange(m + 1) * (L / m) for L, m in zip(lengths, cells)]
     T = period(loop)
     if isinstance(loop, CircleLoop):
-        from ..trim.cells import Grid
         lo, hi = _circle_pieces(CircleLoop(loop.centre, loop.radius), Grid(cells, lengths))
         found = [np.mod(np.concatenate([lo, hi]), T)]
     elif isinstance(loop, PolygonLoop):
@@ -180,15 +180,8 @@ class CurveSide:
         _, d, V, Du, Dv = self._operators(t)
         Dr = sp.diags(d[:, 0]) @ Du + sp.diags(d[:, 1]) @ Dv
         Df = sp.diags(d[:, 1]) @ Du - sp.diags(d[:, 0]) @ Dv
-        P = self.surface.control_points.reshape(-1, 3)
-        x, x_f, x_r = V @ P, Df @ P, Dr @ P
-        c = np.einsum("qi,qi->q", x_f, x_r) / np.einsum("qi,qi->q", x_r, x_r)
-        across = x_f - c[:, None] * x_r
-        length = np.linalg.norm(across, axis=1)
-        Dn = sp.diags(self.outward / length) @ (Df - sp.diags(c) @ Dr)
-        speed = np.linalg.norm(x_r, axis=1)
-        return Trace(V, Dn.tocsr(), x, speed, x_r / speed[:, None],
-                     self.outward * across / length[:, None])
+        return trace_of(V, Df.tocsr(), Dr.tocsr(),
+                        self.surface.control_points.reshape(-1, 3), self.outward)
 
     def closest(self, x: Array) -> Array:
         """Curve parameters of the points of the curve closest to ``x`` ``(Q, 3)``:
@@ -224,16 +217,8 @@ def curve_line(side_a: CurveSide, side_b: CurveSide, where: str) -> tuple[Line, 
     trace_a = side_a.traces(t)
     s = side_b.closest(trace_a.points)
     trace_b = side_b.traces(s)
-    points = np.concatenate([side.surface.control_points.reshape(-1, 3)
-                             for side in (side_a, side_b)])
-    size = float(np.ptp(points, axis=0).max())
-    gap = np.linalg.norm(trace_a.points - trace_b.points, axis=1)
-    if gap.max() > GAP_TOLERANCE * size:
-        worst = int(gap.argmax())
-        raise InputError(
-            f"{where}: the two trim curves do not meet; at t = {t[worst]:.6g} of the first "
-            f"they are {gap[worst]:.3g} apart ({gap[worst] / size:.2g} of the faces' size, "
-            f"more than {GAP_TOLERANCE:g})")
+    check_meet((trace_a, trace_b), (side_a.surface, side_b.surface), t,
+               f"{where}: the two trim curves do not meet; at t = {{at}} of the first")
     weights = w * trace_a.speed
     length = float(weights.sum())
     pieces = (len(breaks_a) - 1, len(breaks_b) - 1)
