@@ -121,3 +121,30 @@ def test_the_body_mesh_covers_each_face_on_its_region_only():
     a, b, c = (X[0, faces[:, k]] for k in range(3))
     area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum()
     assert abs(area - 1.0) < 1e-12
+
+
+def test_frequencies_of_the_split_square():
+    # the clamped square plate's lowest frequencies ω a² √(ρt/D) = 35.985, 73.394 (twice)
+    # (Gorman, Free Vibration Analysis of Rectangular Plates, 1982; Leissa's Ritz values
+    # 35.99 and 73.41 are upper bounds); the 12-16 cell pair reaches 1e-5, the bar is 1e-3
+    model = sd.BodyModel(split_square(12, 16), PLATE, boundary="clamped",
+                         physics="parametric")
+    expected = np.array([35.985, 73.394, 73.394])
+    assert np.max(np.abs(model.frequencies(3) / expected - 1)) < 1e-3
+
+
+def test_trim_interfaces_given_by_hand_are_checked():
+    # the found interface given by hand gives the same body; a loop that bounds nothing
+    # (the ring's rectangle) or a face the body lacks is refused, naming it
+    found = split_square(8, 8)
+    given = sd.Body(found.patches, trim_interfaces=[TrimInterface(0, 0, 1, 1)])
+    assert given.trim_interfaces == found.trim_interfaces
+    with pytest.raises(sd.InputError, match="face 1 has no trim loop 0"):
+        sd.Body(found.patches, trim_interfaces=[TrimInterface(0, 0, 1, 0)])
+    with pytest.raises(sd.InputError, match="face 2 has no trim loop"):
+        sd.Body(found.patches, trim_interfaces=[TrimInterface(0, 0, 2, 1)])
+
+
+def test_a_trimmed_body_refuses_the_intrinsic_energy():
+    with pytest.raises(sd.InputError, match="trimmed faces .* takes physics 'parametric'"):
+        sd.BodyModel(split_square(8, 8), PLATE, boundary="clamped")

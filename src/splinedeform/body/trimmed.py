@@ -110,6 +110,27 @@ def find_trim_interfaces(patches: Sequence[Surface], tol: float) -> tuple[TrimIn
     return tuple(found)
 
 
+def checked_trim_interfaces(patches: Sequence[Surface], given: Sequence[Any]
+                            ) -> tuple[TrimInterface, ...]:
+    """``given`` if each is a :class:`~.interface.TrimInterface` naming a curve loop
+    (:func:`curve_loops`) of two different faces, each loop in one interface at most."""
+    seen: set[tuple[int, int]] = set()
+    for i in given:
+        if not isinstance(i, TrimInterface):
+            raise InputError(f"trim interfaces must be splinedeform.body.TrimInterface "
+                             f"records, got {type(i).__name__}")
+        if i.a == i.b:
+            raise InputError(f"{i}: a trim interface joins two different faces")
+        for p, k in ((i.a, i.loop_a), (i.b, i.loop_b)):
+            if not 0 <= p < len(patches) or k not in curve_loops(patches[p]):
+                raise InputError(f"{i}: face {p} has no trim loop {k} bounding its region "
+                                 f"(the body has {len(patches)} faces)")
+            if (p, k) in seen:
+                raise InputError(f"{i}: loop {k} of face {p} is in two trim interfaces")
+            seen.add((p, k))
+    return tuple(given)
+
+
 def _lengths(surface: Surface) -> tuple[tuple[float, float], tuple[int, int]]:
     (_, lu), (_, lv) = surface.domain
     return (lu, lv), (surface.basis_u.cells, surface.basis_v.cells)
