@@ -9,7 +9,7 @@
   .. math:: (J^T J)\\, δ = J^T (p − x_k), \\qquad J = [x_u\\; x_v],
 
   kept on the parameter domain (clamped, or wrapped in a periodic direction);
-* none given: every face's centre.
+* none given: every face's centre (a trimmed face's nearest point inside its region).
 
 A probe's history is ``d_f(u, v) = Σ_kl N_kl(u, v) (P_f − P_rest)_kl`` of its face at every
 frame (:meth:`splinedeform.readout.BodyReadout.probe`).
@@ -88,6 +88,29 @@ def nearest_face(patches: Sequence[Any], point: Sequence[float]) -> int:
     return int(min(close, key=lambda k: nearest_point(patches[k], p)[0]))
 
 
+PROBE_GRID = 33
+"""Samples per direction among which a trimmed face's default probe is chosen."""
+
+
+def probe_parameters(surface: Any) -> tuple[float, float, str]:
+    """Where a face's default probe reads it: the centre of its parameter rectangle, or, for
+    a trimmed face whose region does not hold the centre, the sample of a
+    :data:`PROBE_GRID` ² grid inside its region nearest to it (``"inside"``)."""
+    (_, lu), (_, lv) = surface.domain
+    centre = np.array([0.5 * lu, 0.5 * lv])
+    if surface.trim is None:
+        return float(centre[0]), float(centre[1]), "centre"
+    from .trim.surface_trim import region_contains
+
+    if region_contains(surface, centre[None])[0]:
+        return float(centre[0]), float(centre[1]), "centre"
+    U, V = np.meshgrid(np.linspace(0.0, lu, PROBE_GRID), np.linspace(0.0, lv, PROBE_GRID))
+    grid = np.stack([U.ravel(), V.ravel()], axis=1)
+    inside = grid[region_contains(surface, grid)]
+    best = inside[np.argmin(np.sum((inside - centre) ** 2, axis=1))]
+    return float(best[0]), float(best[1]), "inside"
+
+
 def body_probes(scenario: Any, body: Any) -> list[BodyProbe]:
     """The probes of a body scenario (module docstring), checked at their keys."""
     from .scenario.body import check_at
@@ -95,9 +118,9 @@ def body_probes(scenario: Any, body: Any) -> list[BodyProbe]:
     faces = list(getattr(body, "faces", range(len(body))))
     probes, named = scenario.output.probes, scenario.output.probe_faces
     if not probes:
-        return [BodyProbe(f"face {f} centre", k, (0.5 * s.basis_u.length,
-                                                   0.5 * s.basis_v.length))
-                for k, (f, s) in enumerate(zip(faces, body.patches))]
+        return [BodyProbe(f"face {f} {where}", k, (u, v))
+                for k, (f, s) in enumerate(zip(faces, body.patches))
+                for u, v, where in [probe_parameters(s)]]
     if named is not None and len(named) != len(probes):
         raise scenario.error("output.probe_faces", f"gives {len(named)} face(s) for "
                              f"{len(probes)} probe(s): one face per entry of output.probes")

@@ -22,9 +22,10 @@ from ..errors import InputError
 from ..knots import KnotVectorBasis, RationalBasis
 from ..refine import boehm_insert
 from ..surface import Surface
-from .interface import Interface
+from .interface import Interface, TrimInterface
 from .topology import (KNOT_TOLERANCE, Topology, body_size, edge_basis, edges_of,
                        find_topology, normalised_knots)
+from .trimmed import checked_trim_interfaces, find_trim_interfaces, without_trimmed_edges
 
 Array = NDArray[np.float64]
 MAX_PASSES = 16
@@ -41,6 +42,12 @@ class Body:
         Where edges meet; found geometrically (:func:`~.topology.find_topology`) if not given.
     tol : float, optional
         Matching distance (default ``1e-6 ×`` the bounding-box diagonal).
+    trim_interfaces : list of TrimInterface, optional
+        Trim loops of two faces that meet along one curve; found geometrically
+        (:func:`~.trimmed.find_trim_interfaces`) if not given.
+
+    Trimmed faces (``surface.trim``) meet along their trim curves: pairs of loops tracing
+    one curve are found geometrically (:mod:`.trimmed`), :attr:`trim_interfaces`.
 
     Examples
     --------
@@ -53,14 +60,20 @@ class Body:
     """
 
     def __init__(self, patches: Sequence[Surface], interfaces: Sequence[Interface] | None = None,
-                 tol: float | None = None):
+                 tol: float | None = None,
+                 trim_interfaces: Sequence[TrimInterface] | None = None):
         self.patches: tuple[Surface, ...] = tuple(patches)
-        found = find_topology(self.patches, tol)
+        found = without_trimmed_edges(self.patches, find_topology(self.patches, tol))
         if interfaces is None:
             self.topology = found
         else:
             self.topology = _given(self.patches, list(interfaces), found)
         self.interfaces: tuple[Interface, ...] = self.topology.interfaces
+        self.trim_interfaces: tuple[TrimInterface, ...] = (
+            checked_trim_interfaces(self.patches, trim_interfaces)
+            if trim_interfaces is not None
+            else find_trim_interfaces(self.patches, self.topology.tol)
+            if any(s.trim is not None for s in self.patches) else ())
 
     @classmethod
     def from_surfaces(cls, surfaces: Sequence[Surface], tol: float | None = None) -> Body:

@@ -45,3 +45,20 @@ class Interface:
         if self.a == self.b and self.edge_a == self.edge_b:
             raise ValueError(f"an interface joins two different edges, got {self.edge_a} twice "
                              f"on patch {self.a}")
+
+
+@dataclass(frozen=True)
+class TrimInterface:
+    """Trim loop ``loop_a`` of face ``a`` meets trim loop ``loop_b`` of face ``b`` along one
+    curve (loops counted as in :attr:`splinedeform.trim.TrimDomain.loops`: 0 the outer
+    loop, then the holes); coupled by :func:`splinedeform.physics.coupling_curves.curve_penalty`.
+    """
+
+    a: int
+    loop_a: int
+    b: int
+    loop_b: int
+
+    def __str__(self) -> str:
+        return (f"the trim interface of face {self.a} loop {self.loop_a} and face {self.b} "
+                f"loop {self.loop_b}")

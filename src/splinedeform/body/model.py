@@ -17,6 +17,7 @@ conforming interfaces and poles and applies the edge conditions of boundary edge
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from typing import Any, Mapping, Sequence
 
 import numpy as np
@@ -34,11 +35,14 @@ from ..readout import BodyReadout
 from ..solvers.rigid import UnresolvedSpectrum, count_by_gap
 from ..solvers.system import Reduction
 from ..surface import Surface
+from ..physics.coupling_curves import curve_penalty
 from ..physics.coupling_model import bends, c0_coupling, interface_coupling
+from ..trim.model_matrices import trimmed_system
 from .body import Body
 from .constraints import boundary_presets, build_body_constraints
 from .interface import EDGES
 from .loads import OnPatch
+from .trimmed import edge_boundary, face_boundary, loop_presets, with_trimmed_faces
 
 Array = NDArray[np.float64]
 PROBE_LIMIT = 1500
@@ -75,7 +79,9 @@ class BodyModel(Model):
     boundary : str or mapping, default "free"
         ``"free" | "pinned" | "clamped"`` for every boundary edge (an edge no other edge
         meets), or ``{(patch, edge): preset}`` (missing boundary edges are free). Interface
-        and pole edges have no preset: they are merged or coupled (Notes).
+        and pole edges have no preset: they are merged or coupled (Notes). A trimmed face's
+        loops are keyed ``(patch, "outer")``, ``(patch, "hole1")`` …; a loop it shares with
+        another face (:attr:`.Body.trim_interfaces`) has no preset either.
     mass_matrix : {"consistent", "lumped"}
     rest : {"initial", "none"}
     physics : {"intrinsic", "parametric"}, default "intrinsic"
@@ -99,7 +105,10 @@ class BodyModel(Model):
     edge's splines (a penalised mortar condition); with bending weights, every interface
     and C0 knot line also by a penalty on the slope jump across it. The factors come from
     the material and the mesh (:mod:`splinedeform.physics.coupling_model`); the mass is
-    the patches' own.
+    the patches' own. A trimmed face (``physics = "parametric"`` only) brings the matrices
+    and the extension map of :func:`~splinedeform.trim.model_matrices.trimmed_system`,
+    and the faces sharing a trim curve are coupled along it by the same penalties
+    (:func:`~splinedeform.physics.coupling_curves.curve_penalty`).
 
     Examples
     --------
@@ -130,15 +139,33 @@ class BodyModel(Model):
                                                                     rest, physics)
         for surface in self.patches:
             check_bending(surface, material)
+        trims = body.trim_interfaces
+        faces = {p for p, s in enumerate(self.patches) if s.trim is not None}
+        if faces and physics != "parametric":
+            raise InputError(f"a body with trimmed faces ({sorted(faces)}) takes physics "
+                             f"'parametric' (each face's energy over its trimmed region); "
+                             f"{physics!r} is not trimmed yet")
+        loops = loop_presets(self.patches, trims, boundary)
+        presets = boundary_presets(edge_boundary(boundary, loops), topology)
         self.constraints = build_body_constraints(
-            self.patches, topology, boundary_presets(boundary, topology), bends(material))
+            self.patches, topology, {k: "free" if k[0] in faces else v
+                                     for k, v in presets.items()}, bends(material))
+        systems = {p: trimmed_system(self.patches[p], material,
+                                     face_boundary(p, self.patches[p], presets, loops),
+                                     mass_matrix == "lumped", physics, rest=rest)
+                   for p in sorted(faces)}
+        if systems:
+            self.constraints = replace(with_trimmed_faces(
+                self.constraints, self.patches, {p: s.constraints for p, s in systems.items()},
+                loops), edges={**presets, **loops})
         if self.constraints.n_free == 0:
             error = InputError(f"no free coordinate: the boundary fixes every control point of "
                                f"the {len(self.patches)} patches; free an edge or refine them")
             error.key = "boundary"  # type: ignore[attr-defined]
             raise error
-        blocks = [patch_matrices(s, material, physics, mass_matrix == "lumped")[2:]
-                  for s in self.patches]
+        blocks = [(systems[p].stiffness, systems[p].mass) if p in systems
+                  else patch_matrices(s, material, physics, mass_matrix == "lumped")[2:]
+                  for p, s in enumerate(self.patches)]
         K = sp.block_diag([k for k, _ in blocks], format="csr")
         M = sp.block_diag([m for _, m in blocks], format="csr")
         offsets = self.constraints.offsets
@@ -146,6 +173,7 @@ class BodyModel(Model):
         ties = self.constraints.ties
         couplings = [interface_coupling(self.patches, topology.interfaces, material,
                                         self.constraints.edges, offsets[:-1], ties.interfaces)]
+        couplings += [curve_penalty(self.patches, i, material, offsets[:-1]) for i in trims]
         couplings += [c0_coupling(s, material, {e: self.constraints.edges.get((p, e), "free")
                                                 for e in EDGES}, int(offsets[p]), size,
                                   {(d, k) for q, d, k in ties.lines if q == p})
@@ -236,7 +264,8 @@ class BodyModel(Model):
         else:
             return None
         n = len(self.patches)
-        links = [(i.a, i.b) for i in self.body.topology.interfaces] or [(0, 0)]
+        links = [(i.a, i.b) for i in self.body.topology.interfaces + self.body.trim_interfaces
+                 ] or [(0, 0)]
         graph = sp.coo_matrix((np.ones(len(links)), np.array(links).T), shape=(n, n))
         parts, label = connected_components(graph, directed=False)
         held = np.zeros(parts, dtype=bool)

@@ -155,9 +155,27 @@ def displacement_penalty(patches: Sequence[Surface], interface: Interface, alpha
     side_a, side_b = _sides(patches, interface)
     line = common_line(side_a, side_b, interface.reversed, _name(interface))
     off_a, off_b, size = _global(patches, interface, offsets)
-    jump = (_place(line.sides[0].values, off_a, size)
-            - _place(line.sides[1].values, off_b, size))
-    return _penalty(jump, line.weights, alpha, line.space(crosspoints) if projected else None)
+    return line_penalty(line, "values", (off_a, off_b, size), alpha,
+                        line.space(crosspoints) if projected else None)
+
+
+def line_penalty(line: Line, kind: str, layout: tuple[int, int, int], factor: float,
+                 space: sp.csr_matrix | None) -> sp.csr_matrix:
+    """The penalty of one jump on a coupling line, whatever the line's shape.
+
+    ``kind = "values"``: ``½ factor ∫ (Π (d_a − d_b))² ds``; ``kind = "slopes"``:
+    ``½ factor ∫ (Π (∂_{n_a} d_a + ∂_{n_b} d_b))² ds`` (outward conormals, so a smooth
+    continuation costs nothing). ``layout`` is ``(offset_a, offset_b, size)``: the sides'
+    first control points among ``size`` concatenated ones; ``space`` the basis ``Φ`` of the
+    trace space at the line's points (``None``: ``Π = I``). An iso-edge's line
+    (:func:`~.coupling_traces.common_line`) and a trim curve's
+    (:func:`~.coupling_curves.curve_line`) are penalised alike.
+    """
+    off_a, off_b, size = layout
+    sign = {"values": -1.0, "slopes": 1.0}[kind]
+    a, b = (getattr(trace, kind) for trace in line.sides)
+    jump = _place(a, off_a, size) + sign * _place(b, off_b, size)
+    return _penalty(jump.tocsr(), line.weights, factor, space)
 
 
 def rotation_penalty(patches: Sequence[Surface], interface: Interface, beta: float,
@@ -173,9 +191,8 @@ def rotation_penalty(patches: Sequence[Surface], interface: Interface, beta: flo
     side_a, side_b = _sides(patches, interface)
     line = common_line(side_a, side_b, interface.reversed, _name(interface))
     off_a, off_b, size = _global(patches, interface, offsets)
-    jump = (_place(line.sides[0].slopes, off_a, size)
-            + _place(line.sides[1].slopes, off_b, size))
-    return _penalty(jump, line.weights, beta, line.space(crosspoints) if projected else None)
+    return line_penalty(line, "slopes", (off_a, off_b, size), beta,
+                        line.space(crosspoints) if projected else None)
 
 
 def _interleaved(operator: sp.csr_matrix, direction: Array, offset: int, size: int
@@ -305,8 +322,7 @@ def c0_rotation_penalty(surface: Surface, direction: str, knot: float, beta: flo
     line = _c0_line(surface, direction, knot)
     count = surface.shape[0] * surface.shape[1]
     size = offset + count if size is None else int(size)
-    jump = _place(line.sides[0].slopes, offset, size) + _place(line.sides[1].slopes, offset, size)
-    return _penalty(jump, line.weights, beta, line.space(crosspoints))
+    return line_penalty(line, "slopes", (offset, offset, size), beta, line.space(crosspoints))
 
 
 def _c0_line(surface: Surface, direction: str, knot: float) -> Line:

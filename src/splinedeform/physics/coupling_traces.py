@@ -44,6 +44,24 @@ class Trace:
     conormal: Array
 
 
+def trace_of(V: sp.csr_matrix, Df: sp.csr_matrix, Dr: sp.csr_matrix, P: Array, outward: int
+             ) -> Trace:
+    """The :class:`Trace` of a side from its operators on the net ``P`` ``(N, 3)``: values
+    ``V``, derivatives across (``Df``) and along (``Dr``) the line.
+
+    The conormal is ``n ∝ x_f − (x_f·x_r / x_r·x_r) x_r``, so
+    ``∂_n d = ±(d_f − c d_r) / |x_f − c x_r|``, the sign ``outward``.
+    """
+    x, x_f, x_r = V @ P, Df @ P, Dr @ P
+    c = np.einsum("qi,qi->q", x_f, x_r) / np.einsum("qi,qi->q", x_r, x_r)
+    across_line = x_f - c[:, None] * x_r
+    length = np.linalg.norm(across_line, axis=1)
+    Dn = sp.diags(outward / length) @ (Df - sp.diags(c) @ Dr)
+    speed = np.linalg.norm(x_r, axis=1)
+    return Trace(V, Dn.tocsr(), x, speed, x_r / speed[:, None],
+                 outward * across_line / length[:, None])
+
+
 @dataclass(frozen=True)
 class Side:
     """One side of a coupling line: ``surface`` near the line ``fixed = value``.
@@ -107,15 +125,7 @@ class Side:
         V, Df, Dr = operator(0, 0), operator(1, 0), operator(0, 1)
         if surface.net_weights is not None:          # general weights: the quotient rule
             V, (Df, Dr) = rational_operators(V, (Df, Dr), surface.net_weights)
-        P = surface.control_points.reshape(-1, 3)
-        x, x_f, x_r = V @ P, Df @ P, Dr @ P
-        c = np.einsum("qi,qi->q", x_f, x_r) / np.einsum("qi,qi->q", x_r, x_r)
-        across_line = x_f - c[:, None] * x_r
-        length = np.linalg.norm(across_line, axis=1)
-        Dn = sp.diags(self.outward / length) @ (Df - sp.diags(c) @ Dr)
-        speed = np.linalg.norm(x_r, axis=1)
-        return Trace(V, Dn.tocsr(), x, speed, x_r / speed[:, None],
-                     self.outward * across_line / length[:, None])
+        return trace_of(V, Df, Dr, surface.control_points.reshape(-1, 3), self.outward)
 
     def points(self) -> int:
         """Gauss points per span along the line: ``n + 1 +`` :data:`EXTRA_POINTS`, or a
@@ -179,21 +189,30 @@ def common_line(side_a: Side, side_b: Side, reversed_: bool, where: str) -> Line
     s_a = lo_a + (hi_a - lo_a) * sigma
     s_b = lo_b + (hi_b - lo_b) * ((1.0 - sigma) if reversed_ else sigma)
     trace_a, trace_b = side_a.traces(s_a), side_b.traces(s_b)
-    points = np.concatenate([side_a.surface.control_points.reshape(-1, 3),
-                             side_b.surface.control_points.reshape(-1, 3)])
-    size = float(np.ptp(points, axis=0).max())
-    gap = np.linalg.norm(trace_a.points - trace_b.points, axis=1)
-    if gap.max() > GAP_TOLERANCE * size:
-        worst = int(gap.argmax())
-        raise InputError(
-            f"{where}: the two edges do not meet; at s = {s_a[worst]:.6g} of the first they are "
-            f"{gap[worst]:.3g} apart ({gap[worst] / size:.2g} of the patches' size, more than "
-            f"{GAP_TOLERANCE:g}). Check the edges and whether one is reversed")
+    check_meet((trace_a, trace_b), (side_a.surface, side_b.surface), s_a,
+               f"{where}: the two edges do not meet; at s = {{at}} of the first",
+               "Check the edges and whether one is reversed")
     # the finer edge's splines (more functions; a's on a tie), ends in a's order
     fine_b = side_b.running.size > side_a.running.size
     projector = side_b.running.matrix(s_b) if fine_b else side_a.running.matrix(s_a)
     return Line((trace_a, trace_b), w * trace_a.speed * (hi_a - lo_a), projector.tocsr(),
                 fine_b and reversed_)
+
+
+def check_meet(traces: tuple[Trace, Trace], surfaces: tuple[Surface, Surface], s: Array,
+               what: str, advice: str = "") -> None:
+    """Raise where the two sides' rest points lie farther apart than :data:`GAP_TOLERANCE`
+    of the two surfaces' size; ``what`` names the place, ``{at}`` the worst parameter
+    among ``s``."""
+    points = np.concatenate([x.control_points.reshape(-1, 3) for x in surfaces])
+    size = float(np.ptp(points, axis=0).max())
+    gap = np.linalg.norm(traces[0].points - traces[1].points, axis=1)
+    if gap.max() > GAP_TOLERANCE * size:
+        worst = int(gap.argmax())
+        raise InputError(
+            f"{what.format(at=f'{s[worst]:.6g}')} they are {gap[worst]:.3g} apart "
+            f"({gap[worst] / size:.2g} of the surfaces' size, more than {GAP_TOLERANCE:g})"
+            + (f". {advice}" if advice else ""))
 
 
 def merged(basis: sp.csr_matrix, start: int, end: int) -> sp.csr_matrix:

@@ -69,6 +69,9 @@ def with_face_trim(scenario: Any, surface: Any, caught: list[warnings.WarningMes
     again, its word on the whole surface replaced by one line of this module's."""
     spec = scenario.surface
     asked = spec.parameters.get("trimmed")
+    from .body import FileBody
+    if isinstance(surface, FileBody) and asked is not False:
+        return with_body_trims(scenario, surface, caught)
     if not isinstance(surface, Surface) or spec.trim is not None or asked is False:
         _shown(caught, drop_whole=asked is False)          # the whole face was asked for
         return surface
@@ -140,3 +143,54 @@ def face_loop_presets(scenario: Any, surface: Any) -> dict[str, str]:
                                      f"{count} trim edge(s), numbered 0 to {count - 1}")
             out[name if count == 1 else f"{name}.{int(key)}"] = preset
     return out
+
+
+def with_body_trims(scenario: Any, body: Any, caught: list[warnings.WarningMessage]) -> Any:
+    """A body of CAD faces (:class:`~splinedeform.scenario.body.FileBody`) with each trimmed
+    face's loops attached where the trimmed model can hold it (as for one face, module
+    docstring), so that faces sharing a trim curve are coupled along it
+    (:mod:`splinedeform.body.trimmed`); the file's interfaces of a face whose rectangle
+    edges leave its region are dropped. A face that cannot be trimmed is taken whole, with
+    the reader's one warning line (with its reason); ``trimmed = true`` refuses it."""
+    from ..body.trimmed import edgeless
+    from ..cad_trims import read_trims
+    from .body import FileBody
+
+    path, asked = scenario.surface.path, scenario.surface.parameters.get("trimmed")
+    patches, kept_whole = list(body.patches), []
+    trimmed_faces: set[int] = set()
+    for p, (face, surface) in enumerate(zip(body.faces, body.patches)):
+        source = f"{path} face {face}"
+        try:
+            domain = read_trims(path, face)
+        except InputError as exc:
+            domain, reason = None, f"its trim loops cannot be read ({exc})"
+        else:
+            if domain is None or (not domain.holes and whole_rectangle(surface, domain.outer)):
+                continue
+            reason = why_untrimmable(scenario, surface)
+        if reason is None:
+            try:
+                patches[p] = equal_cell_form(surface).with_trim(domain)
+                trimmed_faces.add(face)
+                continue
+            except InputError as exc:
+                reason = str(exc)
+        if asked:
+            raise scenario.error("surface.trimmed", f"{source} is trimmed, but {reason}; "
+                                 "set trimmed = false to take its whole surface")
+        kept_whole.append(f"{source} is trimmed; its whole underlying surface is used: "
+                          f"{reason}")
+    for w in caught:
+        message = str(w.message)
+        if WHOLE_SURFACE in message and any(message.startswith(f"{path} face {f} ")
+                                            for f in trimmed_faces | set(body.faces)):
+            continue
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    for line in kept_whole:
+        warnings.warn(line, InputWarning, stacklevel=2)
+    if not trimmed_faces:
+        return body
+    gone = {p for p, s in enumerate(patches) if edgeless(s)}
+    interfaces = [i for i in body.interfaces if not {i.a, i.b} & gone]
+    return FileBody(patches, interfaces, body.faces, body.counts)
