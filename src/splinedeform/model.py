@@ -9,6 +9,13 @@ For every coordinate alike (DESIGN.md §1.5)::
 with exact 1-D Gram matrices ``G_a``; constraints ``d = T d_free`` reduce them to
 ``M_r = Tᵀ M T`` etc. Data flows one way: surface + material + boundary → model →
 static / modes / dynamic solutions.
+
+The model owns static, modes and dynamics for every physics: what differs between the
+plate and the Kirchhoff–Love shell (unknowns per control point, damping, load fields, rigid
+modes, the static solve's refusals, the eigensolvers' guard, read-out) is the
+:class:`~splinedeform.physics.formulation.Formulation` in ``model.formulation``
+(:class:`~splinedeform.physics.plate.PlateFormulation` here, the shell's in
+:class:`splinedeform.ShellModel`).
 """
 
 from __future__ import annotations
@@ -24,11 +31,13 @@ from numpy.typing import ArrayLike, NDArray
 from .assembly import (_largest, check_bending, full_matrices, gram_matrices,
                        patch_matrices, reduced_matrices)
 from .boundary import Constraints, build_constraints
-from .errors import InputError, SingularSystemError
+from .errors import InputError
 from .loads import Load, as_load, static_time
 from .material import Material, check_scales
 from .physics import intrinsic
 from .physics.coupling_model import c0_coupling
+from .physics.formulation import Formulation, damping
+from .physics.plate import METHODS, PlateFormulation
 from . import modal_solve
 from .modal_solve import check_count as _check_count
 from .solution import ModalSolution, Readout, SampledSolution, StaticSolution
@@ -38,12 +47,10 @@ from .solvers.forcing import ReducedForcing
 from .solvers.system import KroneckerFactors, Reduction
 from .surface import Surface
 from .threads import owned
-from .static_solve import check_options, solve_stiffness  # noqa: F401
+from .static_solve import check_options
 from .trim.model_matrices import trimmed_system
 
 Array = NDArray[np.float64]
-METHODS = ("analytic", "newmark", "radau3", "radau5", "radau7", "genalpha", "rk45", "dop853",
-           "radau", "bdf")
 STEP_METHODS = ("newmark", "radau3", "radau5", "radau7", "genalpha")   # take a step dt
 
 
@@ -112,6 +119,8 @@ class Model:
                 "(surface.cells; a CAD or control net surface: insert knots with surface.refine)")
             error.key = "boundary"  # type: ignore[attr-defined]
             raise error
+        self.formulation: Formulation = PlateFormulation(
+            physics, material, surface, unconstrained=self.constraints.unconstrained)
         lumped = mass_matrix == "lumped"
         general = surface.net_weights is not None         # weights that do not factor
         self.gram_u, self.gram_v = (None, None) if general else gram_matrices(surface)
@@ -143,9 +152,8 @@ class Model:
         and the caches."""
         material = self.material
         if getattr(self, "_C", None) is None:
-            self._C = ((material.damping / material.mass) * self._M
-                       + material.rayleigh * self._K).tocsc()
-        if self._M.nnz:
+            self._C = damping(self.formulation, self._M, self._K)
+        if self._M.nnz and isinstance(material, Material):
             check_scales(material, _largest(self._K), _largest(self._M))
         self._eigen: tuple[Array, Array] | None = None
         self._bases: dict[tuple, modal_basis.ModalBasis] = {}
@@ -170,9 +178,20 @@ class Model:
 
     # -- layout --------------------------------------------------------------------
     @property
+    def T(self) -> sp.csr_matrix:
+        """The constraint map ``d = T d_free`` (rows: the formulation's unknowns)."""
+        return self.constraints.T
+
+    @property
     def n_free(self) -> int:
-        """Number of free coordinates (moving control points per coordinate)."""
-        return self.constraints.n_free
+        """Number of free coordinates (moving control points per coordinate, or the
+        shell's free unknowns)."""
+        return int(self.T.shape[1])
+
+    @property
+    def unknowns_label(self) -> str:
+        """How summaries name :attr:`n_free`."""
+        return self.formulation.unknowns_label
 
     def matrices(self) -> tuple[sp.csc_matrix, sp.csc_matrix, sp.csc_matrix]:
         """Reduced ``(M_r, C_r, K_r)``, each ``(n_free, n_free)``, shared by x, y and z."""
@@ -180,34 +199,38 @@ class Model:
 
     def to_full(self, d_free: Array) -> Array:
         """Full displacement net ``T d_free`` as ``(n_u, n_v, 3)`` (or ``(n_u, n_v)`` for a scalar field)."""
-        full = self.constraints.T @ d_free
+        full = self.T @ d_free
         return np.asarray(full).reshape(self.surface.shape + np.shape(d_free)[1:])
 
     @property
     def reduction(self) -> Reduction:
         """The constraint map and load offset the solvers reduce loads with."""
-        rest = self._reduce_force(np.zeros((self.constraints.T.shape[0], 3))) \
+        rest = self._reduce_force(np.zeros((self.T.shape[0], 3))) \
             if self.rest == "none" else None
         return self._reduction(rest)
 
     def _reduction(self, rest: Array | None) -> Reduction:
-        """:class:`Reduction` of ``T`` with the surface loads are evaluated on."""
-        return Reduction(self.constraints.T, self.surface, rest)
+        """:class:`Reduction` of ``T`` with the formulation's load fields."""
+        return self.formulation.reduction(self.T, rest)
 
     @property
     def readout(self) -> Readout:
         """What a solution of this model needs to read out its free coordinates."""
-        return Readout(self.surface, self.constraints.T, self._M, self._K)
+        return self.formulation.readout(self.T, self._M, self._K)
 
-    def load_vector(self, load: Load, t: float = 0.0) -> Array:
-        """Reduced generalised force ``Tᵀ (F(t) [- K p0 when rest='none'])``, shape ``(n_free, 3)``."""
-        F = as_load(load).vector(self.surface, t)
-        return self._reduce_force(F)
+    def load_vector(self, load: Load | None, t: float = 0.0) -> Array:
+        """Reduced generalised force ``Tᵀ (F(t) [- K p0 when rest='none'])``: ``(n_free, 3)``
+        (one unknown per control point) or ``(n_free,)`` (three, interleaved)."""
+        reduction = self._reduction(None)
+        F = sum((term.profile(t) * reduction.field(term, t) for term in as_load(load).terms()),
+                np.zeros((self.T.shape[0], reduction.columns)))
+        F_r = self._reduce_force(F)
+        return F_r if reduction.columns == 3 else F_r[:, 0]
 
     def _reduce_force(self, F_full: Array) -> Array:
         if self.rest == "none":
             F_full = F_full - self.K_full @ self._rest_net()
-        return np.asarray(self.constraints.T.T @ F_full)
+        return np.asarray(self.T.T @ F_full)
 
     def _rest_net(self) -> Array:
         """The rest control points ``p0`` as rows ``(n_points, 3)`` of ``T``'s layout."""
@@ -222,29 +245,29 @@ class Model:
         the time ``t`` at which its equilibrium is wanted; it is never taken at ``t = 0``
         silently.
 
+        The solve and its refusals are the formulation's
+        (:meth:`~splinedeform.physics.formulation.Formulation.static_displacement`): the
+        plate's band Cholesky, the shell's nested dissection with its free rigid motions
+        removed by ``Rᵀ M_r d = 0``.
+
         Raises
         ------
         SingularSystemError
-            When the surface is unconstrained (rigid motions have no stiffness) or the
-            weights leave some deformation without energy.
+            When the surface is unconstrained (rigid motions have no stiffness), the
+            weights leave some deformation without energy, or a shell's load does work on
+            a rigid motion its boundary leaves free.
         """
         start = time.perf_counter()
-        if self.constraints.unconstrained:
-            raise SingularSystemError(
-                "static solve of an unconstrained surface: every edge is free and no control "
-                "point is fixed, so rigid translations cost no energy and K is singular. "
-                "Fix an edge (boundary='clamped' or e.g. {'u0': 'pinned'}) or some control "
-                "points (fixed=mask)")
         F = self.load_vector(as_load(load), static_time(as_load(load), t))
         d = self._solve_stiffness(F)
         return StaticSolution(self.readout, d, F, {"static": time.perf_counter() - start})
 
     def _solve_stiffness(self, F: Array) -> Array:
-        return solve_stiffness(self, F)
+        return self.formulation.static_displacement(self, F)
 
     # -- modes -------------------------------------------------------------------------
     @owned
-    def eigen(self, k: int | None = None) -> tuple[Array, Array]:
+    def eigen(self, k: int | None = None, check_spectrum: bool = True) -> tuple[Array, Array]:
         """Lowest ``k`` (default all) eigenpairs of ``K_r φ = λ M_r φ`` with ``Φᵀ M_r Φ = I``.
 
         Ascending ``λ`` (round-off negatives clipped to 0) and explicit ``Φ`` of shape
@@ -254,13 +277,18 @@ class Model:
         up to ``DENSE_MAX`` (see :mod:`splinedeform.solvers.modal_basis`). A few modes
         (``k <= n/10``, ``n >= 400``) of a net whose modes are not yet known come from
         sparse Lanczos too unless the separable factors apply: ``O(n k²)`` against the
-        ``O(n³)`` of all modes. Cached (:mod:`splinedeform.spectrum`).
+        ``O(n³)`` of all modes. Cached (:mod:`splinedeform.spectrum`). Each computed pair
+        is checked by the formulation's guard (the plate: the condition number; the shell:
+        each pair's residual, :mod:`splinedeform.solvers.eigen_trust`) and refused if not
+        resolved; ``check_spectrum=False`` skips the check (at the caller's risk).
         """
-        return spectrum.eigen(self, None if k is None else _check_count(k, self.n_free))
+        return spectrum.eigen(self, None if k is None else _check_count(k, self.n_free),
+                              check_spectrum)
 
     @owned
     def modal_basis(self, eigensolver: str = "auto", modes: int | None = None,
-                    omega_max: float | None = None) -> modal_basis.ModalBasis:
+                    omega_max: float | None = None, check_spectrum: bool = True
+                    ) -> modal_basis.ModalBasis:
         """Modes as a :class:`~splinedeform.solvers.modal_basis.ModalBasis` (cached).
 
         Parameters
@@ -269,8 +297,10 @@ class Model:
             See :func:`~splinedeform.solvers.modal_basis.choose`.
         modes, omega_max : optional
             Keep only the lowest ``modes`` modes, or those with ``ω <= omega_max``.
+        check_spectrum : bool
+            See :meth:`eigen`.
         """
-        return spectrum.modal_basis_of(self, eigensolver, modes, omega_max)
+        return spectrum.modal_basis_of(self, eigensolver, modes, omega_max, check_spectrum)
 
     def kronecker_factors(self) -> KroneckerFactors:
         """The reduced 1-D Gram factors of ``M_r`` and ``K_r`` (:mod:`splinedeform.spectrum`)."""
@@ -280,20 +310,26 @@ class Model:
     def rigid_modes(self) -> int | None:
         """Dimension of ``null K_r`` (motions without energy) from the weights and the
         constraints, not from eigenvalues (:func:`~splinedeform.solvers.rigid.rigid_count`);
-        ``None`` where no structure is known (intrinsic plate without tension)."""
+        ``None`` where no structure is known (intrinsic plate without tension); the
+        formulation's basis of ``null K_r`` where it has one (the shell's free rigid
+        motions)."""
+        basis = self.formulation.rigid_basis
+        if basis is not None:
+            return int(basis.shape[1])
         if self._rigid is None:
             self._rigid = (spectrum.rigid_count(self),)
         return self._rigid[0]
 
-    def frequencies(self, k: int = 6) -> Array:
+    def frequencies(self, k: int = 6, check_spectrum: bool = True) -> Array:
         """Lowest ``k`` undamped angular frequencies ``ω_i = √λ_i``, ascending."""
-        return np.sqrt(self.eigen(k)[0])
+        return np.sqrt(self.eigen(k, check_spectrum)[0])
 
-    def modes(self, k: int = 6) -> tuple[Array, Array]:
-        """Lowest ``k`` frequencies and mode shapes as scalar fields on the net ``(k, n_u, n_v)``."""
-        lam, phi = self.eigen(k)
-        shapes = np.asarray(self.constraints.T @ phi).T.reshape((phi.shape[1],) + self.surface.shape)
-        return np.sqrt(lam), shapes
+    def modes(self, k: int = 6, check_spectrum: bool = True) -> tuple[Array, Any]:
+        """Lowest ``k`` frequencies and mode shapes: scalar fields on the net
+        ``(k, n_u, n_v)`` (one unknown per control point; x, y and z move alike) or control
+        net displacements ``(k, n_u, n_v, 3)`` (the shell); a body's: a list, one per patch."""
+        lam, phi = self.eigen(k, check_spectrum)
+        return np.sqrt(lam), self.readout.mode_shapes(phi)
 
     # -- dynamics ------------------------------------------------------------------------
     def initial_state(self, displacement: ArrayLike | None, velocity: ArrayLike | None
@@ -303,24 +339,21 @@ class Model:
                 self._to_free(velocity, "initial_velocity"))
 
     def _to_free(self, net: ArrayLike | None, what: str) -> Array:
+        """Free coordinates ``(n_free, columns)`` of a displacement net (a body's: a list),
+        by least squares ``Tᵀ T d_free = Tᵀ d``; refused where ``d`` is not in ``range T``."""
+        readout = self.readout
         if net is None:
-            return np.zeros((self.n_free, 3))
-        flat = self._flatten_net(net, what)
+            return np.zeros((self.n_free, readout.columns))
+        flat = readout.rows(net, what)
         if not np.all(np.isfinite(flat)):
             raise InputError(f"{what} must be finite")
-        T = self.constraints.T
-        free = spla.spsolve((T.T @ T).tocsc(), T.T @ flat).reshape(-1, 3)
+        T = self.T
+        free = np.asarray(spla.spsolve((T.T @ T).tocsc(), T.T @ flat)).reshape(
+            -1, flat.shape[1])
         if np.linalg.norm(T @ free - flat) > 1e-9 * max(np.linalg.norm(flat), 1e-300):
-            raise InputError(f"{what} moves control points that the boundary conditions fix")
+            raise InputError(f"{what} moves control points that the boundary conditions fix "
+                             "or tie")
         return free
-
-    def _flatten_net(self, net: ArrayLike, what: str) -> Array:
-        """A net ``(n_u, n_v, 3)`` as rows ``(n_points, 3)``; the shape checked."""
-        arr = np.asarray(net, dtype=float)
-        if arr.shape != self.surface.shape + (3,):
-            raise InputError(f"{what} must have shape (n_u, n_v, 3) = "
-                             f"{self.surface.shape + (3,)}, got {arr.shape}")
-        return arr.reshape(-1, 3)
 
     @owned
     def dynamic(self, load: Load | None, t_end: float, method: str = "analytic",
@@ -365,6 +398,9 @@ class Model:
         """
         if method not in METHODS:
             raise InputError(f"unknown method {method!r}; choose one of {METHODS}")
+        if method not in self.formulation.methods:
+            raise InputError(f"the {self.physics} model's dynamic solve takes the methods "
+                             f"{self.formulation.methods}, got {method!r}")
         try:
             t_end = float(t_end)
         except (TypeError, ValueError):
