@@ -28,16 +28,13 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
-from .assembly import (_largest, check_bending, full_matrices, gram_matrices,
-                       patch_matrices, reduced_matrices)
-from .boundary import Constraints, build_constraints
+from .assembly import _largest, check_bending, full_matrices
+from .boundary import Constraints
 from .errors import InputError
 from .loads import Load, as_load, static_time
 from .material import Material, check_scales
-from .physics import intrinsic
-from .physics.coupling_model import c0_coupling
 from .physics.formulation import Formulation, damping
-from .physics.plate import METHODS, PlateFormulation
+from .physics.plate import METHODS, surface_system
 from . import modal_solve
 from .modal_solve import check_count as _check_count
 from .solution import ModalSolution, Readout, SampledSolution, StaticSolution
@@ -48,7 +45,6 @@ from .solvers.system import KroneckerFactors, Reduction
 from .surface import Surface
 from .threads import owned
 from .static_solve import check_options
-from .trim.model_matrices import trimmed_system
 
 Array = NDArray[np.float64]
 STEP_METHODS = ("newmark", "radau3", "radau5", "radau7", "genalpha")   # take a step dt
@@ -105,47 +101,17 @@ class Model:
         self.mass_matrix = mass_matrix
         self.rest = rest
         self.physics = physics
-        trimmed = None if surface.trim is None else trimmed_system(
-            surface, material, boundary, mass_matrix == "lumped", physics, fixed, rest)
-        self.constraints: Constraints = trimmed.constraints if trimmed else build_constraints(
-            surface.basis_u, surface.basis_v, boundary,
-            None if fixed is None else np.asarray(fixed), surface.control_points)
-        if self.constraints.n_free == 0:
-            error = InputError(
-                f"no free coordinate: the boundary {self.constraints.edges} fixes every one of "
-                f"the {surface.shape[0]} x {surface.shape[1]} control points (cells "
-                f"{surface.basis_u.cells} x {surface.basis_v.cells}, degree "
-                f"{surface.basis_u.degree}), so nothing can move; free an edge, or use more cells "
-                "(surface.cells; a CAD or control net surface: insert knots with surface.refine)")
-            error.key = "boundary"  # type: ignore[attr-defined]
-            raise error
-        self.formulation: Formulation = PlateFormulation(
-            physics, material, surface, unconstrained=self.constraints.unconstrained)
-        lumped = mass_matrix == "lumped"
-        general = surface.net_weights is not None         # weights that do not factor
-        self.gram_u, self.gram_v = (None, None) if general else gram_matrices(surface)
-        # K and M on the whole net: assembled here only where the constrained matrices are
-        # made from them, else when first asked for (K_full, M_full)
-        self._full: tuple[sp.csr_matrix, sp.csr_matrix] | None = (
-            intrinsic.matrices(surface, material, lumped) if physics == "intrinsic"
-            else (trimmed.stiffness, trimmed.mass) if trimmed
-            else patch_matrices(surface, material, physics, lumped)[2:] if general else None)
-        kinks = c0_coupling(surface, material, self.constraints.edges)
-        if kinks is not None:                  # the slopes tied across each C0 line
-            K, M = self._full_matrices()
-            self._full, self.gram_u, self.gram_v = ((K + kinks).tocsr(), M), None, None
-        reduced = None if physics == "intrinsic" or trimmed or kinks is not None or general else \
-            reduced_matrices(self.gram_u, self.gram_v, material, lumped, self.constraints)
-        if reduced is None:
-            T = self.constraints.T
-            K, M = self._full_matrices()
-            self._K, self._M = (T.T @ K @ T).tocsc(), (T.T @ M @ T).tocsc()
-            self._C: sp.csc_matrix | None = None
-        else:
-            self._K, self._M, self._C = reduced
+        system = surface_system(surface, material, boundary, fixed, mass_matrix, physics, rest)
+        self.constraints: Constraints = system.constraints
+        self.formulation: Formulation = system.formulation
+        self.gram_u, self.gram_v = system.gram_u, system.gram_v
+        # K and M on the whole net: assembled only where the constrained matrices are made
+        # from them, else when first asked for (K_full, M_full)
+        self._full: tuple[sp.csr_matrix, sp.csr_matrix] | None = system.full
+        self._K, self._M, self._C = system.reduced
         self._finish(start)
-        if trimmed:
-            self._rigid = (trimmed.rigid_modes,)
+        if system.rigid_modes is not None:      # a trimmed net's, counted on its region
+            self._rigid = (system.rigid_modes,)
 
     def _finish(self, start: float) -> None:
         """Damping ``C_r = (γ/μ) M_r + β K_r`` (unless made with K_r), the checks of scale

@@ -89,6 +89,16 @@ class Readout(_Energies):
                              f"{self.surface.shape + (3,)}, got {arr.shape}")
         return self._rows(arr)
 
+    def deformed(self, nets: Array, name: str) -> Surface:
+        """The surface's bases with the control net ``nets``."""
+        return self.surface.with_control_points(nets, name=name)
+
+    def patch(self, nets: Array, patch: int | None) -> tuple[Surface, Array]:
+        """The rest surface and ``nets`` (a single surface: ``patch`` None or 0)."""
+        if patch not in (None, 0):
+            raise InputError(f"a single surface has no patch {patch!r}")
+        return self.surface, nets
+
     def mode_shapes(self, phi: Array) -> Array:
         """Mode shapes of ``phi (n_free, k)``: scalar fields ``(k, n_u, n_v)`` on the net
         (one unknown per point), control net displacements ``(k, n_u, n_v, 3)`` (three)."""

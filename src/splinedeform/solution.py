@@ -72,22 +72,6 @@ def _check_times(t: ArrayLike, t_end: float | None = None) -> tuple[Array, bool]
     return np.atleast_1d(arr), arr.ndim == 0
 
 
-def _deformed(readout: Any, nets: Any, name: str) -> Any:
-    """The deformed surface of ``nets`` (a body's: a list of its deformed patches)."""
-    if isinstance(readout, BodyReadout):
-        return readout.deformed(nets, name)
-    return readout.surface.with_control_points(nets, name=name)
-
-
-def _patch(readout: Any, nets: Any, patch: int | None) -> tuple[Surface, Array]:
-    """The rest surface and nets of ``patch`` (a single surface: ``None`` or 0)."""
-    if isinstance(readout, BodyReadout):
-        return readout.patch(nets, patch)
-    if patch not in (None, 0):
-        raise InputError(f"a single surface has no patch {patch!r}")
-    return readout.surface, nets
-
-
 class _Displaced:
     """Shared read-out of a state in free coordinates."""
 
@@ -122,13 +106,13 @@ class StaticSolution(_Displaced):
 
     def surface(self) -> Any:
         """The deformed surface (a body's: a list of its deformed patches)."""
-        return _deformed(self.readout, self.control_points(), "static")
+        return self.readout.deformed(self.control_points(), "static")
 
     @owned
     def displacement(self, u: ArrayLike, v: ArrayLike, patch: int | None = None) -> Array:
         """Displacement ``d(u, v)`` of surface points, shape ``S + (3,)`` (of ``patch`` for
         a body)."""
-        rest, net = _patch(self.readout, self._full(self.d_free, rest=False), patch)
+        rest, net = self.readout.patch(self._full(self.d_free, rest=False), patch)
         return rest.derivative(u, v, control_points=net)
 
     def net_displacement(self) -> Any:
@@ -192,7 +176,7 @@ class Solution(_Displaced):
 
     def surface(self, t: float) -> Any:
         """The deformed surface at time ``t`` (a body's: a list of its deformed patches)."""
-        return _deformed(self.readout, self.control_points(float(t)), f"t={float(t):g}")
+        return self.readout.deformed(self.control_points(float(t)), f"t={float(t):g}")
 
     @owned
     def displacement(self, t: ArrayLike, u: ArrayLike, v: ArrayLike,
@@ -200,7 +184,7 @@ class Solution(_Displaced):
         """Displacement of surface points: ``S + (3,)`` for scalar ``t``, ``(F,) + S + (3,)``
         else (of ``patch`` for a body)."""
         times, scalar = _check_times(t)
-        rest, nets = _patch(self.readout, self.control_points(times), patch)
+        rest, nets = self.readout.patch(self.control_points(times), patch)
         nets = nets - rest.control_points
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
         E = rest.evaluation_matrix(u, v)

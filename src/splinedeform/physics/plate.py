@@ -16,17 +16,23 @@ are counted from the weights and the constraints (:mod:`splinedeform.spectrum`),
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Mapping
 
 import numpy as np
 import scipy.sparse as sp
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
-from ..errors import SingularSystemError
+from ..assembly import full_matrices, gram_matrices, patch_matrices, reduced_matrices
+from ..boundary import Constraints, build_constraints
+from ..errors import InputError, SingularSystemError
 from ..material import Material
 from ..readout import BodyReadout, Readout
 from ..solvers.system import Reduction
 from ..static_solve import solve_stiffness
+from ..surface import Surface
+from ..trim.model_matrices import trimmed_system
+from . import intrinsic
+from .coupling_model import c0_coupling
 
 Array = NDArray[np.float64]
 METHODS = ("analytic", "newmark", "radau3", "radau5", "radau7", "genalpha", "rk45", "dop853",
@@ -88,3 +94,69 @@ class PlateFormulation:
         if self.patches is None:
             return Readout(self.surface, T, M_r, K_r)
         return BodyReadout(self.patches, T, M_r, K_r)
+
+
+@dataclass(frozen=True)
+class PlateSystem:
+    """The plate of one surface, assembled: its formulation, constraint map, the 1-D Gram
+    factors (``None`` where the matrices are no Kronecker products), ``(K, M)`` of the
+    whole net where assembled (else ``None``: made from the Gram factors when asked),
+    ``(K_r, M_r, C_r)`` (``C_r`` None: from the formulation) and a trimmed net's rigid
+    mode count (else ``None``)."""
+
+    formulation: PlateFormulation
+    constraints: Constraints
+    gram_u: Any
+    gram_v: Any
+    full: tuple[sp.csr_matrix, sp.csr_matrix] | None
+    reduced: tuple[sp.csc_matrix, sp.csc_matrix, sp.csc_matrix | None]
+    rigid_modes: int | None
+
+
+def surface_system(surface: Surface, material: Material, boundary: str | Mapping[str, str],
+                   fixed: ArrayLike | None, mass_matrix: str, physics: str, rest: str
+                   ) -> PlateSystem:
+    """Assemble the plate of :class:`splinedeform.Model` on one surface.
+
+    ``parametric`` with weights that factor: ``K_r``, ``M_r`` from the reduced Kronecker
+    factors (:func:`~splinedeform.assembly.reduced_matrices`) and ``C_r`` with them;
+    otherwise ``K_r = Tᵀ K T``, ``M_r = Tᵀ M T`` of the matrices of the whole net
+    (``intrinsic``, :mod:`.intrinsic`; a trimmed region,
+    :mod:`splinedeform.trim.model_matrices`; general NURBS weights), plus the penalty
+    tying the slopes across each C0 knot line (:mod:`.coupling_model`).
+    """
+    lumped = mass_matrix == "lumped"
+    trimmed = None if surface.trim is None else trimmed_system(
+        surface, material, boundary, lumped, physics, fixed, rest)
+    constraints = trimmed.constraints if trimmed else build_constraints(
+        surface.basis_u, surface.basis_v, boundary,
+        None if fixed is None else np.asarray(fixed), surface.control_points)
+    if constraints.n_free == 0:
+        error = InputError(
+            f"no free coordinate: the boundary {constraints.edges} fixes every one of "
+            f"the {surface.shape[0]} x {surface.shape[1]} control points (cells "
+            f"{surface.basis_u.cells} x {surface.basis_v.cells}, degree "
+            f"{surface.basis_u.degree}), so nothing can move; free an edge, or use more cells "
+            "(surface.cells; a CAD or control net surface: insert knots with surface.refine)")
+        error.key = "boundary"  # type: ignore[attr-defined]
+        raise error
+    formulation = PlateFormulation(physics, material, surface,
+                                   unconstrained=constraints.unconstrained)
+    general = surface.net_weights is not None         # weights that do not factor
+    gram_u, gram_v = (None, None) if general else gram_matrices(surface)
+    full = (intrinsic.matrices(surface, material, lumped) if physics == "intrinsic"
+            else (trimmed.stiffness, trimmed.mass) if trimmed
+            else patch_matrices(surface, material, physics, lumped)[2:] if general else None)
+    kinks = c0_coupling(surface, material, constraints.edges)
+    if kinks is not None:                  # the slopes tied across each C0 line
+        K, M = full if full is not None else full_matrices(gram_u, gram_v, material, lumped)
+        full, gram_u, gram_v = ((K + kinks).tocsr(), M), None, None
+    reduced = None if full is not None else reduced_matrices(gram_u, gram_v, material,
+                                                             lumped, constraints)
+    if reduced is None:                    # Tᵀ K T of the whole net's matrices
+        if full is None:
+            full = full_matrices(gram_u, gram_v, material, lumped)
+        T = constraints.T
+        reduced = ((T.T @ full[0] @ T).tocsc(), (T.T @ full[1] @ T).tocsc(), None)
+    return PlateSystem(formulation, constraints, gram_u, gram_v, full, reduced,
+                       trimmed.rigid_modes if trimmed else None)
