@@ -239,7 +239,7 @@ def _largest_below(basis: Any, correction: Any, report: dict[str, Any], jumps: l
                          for g, part in zip(coef, correction.jump_parts)], axis=0)
     _, p, c = np.unravel_index(int(np.argmax(np.abs(statics))), statics.shape)
     lam = basis.lam
-    zero = np.zeros((lam.size, 3))
+    zero = np.zeros((lam.size, statics.shape[-1]))       # 3 coordinates, or 1 column
     response = ModalResponse(lam, gamma + beta * lam, zero, zero,
                              [(t_j, basis.project(merged[t_j])) for t_j in order], [])
     row = basis.phi[p]                          # a DenseBasis (automatic_basis)

@@ -87,6 +87,9 @@ class Model:
     9
     """
 
+    #: the patches of a body (``None``: one surface, :attr:`surface`)
+    patches: tuple[Surface, ...] | None = None
+
     def __init__(self, surface: Surface, material: Material,
                  boundary: str | Mapping[str, str] = "free", fixed: ArrayLike | None = None,
                  mass_matrix: str = "consistent", rest: str = "initial",
