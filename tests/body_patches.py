@@ -46,3 +46,18 @@ def split_square(splits: tuple[int, int], cells: int) -> Surface:
     gu, gv = bu.greville(), bv.greville()
     net = np.stack(list(np.meshgrid(gu, gv, indexing="ij")) + [np.zeros((gu.size, gv.size))], axis=-1)
     return Surface(net, bu, bv)
+
+
+def hemisphere(radius: float, start: float, cells: int = 8) -> Surface:
+    """Longitudes ``[start, start + π]`` (``u``) and polar angle ``v ∈ [0, π]`` (``v0`` at the
+    south pole, outward normal) of the sphere of ``radius``, interpolated by a bicubic patch
+    of ``cells × cells`` spans: a patch with a pole at each end of ``v``."""
+    from math import pi
+
+    from splinedeform.shapes import from_function
+
+    def f(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        phi = u + start
+        return radius * np.stack([np.sin(v) * np.cos(phi), np.sin(v) * np.sin(phi),
+                                  -np.cos(v)], axis=-1)
+    return from_function(f, cells=(cells, cells), domain=((0, pi), (0, pi)))

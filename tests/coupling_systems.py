@@ -39,12 +39,18 @@ def flat_patch(x0: float, length: float, cells_u: int, cells_v: int, degree: int
     return Surface(P, bu, bv)
 
 
-def c0_basis(degree: int, cells: int) -> KnotVectorBasis:
-    """Open knots on ``[0, 1]``, ``cells`` equal spans, ``u = 1/2`` repeated ``degree`` times."""
+def c0_basis(degree: int, cells: int, repeats: int | None = None) -> KnotVectorBasis:
+    """Open knots on ``[0, 1]``, ``cells`` equal spans, ``u = 1/2`` repeated ``repeats`` times
+    (default ``degree``: a C0 line)."""
     inner = np.arange(1, cells) / cells
-    inner = np.concatenate([inner[inner != 0.5], np.full(degree, 0.5)])
+    inner = np.concatenate([inner[inner != 0.5], np.full(repeats or degree, 0.5)])
     return KnotVectorBasis(degree, np.sort(np.concatenate([np.zeros(degree + 1), inner,
                                                            np.ones(degree + 1)])))
+
+
+def c1_basis(degree: int, cells: int) -> KnotVectorBasis:
+    """:func:`c0_basis` with ``u = 1/2`` repeated ``degree − 1`` times: ``C^1`` there."""
+    return c0_basis(degree, cells, degree - 1)
 
 
 def load_vector(surface: Surface, x0: float, f: Callable[[np.ndarray], np.ndarray]

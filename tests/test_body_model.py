@@ -162,3 +162,20 @@ def test_non_manifold_edge_is_refused() -> None:
     assert body.summary()["non_manifold"] == 1
     with pytest.raises(sd.InputError, match=r"non-manifold edge: 3 patch edges meet"):
         sd.BodyModel(body, MEMBRANE)
+
+
+@pytest.mark.parametrize("physics, twist, boundary, count", [
+    # (Δd)² vanishes on the harmonic fields of bidegree <= (3, 3): 1, x, y, xy, x² − y²,
+    # x³ − 3xy², 3x²y − y³, x³y − xy³ (C1 across the tied line, so harmonic on the whole
+    # square); those vanishing on x = 0: x, xy, x³ − 3xy², x³y − xy³
+    ("intrinsic", 1.0, "free", 8),
+    ("intrinsic", 1.0, {(0, "u0"): "pinned"}, 4),
+    # d_uu² + 2 w11 d_uv² + d_vv²: the fields 1, x, y (and xy where w11 = 0)
+    ("parametric", 1.0, "free", 3),
+    ("parametric", 0.0, "free", 4),
+])
+def test_a_free_bending_body_counts_its_rigid_modes(physics, twist, boundary, count) -> None:
+    material = sd.Material(w20=1.0, w11=twist, w02=1.0)
+    model = sd.BodyModel(halves(), material, boundary=boundary, physics=physics)
+    assert model.rigid_modes == count
+    assert model.constraints.ties.interfaces == {0}       # the halves' line tied C1

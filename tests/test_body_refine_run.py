@@ -67,15 +67,31 @@ def test_refinement_of_a_body_keeps_its_geometry_and_its_conforming_edges(box_3d
     assert found["shared"] == 12 and found["non_conforming"] == 0 and found["boundary"] == 0
 
 
-def test_different_counts_in_u_and_v_are_refused_on_a_body(box_3dm, tmp_path):
-    from splinedeform.errors import ScenarioError
+@pytest.mark.parametrize("surface", ["refine = {u = 1, v = 2}", "elevate = [1, 0]",
+                                     "elevate = [2, 1]\nrefine = [0, 3]"])
+def test_different_counts_in_u_and_v_are_repaired_on_a_body(box_3dm, tmp_path, surface):
+    """A box edge is a u edge of one face and a v edge of its neighbour: counts that differ
+    in u and v are repaired by exact elevation and knot insertion (scenario/body.py)."""
+    from splinedeform.body import Body
 
-    for key, value in (("refine", "{u = 1, v = 2}"), ("elevate", "[1, 0]")):
-        with pytest.raises(ScenarioError) as info:
-            built_surface(scenario_file(tmp_path, box_3dm, f"{key} = {value}"))
-        message = str(info.value)
-        assert f"surface.{key}: a body takes the same count in u and v" in message
-        assert "a u edge of one face and a v edge of its neighbour" in message
+    rest = built_surface(scenario_file(tmp_path, box_3dm))
+    fine = built_surface(scenario_file(tmp_path, box_3dm, surface))
+    for coarse, refined in zip(rest, fine):
+        # exact refinement: the same surface up to round-off of the refinement matrices
+        # (1e-12 of the size)
+        np.testing.assert_allclose(sample(refined), sample(coarse), rtol=0,
+                                   atol=1e-12 * SIZE)
+    # every file interface conforms on the refined faces (merged, not penalised), and so
+    # does every interface found again from the geometry alone (an independent matching)
+    assert len(fine.interfaces) == 12 and all(i.conforming for i in fine.interfaces)
+    found = Body.from_surfaces(list(fine)).summary()
+    assert found["shared"] == 12 and found["non_conforming"] == 0
+    # at least the counts asked for: each face has at least the degree and spans it asked
+    elevate = {"refine = {u = 1, v = 2}": (0, 0), "elevate = [1, 0]": (1, 0)}.get(surface,
+                                                                                    (2, 1))
+    for coarse, refined in zip(rest, fine):
+        assert refined.basis_u.degree >= coarse.basis_u.degree + elevate[0]
+        assert refined.basis_v.degree >= coarse.basis_v.degree + elevate[1]
 
 
 def test_a_cubic_box_bends_under_internal_pressure_closed_and_symmetric(box_3dm, tmp_path):
@@ -176,8 +192,10 @@ def test_face_edges_are_checked_at_their_key(box_3dm, tmp_path):
             f"meets edge {joined.edge_b} of face {body.faces[joined.b]})") in message
     assert "boundary.faces.5: face 5 is not in this body, whose faces are [0, 1, 2, 3, 4]" \
         in refusal('[boundary.faces]\n5 = {u0 = "clamped"}\n')
-    assert "boundary.faces.0.u0: Input should be 'free', 'pinned' or 'clamped'" \
-        in refusal('[boundary.faces]\n0 = {u0 = "diaphragm"}\n')
+    assert ("boundary.faces.0.u0: 'diaphragm' is an edge of the Kirchhoff–Love shell only"
+            in refusal('[boundary.faces]\n0 = {u0 = "diaphragm"}\n'))
+    assert "boundary.faces.0.u0: Input should be 'free', 'pinned'" \
+        in refusal('[boundary.faces]\n0 = {u0 = "hinged"}\n')
     assert "boundary.faces.0.w0" in refusal('[boundary.faces]\n0 = {w0 = "clamped"}\n')
     # one face read alone is not a body: the key is refused there
     single = scenario_file(tmp_path, box_3dm, "face = 0\nelevate = 1",

@@ -191,8 +191,6 @@ def refusal(folder, source, **kwargs) -> str:
 
 
 def test_what_a_body_does_not_take_is_refused_at_its_key(box_3dm, tmp_path):
-    message = refusal(tmp_path, box_3dm, formats='["gif"]')
-    assert "output.formats: gif is not written for a body of 6 faces yet" in message
     message = refusal(tmp_path, box_3dm, formats='["report"]',
                       loads='[[load]]\nkind = "point"\nat = [0.5, 0.5]\nforce = [0, 0, 1.0]\n')
     assert "load[1].face: a point load on a body names its face" in message
@@ -241,3 +239,47 @@ def test_a_body_scenario_is_written_back_as_it_runs(box_3dm, tmp_path):
     again = parse_scenario(text, directory=tmp_path)
     assert again.loads == scenario.loads and again.surface == scenario.surface
     assert "face" not in again.raw["surface"]
+
+
+def test_control_nets_and_the_animation_hold_every_face(box_3dm, tmp_path):
+    """json / npz hold every face's nets keyed by face number; the GIF (and MP4 where an
+    encoder is installed) draws the whole body in every frame."""
+    from PIL import Image
+
+    from splinedeform.export.body_nets import read_body_control_nets
+    from splinedeform.pipeline import run
+    from splinedeform.scenario import load_scenario
+    from splinedeform.viz import mp4_available
+
+    formats = ["json", "npz", "gif"] + (["mp4"] if mp4_available() else [])
+    scenario = load_scenario(write_scenario(tmp_path, box_3dm, formats=json.dumps(formats)))
+    out = tmp_path / "out"
+    result = run(scenario, out)
+    # read by the standard library and numpy alone: every face, every frame. JSON floats
+    # are written with repr and the NPZ holds the arrays themselves, so both give the
+    # solution's numbers back (to the last bit; compared at 1e-15 relative)
+    document = json.loads((out / "box_nets.json").read_text())
+    assert document["faces"] == [0, 1, 2, 3, 4, 5] and len(document["times"]) == 3
+    arrays = np.load(out / "box_nets.npz")
+    assert list(arrays["faces"]) == [0, 1, 2, 3, 4, 5]
+    for k, nets in enumerate(result.nets):
+        np.testing.assert_allclose(document["nets"][str(k)]["control_points"], nets,
+                                   rtol=1e-15, atol=0)
+        np.testing.assert_allclose(arrays[f"face{k}/control_points"], nets, rtol=1e-15,
+                                   atol=0)
+        assert document["nets"][str(k)]["basis"]["u"]["knots"] == \
+            arrays[f"face{k}/knots_u"].tolist()
+    # read back as surfaces: each face at the last frame is the deformed patch (the same
+    # bases and net evaluated twice: round-off, 1e-12 of the size)
+    for path in (out / "box_nets.json", out / "box_nets.npz"):
+        faces = read_body_control_nets(path)
+        for k, patch in enumerate(result.built.surface.patches):
+            deformed = patch.with_control_points(result.nets[k][-1])
+            s = np.linspace(0.0, 1.0, 5)
+            np.testing.assert_allclose(faces[k].evaluate(s[:, None], s[None, :]),
+                                       deformed.evaluate(s[:, None], s[None, :]),
+                                       rtol=0, atol=1e-12 * SIZE)
+    with Image.open(out / "box.gif") as gif:
+        assert gif.n_frames == 3 and gif.size == (640, 480)
+    if "mp4" in formats:
+        assert (out / "box.mp4").stat().st_size > 0

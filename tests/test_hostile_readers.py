@@ -124,7 +124,7 @@ def test_a_named_pipe_in_place_of_an_output_is_refused_by_its_digest(tmp_path):
 
 
 def test_a_named_pipe_beside_a_sculpt_save_is_not_the_same_file(tmp_path):
-    from splinedeform.sculpt.session import _same_file
+    from splinedeform.sculpt.save import same_file as _same_file
 
     source = tmp_path / "grid.npy"
     source.write_bytes(b"\x93NUMPY")

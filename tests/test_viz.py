@@ -275,10 +275,13 @@ def test_a_frame_drawn_over_the_kept_background_is_the_full_drawing():
     pixels: antialiasing along the silhouette, composited once more over the background)."""
     from splinedeform.viz.animation import _FrameDrawer
     from splinedeform.viz.figures import _collection, _face_colors
+    from splinedeform.viz.surfaces import _displaced_meshes
 
     s = plane(3)
     times, nets = motion(s, 3)
-    draw = _FrameDrawer(s, s.control_points, times, nets, 10, 1.0, (28.0, -60.0))
+    draw = _FrameDrawer(np.asarray(times, dtype=float),
+                        _displaced_meshes(s, s.control_points, list(nets), 10, 1.0), 1.0,
+                        (28.0, -60.0))
     draw(0)
     image = draw(2)
     surface = _collection(draw.X[2], draw.faces, _face_colors(draw.mag[2], draw.faces,

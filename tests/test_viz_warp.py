@@ -123,8 +123,8 @@ def test_the_warp_factor_is_stated_in_the_picture_and_the_animation():
     assert "× 50" in texts(surfaces_figure(X, mag, faces, ["a", "b"], float(mag.max()),
                                            warp=50.0))
     assert "×" not in texts(surfaces_figure(X, mag, faces, ["a", "b"], float(mag.max())))
-    draw = _FrameDrawer(s, s.control_points, [0.0, 1.0], [s.control_points, moved], 4, 50.0,
-                        (20.0, 30.0), label="load factor")
+    draw = _FrameDrawer(np.array([0.0, 1.0]), (X, mag, faces), 50.0, (20.0, 30.0),
+                        label="load factor")
     draw(1)
     assert draw.ax.get_title() == "load factor = 1  ·  displacement drawn × 50 (output.warp)"
     assert (draw.ax.elev, draw.ax.azim) == (20.0, 30.0)

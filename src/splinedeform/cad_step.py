@@ -118,9 +118,13 @@ def write_step(path: str | os.PathLike, patches: list[NurbsPatch],
             from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
 
             writer = STEPControl_Writer()    # (which sets the unit to its default)
+            before = Interface_Static.CVal_s("write.step.unit")
             Interface_Static.SetCVal_s("write.step.unit", name)  # converted from millimetres
-            ok = writer.Transfer(compound, STEPControl_AsIs) == IFSelect_RetDone and \
-                writer.Write(str(tmp)) == IFSelect_RetDone
+            try:
+                ok = writer.Transfer(compound, STEPControl_AsIs) == IFSelect_RetDone and \
+                    writer.Write(str(tmp)) == IFSelect_RetDone
+            finally:                         # a process-wide setting: left as it was
+                Interface_Static.SetCVal_s("write.step.unit", before)
         else:
             from OCP.IGESControl import IGESControl_Writer
 

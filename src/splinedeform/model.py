@@ -74,9 +74,11 @@ class Model:
         (:mod:`splinedeform.physics.intrinsic`), independent of the parametrisation.
         A trimmed surface (``surface.trim``) takes ``parametric`` over its trimmed region
         (:mod:`splinedeform.trim.model_matrices`), with ``boundary`` naming its loops
-        (``{"outer": "clamped", "hole1": "free"}``). With bending weights, the rotation
-        across each C0 knot line is tied by a penalty
-        (:mod:`splinedeform.physics.coupling_model`), which leaves no Kronecker factors.
+        (``{"outer": "clamped", "hole1": "free"}``). With bending weights, the tangent
+        continuity across each C0 knot line where the rest shape is smooth is imposed
+        exactly by the constraint map (:mod:`splinedeform.physics.coupling_ties`), the
+        rotation across any other by a penalty (:mod:`splinedeform.physics.coupling_model`);
+        either leaves no Kronecker factors.
 
     Examples
     --------

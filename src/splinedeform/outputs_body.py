@@ -2,15 +2,21 @@
 
 * ``obj`` / ``stl`` / ``ply``: the deformed body (at ``output.time``, else the last frame)
   as one mesh welded across shared edges and seams, with ``patch`` and ``displacement``;
-* ``vtu``: a ParaView series ``name.pvd`` of welded ``.vtu`` meshes, one per frame;
+* ``vtu``: a ParaView series ``name.pvd`` of welded ``.vtu`` meshes, one per frame (a
+  shell's with its stresses, :mod:`splinedeform.outputs_body_shell`);
+* ``json`` / ``npz``: ``name_nets.json`` / ``.npz``, every face's nets in every frame keyed
+  by its face number (:mod:`splinedeform.export.body_nets`);
 * ``3dm``, ``step``, ``iges``: the deformed body's faces in the file's unit (the ``.3dm``
   one named surface per face, STEP / IGES sewn into one shell);
 * ``images``: ``surfaces.png`` (every face at rest and at the frame of largest
-  displacement, one welded mesh), ``probes.png`` for a dynamic solve (the faces' centres);
-* ``report``: ``report.json`` / ``report.md`` naming the unit, the faces and the topology.
-
-Other formats are refused for a body when the scenario is built
-(:func:`splinedeform.scenario.body.check_body_scenario`).
+  displacement, one welded mesh), ``probes.png`` for a dynamic solve (the probes), and
+  for a shell ``stresses.png`` (every face at the frame where von Mises peaks);
+* ``gif`` / ``mp4``: the whole body's motion, each frame one welded mesh
+  (:func:`splinedeform.viz.write_body_animation`; for modes, the lowest mode);
+* ``report``: ``report.json`` / ``report.md`` naming the unit, the faces and the topology,
+  and for a shell the stresses per face;
+* ``viewer``: ``viewer.html``, every frame of the welded mesh and every face's net
+  (:func:`splinedeform.viz.viewer_body.write_body_viewer`).
 """
 
 from __future__ import annotations
@@ -20,6 +26,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from .export.shell_fields import is_shell
+from .outputs_body_shell import (body_mode_maxima, body_stress_fields, body_stress_report,
+                                 frame_peaks, render_body_stresses)
 
 if TYPE_CHECKING:
     from .outputs import Stages
@@ -41,11 +51,21 @@ def body_outputs(result: RunResult) -> list[str]:
     names = [f"{name}.{ext}" for ext in ("obj", "stl", "ply") if ext in formats]
     if "vtu" in formats:
         names += [*frame_file_names(name, len(result.times)), f"{name}.pvd"]
+    names += [f"{name}_nets.{ext}" for ext in ("json", "npz") if ext in formats]
     names += [f"{name}.3dm"] if "3dm" in formats else []
     names += [f"{name}{suffix}" for ext, suffix in _suffixes().items() if ext in formats]
     if "images" in formats:
         names += ["surfaces.png"] + (["probes.png"] if s.solve.kind == "dynamic" else [])
+        names += ["stresses.png"] if is_shell(result.built.model) else []
+    names += [f"{name}.{ext}" for ext in ("gif", "mp4") if ext in formats]
+    names += ["viewer.html"] if "viewer" in formats else []
     return names + (["report.json", "report.md"] if "report" in formats else [])
+
+
+def _faces(result: RunResult) -> list[int]:
+    """The file's face number of each patch (the patch index for a body of patches)."""
+    body = result.built.surface
+    return list(getattr(body, "faces", range(len(body.patches))))
 
 
 def deformed_nets(result: RunResult) -> list[Any]:
@@ -76,9 +96,20 @@ def write_body_files(result: RunResult, folder: Path, stages: Stages) -> None:
                 result.outputs.append((f"mesh .{ext}", body_files.write_body_mesh(
                     folder / f"{name}.{ext}", patches, deformed_nets(result), rest, res)))
     if "vtu" in formats:
+        fields = (body_stress_fields(result.built.model, rest, result.nets, res)
+                  if is_shell(result.built.model) else None)
         with stages.stage("time series"):
             result.outputs.append(("time series .pvd", body_files.write_body_series(
-                folder, name, patches, rest, result.times, result.nets, res)))
+                folder, name, patches, rest, result.times, result.nets, res, fields)))
+    wanted = [ext for ext in ("json", "npz") if ext in formats]
+    if wanted:
+        from .export.body_nets import write_body_control_nets
+
+        with stages.stage("control nets"):
+            for path in write_body_control_nets(folder, f"{name}_nets", patches,
+                                                _faces(result), result.times, result.nets,
+                                                formats=wanted):
+                result.outputs.append((f"control nets {path.suffix}", path))
     if "3dm" in formats:
         with stages.stage("CAD surfaces"):
             result.outputs.append(("NURBS surfaces .3dm", body_files.write_body_3dm(
@@ -90,6 +121,16 @@ def write_body_files(result: RunResult, folder: Path, stages: Stages) -> None:
                     folder / f"{name}{suffix}", patches, deformed_nets(result), units)))
     if "images" in formats:
         _write_images(result, folder, stages)
+    for ext in ("gif", "mp4"):
+        if ext in formats:
+            _write_animation(result, folder / f"{name}.{ext}", stages)
+    if "viewer" in formats:
+        from .viz.viewer_body import write_body_viewer
+
+        with stages.stage("viewer"):
+            result.outputs.append(("viewer", write_body_viewer(
+                folder / "viewer.html", patches, rest, result.times, result.nets, res,
+                title=s.title or s.name)))
     if "report" in formats:
         from .outputs import write_report
 
@@ -113,6 +154,28 @@ def _write_images(result: RunResult, folder: Path, stages: Stages) -> None:
         if s.solve.kind == "dynamic":
             result.outputs.append(("probe plot", viz.plot_probes(
                 folder / "probes.png", result.times, result.probes)))
+        model, res = result.built.model, s.output.resolution
+        if is_shell(model):
+            f = int(np.argmax(frame_peaks(model, result.rest_net, result.nets, res)))
+            result.outputs.append(("stress picture", render_body_stresses(
+                folder / "stresses.png", model, result.rest_net, [n[f] for n in result.nets],
+                f"{label} = {result.times[f]:.4g}", res)))
+
+
+def _write_animation(result: RunResult, path: Path, stages: Stages) -> None:
+    """The body's motion as a GIF or MP4, every frame the whole body."""
+    from .outputs import FRAME_LABELS
+    from .viz import write_body_animation
+
+    s = result.scenario
+    stage = f"animation {path.suffix}"
+    with stages.stage(stage):
+        result.outputs.append((stage, write_body_animation(
+            path, list(result.built.surface.patches), result.rest_net, result.times,
+            result.nets, resolution=s.output.resolution,
+            progress=lambda done, total: stages.tick(stage, done, total + 1),
+            fps=s.output.fps, warp=_warp(result), camera=s.output.camera,
+            label=FRAME_LABELS[s.solve.kind])))
 
 
 def _warp(result: RunResult) -> float:
@@ -149,7 +212,15 @@ def body_report(result: RunResult) -> dict[str, Any]:
         "solver": solver_section(result),
         "timings": {**solution_timings(result), **result.timings},
     }
+    shell = is_shell(result.built.model)
     if result.omegas is not None:
         report["modes"] = mode_table(result.omegas)
-    add_energies_and_probes(report, result)
+        if shell and result.shell_modes is not None:
+            report["modes"].update(body_mode_maxima(result.built.model, result.shell_modes,
+                                                    s.output.resolution))
+    label = add_energies_and_probes(report, result)
+    if shell:
+        report.update(body_stress_report(result.built.model, faces, result.rest_net,
+                                         result.times, result.nets, s.output.resolution,
+                                         result.probe_points, result.probe_patches, label))
     return report

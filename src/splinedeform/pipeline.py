@@ -55,6 +55,8 @@ class RunResult:
     shell_modes: Any = None
     probes: dict[str, Any] = field(default_factory=dict)
     probe_points: dict[str, tuple[float, float]] = field(default_factory=dict)
+    #: a body's probes: the patch each probe of :attr:`probe_points` lies on
+    probe_patches: dict[str, int] = field(default_factory=dict)
     energy: dict[str, Any] | None = None
     max_displacement: float = 0.0
     #: ``max_(u,v) |d_f(u, v)|`` on the output grid at each frame ``f``

@@ -23,8 +23,9 @@ from .scenario import Built, Scenario, _located
 
 def body_static(model: Any, load: Any) -> Any:
     """``model.static(load)``, or for a body that nothing holds the floating equilibrium
-    (module docstring)."""
-    if not model.constraints.unconstrained or model.rigid_modes != 1:
+    (module docstring; the shell removes its free rigid motions itself)."""
+    constraints = getattr(model, "constraints", None)
+    if constraints is None or not constraints.unconstrained or model.rigid_modes != 1:
         return model.static(load)
     import time
 
@@ -42,7 +43,7 @@ def body_static(model: Any, load: Any) -> Any:
 
 def solve_body(scenario: Scenario, built: Built, stages: Any) -> Any:
     """The :class:`~splinedeform.pipeline.RunResult` of a body scenario (module docstring)."""
-    from .pipeline import RunResult, solve_and_modes
+    from .pipeline import RunResult, _net_normals, solve_and_modes
 
     solve = scenario.solve
     times = np.asarray(solve.frame_times() if solve.kind == "dynamic"
@@ -52,17 +53,25 @@ def solve_body(scenario: Scenario, built: Built, stages: Any) -> Any:
     mode_nets = None if shapes is None else body_mode_displacements(patches, shapes)
     with stages.stage("frames"), _located(scenario, "solve"):
         nets = _frames(scenario, patches, solution, times, mode_nets)
+    shell_modes = None
+    if shapes is not None and shapes[0].ndim == 4:     # the shell's modes move x, y, z
+        shell_modes = shapes
+        shapes = [np.einsum("kabc,abc->kab", phi, _net_normals(s))
+                  for phi, s in zip(shapes, patches)]
     result = RunResult(scenario=scenario, built=built, solution=solution, times=times,
-                       nets=nets, omegas=omegas, mode_shapes=shapes, mode_nets=mode_nets)
+                       nets=nets, omegas=omegas, mode_shapes=shapes, mode_nets=mode_nets,
+                       shell_modes=shell_modes)
     _measure(result)
     return result
 
 
 def body_mode_displacements(patches: Any, shapes: list[Any]) -> list[Any]:
-    """Per patch the modes as net displacements ``φ_k n`` scaled over the whole body."""
+    """Per patch the modes as net displacements ``φ_k n`` (a shell's modes ``(k, n_u, n_v,
+    3)`` are displacements already) scaled over the whole body."""
     from .pipeline import _net_normals
 
-    D = [phi[..., None] * _net_normals(s)[None] for s, phi in zip(patches, shapes)]
+    D = [phi if phi.ndim == 4 else phi[..., None] * _net_normals(s)[None]
+         for s, phi in zip(patches, shapes)]
     rest = np.concatenate([s.control_points.reshape(-1, 3) for s in patches])
     size = float(np.ptp(rest, axis=0).max()) or 1.0
     peak = np.max([np.linalg.norm(d, axis=-1).max(axis=(1, 2)) for d in D], axis=0)
@@ -84,25 +93,37 @@ def _frames(scenario: Scenario, patches: Any, solution: Any, times: Any, mode_ne
     return [r + phase * m[0] for r, m in zip(rests, mode_nets)]
 
 
+def body_readout(model: Any) -> Any:
+    """The :class:`~splinedeform.readout.BodyReadout` of a body's model (a plate body's
+    own, or the shell body's patches, map and reduced matrices)."""
+    from .readout import BodyReadout
+
+    readout = getattr(model, "readout", None)
+    if isinstance(readout, BodyReadout):
+        return readout
+    M, _, K = model.matrices()
+    return BodyReadout(tuple(model.patches), model.T, M, K)
+
+
 def _measure(result: Any) -> None:
-    """Each face's centre displacement per frame (the probes), the largest displacement on
-    the patches' output grids per frame, and the energies."""
+    """The probes' displacements per frame (:mod:`splinedeform.probes_body`: each face's
+    centre unless ``output.probes`` names points), the largest displacement on the patches'
+    output grids per frame, and the energies."""
+    from .probes_body import body_probes
     from .run_measures import displacement_per_frame, energies
 
     scenario, body = result.scenario, result.built.surface
-    F = len(result.times)
-    per_frame = np.zeros(F)
-    for k, (surface, nets) in enumerate(zip(body.patches, result.nets)):
-        D = nets - surface.control_points
-        (_, lu), (_, lv) = surface.domain
-        E = surface.evaluation_matrix(np.array([0.5 * lu]), np.array([0.5 * lv]))
-        face = body.faces[k] if hasattr(body, "faces") else k
-        name = f"face {face} centre"
-        result.probes[name] = np.asarray(E @ np.moveaxis(D.reshape(F, -1, 3), 0, 1)
-                                         .reshape(E.shape[1], F * 3)).reshape(F, 3)
-        result.probe_points[name] = (0.5 * lu, 0.5 * lv)
+    readout = body_readout(result.built.model)
+    with _located(scenario, "output.probes"):
+        probes = body_probes(scenario, body)
+    for probe in probes:
+        result.probes[probe.name] = readout.probe(result.nets, probe.patch, *probe.at)
+        result.probe_points[probe.name] = probe.at
+        result.probe_patches[probe.name] = probe.patch
+    per_frame = np.zeros(len(result.times))
+    for surface, nets in zip(body.patches, result.nets):
         per_frame = np.maximum(per_frame, displacement_per_frame(
-            surface, D, scenario.output.resolution))
+            surface, nets - surface.control_points, scenario.output.resolution))
     result.displacement_per_frame = per_frame
     result.max_displacement = float(per_frame.max(initial=0.0))
     result.energy = energies(result)

@@ -163,6 +163,17 @@ class BodyReadout(_Energies):
                              f"[0, {len(self.surfaces) - 1}], got {patch!r}")
         return self.surfaces[patch], nets[patch]
 
+    def probe(self, nets: list[Array], patch: int, u: float, v: float) -> Array:
+        """Displacement ``d_f(u, v) = Σ_kl N_kl(u, v) (P_f − P_rest)_kl`` of the point
+        ``(u, v)`` of patch ``patch`` in every frame, for per-patch nets ``(F, n_u, n_v, 3)``
+        (rest included): ``(F, 3)``."""
+        surface, P = self.patch(nets, patch)
+        D = np.asarray(P, dtype=float) - surface.control_points
+        E = surface.evaluation_matrix(np.array([u], dtype=float), np.array([v], dtype=float))
+        F = D.shape[0]
+        flat = np.moveaxis(D.reshape(F, -1, 3), 0, 1).reshape(E.shape[1], F * 3)
+        return np.asarray(E @ flat).reshape(F, 3)
+
 
 def _expand(T: sp.spmatrix, d_free: Array, per_point: int = 1) -> Array:
     """``T d_free`` → ``(..., n_points, 3)`` for ``d_free`` of shape ``(..., n_free, 3)``

@@ -41,6 +41,8 @@ from splinedeform.physics.shell import ShellMaterial
 from splinedeform.physics.shell_model import ShellModel
 from splinedeform.refine import refine_surface
 
+import body_patches
+
 R, T, E, NU, P = 2.0, 2e-3, 1.0e6, 0.3, 1.0          # t / R = 1e-3
 MATERIAL = ShellMaterial(E, NU, T)
 W = P * R ** 2 * (1 - NU) / (2 * E * T)             # membrane radial displacement
@@ -164,13 +166,8 @@ def test_six_patches_of_a_cube_sphere():
 
 
 def hemisphere(start: float) -> sd.Surface:
-    """Longitudes ``[start, start + π]`` (``u``) and polar angle ``v ∈ [0, π]`` (``v0`` at the
-    south pole, outward normal), interpolated by a bicubic patch of 8 × 8 cells."""
-    def f(u: np.ndarray, v: np.ndarray) -> np.ndarray:
-        phi = u + start
-        return R * np.stack([np.sin(v) * np.cos(phi), np.sin(v) * np.sin(phi), -np.cos(v)],
-                            axis=-1)
-    return sd.shapes.from_function(f, cells=(8, 8), domain=((0, pi), (0, pi)))
+    """:func:`body_patches.hemisphere` of radius ``R``, 8 × 8 cells."""
+    return body_patches.hemisphere(R, start)
 
 
 def test_two_hemispheres_share_their_poles():

@@ -105,24 +105,30 @@ class Body:
         patches = list(self.patches)
         for _ in range(MAX_PASSES):
             topology = find_topology(patches, self.topology.tol)
-            wanted: dict[tuple[int, str], list[list[float]]] = {}
-            for interface, aligned in zip(topology.interfaces, topology.aligned):
-                if interface.conforming or not aligned:
-                    continue
-                sides = ((interface.a, interface.edge_a, interface.b, interface.edge_b),
-                         (interface.b, interface.edge_b, interface.a, interface.edge_a))
-                for p, e, q, f in sides:
-                    missing = _missing(edge_basis(patches[p], e), edge_basis(patches[q], f),
-                                       interface.reversed)
-                    direction = "v" if e[0] == "u" else "u"
-                    if missing:
-                        wanted.setdefault((p, direction), []).append(missing)
-            if not wanted:
+            if not insert_missing_knots(patches, [
+                    i for i, aligned in zip(topology.interfaces, topology.aligned)
+                    if aligned and not i.conforming]):
                 return Body(patches, None, self.topology.tol)
-            for (p, direction), values in wanted.items():
-                patches[p] = insert_knots_at(patches[p], direction, _distinct(values))
         raise InputError(f"knot insertion did not make the interfaces conform in {MAX_PASSES} "
                          "rounds; refine the patches to common knots")
+
+
+def insert_missing_knots(patches: list[Surface], interfaces: Sequence[Interface]) -> bool:
+    """One round of :meth:`Body.conforming` on ``interfaces``: into each side of each the
+    knots of the other side that it lacks, ``patches`` replaced in place; whether any knot
+    was inserted (a direction's new knots change every edge along it: repeat until none)."""
+    wanted: dict[tuple[int, str], list[list[float]]] = {}
+    for interface in interfaces:
+        sides = ((interface.a, interface.edge_a, interface.b, interface.edge_b),
+                 (interface.b, interface.edge_b, interface.a, interface.edge_a))
+        for p, e, q, f in sides:
+            missing = _missing(edge_basis(patches[p], e), edge_basis(patches[q], f),
+                               interface.reversed)
+            if missing:
+                wanted.setdefault((p, "v" if e[0] == "u" else "u"), []).append(missing)
+    for (p, direction), values in wanted.items():
+        patches[p] = insert_knots_at(patches[p], direction, _distinct(values))
+    return bool(wanted)
 
 
 def _given(patches: tuple[Surface, ...], interfaces: list[Interface], found: Topology

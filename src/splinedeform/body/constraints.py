@@ -17,6 +17,10 @@ each), ``N = Σ n_u n_v``. The map ``d = T d_free`` is built in two steps:
    of ``T_b`` to classes, ``T = T_b S``: the columns of one class are summed, and a class
    with a member that its patch's edge condition fixes (a zero row of ``T_b``) is fixed as a
    whole. Displacement continuity across the interface is then exact.
+3. **Ties.** Where the energy bends, the tangent continuity across smooth conforming
+   interfaces and C0 lines is imposed exactly too: ``T = T_b S E`` with
+   ``range E = null(C T_b S)`` for the ties ``C d = 0`` of
+   :mod:`splinedeform.physics.coupling_ties`.
 
 A merged point must be a coefficient of its own (a unit row of ``T_b``) or fixed (a zero
 row): knot layouts whose edge conditions couple several coefficients (Höllig's uniform
@@ -36,9 +40,11 @@ from scipy.sparse.csgraph import connected_components
 from ..boundary import EDGES, build_constraints, edge_points
 from ..errors import InputError
 from ..surface import Surface
+from ..physics.coupling_ties import Ties, impose, smooth_ties
 from .topology import Edge, Topology
 
 BODY_PRESETS = ("free", "pinned", "clamped")
+NO_TIES = Ties(sp.csr_matrix((0, 0)), frozenset(), frozenset())
 
 
 @dataclass(frozen=True)
@@ -54,12 +60,16 @@ class BodyConstraints:
         The preset of each boundary edge, keyed ``(patch, edge)``.
     offsets : ndarray of int
         First row of each patch (``len(patches) + 1`` values).
+    ties : Ties
+        The interfaces and C0 lines whose tangent continuity ``T`` holds exactly
+        (:mod:`splinedeform.physics.coupling_ties`), which need no rotation penalty.
     """
 
     T: sp.csr_matrix
     free_index: NDArray[np.int64]
     edges: dict[Edge, str]
     offsets: NDArray[np.int64]
+    ties: Ties = field(default_factory=lambda: NO_TIES)
     T_u: None = field(default=None, init=False)
     T_v: None = field(default=None, init=False)
     has_fixed_points: bool = field(default=False, init=False)
@@ -115,8 +125,15 @@ def edge_rows(surface: Surface, edge: str) -> NDArray[np.int64]:
 
 
 def build_body_constraints(patches: Sequence[Surface], topology: Topology,
-                           presets: dict[Edge, str]) -> BodyConstraints:
-    """``T = T_b S`` (module docstring): conforming interfaces merged, the given presets."""
+                           presets: dict[Edge, str], smooth: bool = False) -> BodyConstraints:
+    """``T = T_b S`` (module docstring): conforming interfaces merged, the given presets;
+    with ``smooth`` (an energy that bends) also ``T = T_b S E``, the smooth lines tied.
+
+    Returns
+    -------
+    BodyConstraints
+        Its ``ties`` name the interfaces and C0 lines tied exactly
+        (:mod:`splinedeform.physics.coupling_ties`)."""
     sizes = np.array([s.shape[0] * s.shape[1] for s in patches])
     offsets = np.concatenate([[0], np.cumsum(sizes)])
     maps, columns = [], []
@@ -159,4 +176,9 @@ def build_body_constraints(patches: Sequence[Surface], topology: Topology,
                       shape=(column_point.size, classes.size))
     first = np.full(label.max() + 1, n, dtype=np.int64)
     np.minimum.at(first, label, np.arange(n))
-    return BodyConstraints((Tb @ S).tocsr(), first[classes], dict(presets), offsets)
+    T, free_index = (Tb @ S).tocsr(), first[classes]
+    ties = smooth_ties(patches, topology.interfaces, offsets) if smooth else NO_TIES
+    if ties.C.shape[0]:
+        T, kept = impose(T, ties.C @ T)
+        free_index = free_index[kept]
+    return BodyConstraints(T, free_index, dict(presets), offsets, ties)

@@ -20,6 +20,7 @@ import time
 from typing import Any, Mapping, Sequence
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 from numpy.typing import NDArray
 from scipy.sparse.csgraph import connected_components
@@ -29,9 +30,10 @@ from ..errors import InputError
 from ..loads import Point
 from ..material import Material
 from ..model import Model, check_options
+from ..solvers.rigid import UnresolvedSpectrum, count_by_gap
 from ..solvers.system import Reduction
 from ..surface import Surface
-from ..physics.coupling_model import c0_coupling, interface_coupling
+from ..physics.coupling_model import bends, c0_coupling, interface_coupling
 from ..physics.plate import PlateFormulation
 from .body import Body
 from .constraints import boundary_presets, build_body_constraints
@@ -39,6 +41,9 @@ from .interface import EDGES
 from .loads import OnPatch
 
 Array = NDArray[np.float64]
+PROBE_LIMIT = 1500
+"""Most free coordinates whose rigid modes a bending body without a clamped part counts on
+its dense spectrum (:attr:`BodyModel.rigid_modes`): a few seconds of ``eigh``."""
 
 
 class BodyReduction(Reduction):
@@ -126,7 +131,7 @@ class BodyModel(Model):
         for surface in self.patches:
             check_bending(surface, material)
         self.constraints = build_body_constraints(
-            self.patches, topology, boundary_presets(boundary, topology))
+            self.patches, topology, boundary_presets(boundary, topology), bends(material))
         if self.constraints.n_free == 0:
             error = InputError(f"no free coordinate: the boundary fixes every control point of "
                                f"the {len(self.patches)} patches; free an edge or refine them")
@@ -138,10 +143,12 @@ class BodyModel(Model):
         M = sp.block_diag([m for _, m in blocks], format="csr")
         offsets = self.constraints.offsets
         size = int(offsets[-1])
+        ties = self.constraints.ties
         couplings = [interface_coupling(self.patches, topology.interfaces, material,
-                                        self.constraints.edges, offsets[:-1])]
+                                        self.constraints.edges, offsets[:-1], ties.interfaces)]
         couplings += [c0_coupling(s, material, {e: self.constraints.edges.get((p, e), "free")
-                                                for e in EDGES}, int(offsets[p]), size)
+                                                for e in EDGES}, int(offsets[p]), size,
+                                  {(d, k) for q, d, k in ties.lines if q == p})
                       for p, s in enumerate(self.patches)]
         for penalty in (c for c in couplings if c is not None):
             K = (K + penalty).tocsr()
@@ -175,8 +182,19 @@ class BodyModel(Model):
         (``w20, w02 > 0``) it is 0 where a clamped edge holds every part: a field without
         energy is a polynomial with ``d_uu = d_vv = 0`` (``Δ d = 0`` intrinsic) on each span,
         which vanishes with its value and slope on a segment (unique continuation), and the
-        merged points and the penalties carry value and slope across every span border and
-        interface. ``None`` (unknown) otherwise."""
+        merged points, the ties and the penalties carry value and slope across every span
+        border and interface. Otherwise (a bending body with a free part) it is counted on
+        the matrices themselves, up to :data:`PROBE_LIMIT` free coordinates: the
+        eigenvalues of ``K_r φ = λ M_r φ`` at round-off level behind a clear gap
+        (:func:`~splinedeform.solvers.rigid.count_by_gap`; a connected closed body: 1, the
+        constants, as ``Δ_S d = 0`` on a closed surface leaves nothing else; a free flat
+        plate: the fields linear in ``x, y``). ``None`` (unknown) beyond that size, with
+        no bending in both directions, or without a clear gap."""
+        if self._rigid is None:
+            self._rigid = (self._rigid_count(),)
+        return self._rigid[0]
+
+    def _rigid_count(self) -> int | None:
         m = self.material
         if m.w10 > 0 and m.w01 > 0:
             holds = ("pinned", "clamped")
@@ -191,9 +209,18 @@ class BodyModel(Model):
         held = np.zeros(parts, dtype=bool)
         for (p, _), preset in self.constraints.edges.items():
             held[label[p]] |= preset in holds
-        if holds == ("clamped",):
-            return 0 if held.all() else None
-        return int(np.sum(~held))
+        if holds == ("pinned", "clamped"):
+            return int(np.sum(~held))
+        if held.all():
+            return 0
+        if self.n_free > PROBE_LIMIT:
+            return None
+        lam = sla.eigh(self._K.toarray(), self._M.toarray(), eigvals_only=True,
+                       check_finite=False)
+        try:
+            return count_by_gap(lam, "the rigid modes of a free bending body")
+        except UnresolvedSpectrum:
+            return None
 
 
 def _refuse(topology: Any) -> None:

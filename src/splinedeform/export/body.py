@@ -18,7 +18,7 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -95,6 +95,16 @@ def welded_body(surfaces: Sequence[Surface], frames: Sequence[ArrayLike], resolu
     patch : ndarray of int, shape ``(N,)``
         The patch each point was first sampled on.
     """
+    X, faces, patch, _ = welded_body_points(surfaces, frames, resolution)
+    return X, faces, patch
+
+
+def welded_body_points(surfaces: Sequence[Surface], frames: Sequence[ArrayLike],
+                       resolution: int = 32) -> tuple[NDArray[np.float64], NDArray[np.int64],
+                                                      NDArray[np.int64], NDArray[np.int64]]:
+    """:func:`welded_body` and ``keep``: the index of each welded point among the patches'
+    grid points put side by side (patch after patch, each row-major), so that values
+    sampled on those grids (a shell's stresses) follow the points."""
     blocks, faces, owner, offset = [], [], [], 0
     for k, (surface, P) in enumerate(zip(surfaces, frames)):
         X, F = tessellate_frames(surface, P, resolution)
@@ -104,7 +114,7 @@ def welded_body(surfaces: Sequence[Surface], frames: Sequence[ArrayLike], resolu
         offset += X.shape[1]
     X = np.concatenate(blocks, axis=1)
     keep, welded = weld(X, np.concatenate(faces))
-    return X[:, keep], welded, np.concatenate(owner)[keep]
+    return X[:, keep], welded, np.concatenate(owner)[keep], keep
 
 
 def write_body_mesh(path: str | os.PathLike, surfaces: Sequence[Surface],
@@ -123,27 +133,43 @@ def write_body_mesh(path: str | os.PathLike, surfaces: Sequence[Surface],
     return write_mesh(path, X[1], faces, data)
 
 
-def write_body_series(directory: str | os.PathLike, stem: str, surfaces: Sequence[Surface],
-                      rest_nets: Sequence[ArrayLike], times: ArrayLike,
-                      nets: Sequence[ArrayLike], resolution: int = 32) -> Path:
-    """The body's motion as a ParaView series ``stem.pvd`` + ``stem_0000.vtu`` … (see the
-    module docstring); ``nets[k]`` has shape ``(F, n_u, n_v, 3)``, the frames of patch
-    ``k`` at ``times``. Returns the ``.pvd`` file (written last)."""
-    _check_stem(stem)
+def welded_motion(surfaces: Sequence[Surface], rest_nets: Sequence[ArrayLike],
+                  times: ArrayLike, nets: Sequence[ArrayLike], resolution: int = 32
+                  ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64],
+                             NDArray[np.int64], NDArray[np.int64]]:
+    """``(times, points, faces, patch, keep)``: the body's welded mesh
+    (:func:`welded_body_points`) at rest (``points[0]``) and in the frames ``nets[k]``
+    ``(F, n_u, n_v, 3)`` of each patch ``k`` at ``times`` (``points[1:]``), checked;
+    ``keep`` indexes the welded points among the patches' grids side by side."""
     rest = _check_body(surfaces, rest_nets, "rest net")
     if len(nets) != len(surfaces):
         raise InputError(f"a body of {len(surfaces)} patch(es) needs as many frame sets, "
                          f"got {len(nets)}")
     checked = [check_frames(s, times, P) for s, P in zip(surfaces, nets)]
-    t = checked[0][0]
-    X, faces, patch = welded_body(
+    X, faces, patch, keep = welded_body_points(
         surfaces, [np.concatenate([r[None], P]) for r, (_, P) in zip(rest, checked)],
         resolution)
+    return checked[0][0], X, faces, patch, keep
+
+
+def write_body_series(directory: str | os.PathLike, stem: str, surfaces: Sequence[Surface],
+                      rest_nets: Sequence[ArrayLike], times: ArrayLike,
+                      nets: Sequence[ArrayLike], resolution: int = 32,
+                      fields: Callable[[int], Mapping[str, NDArray]] | None = None) -> Path:
+    """The body's motion as a ParaView series ``stem.pvd`` + ``stem_0000.vtu`` … (see the
+    module docstring); ``nets[k]`` has shape ``(F, n_u, n_v, 3)``, the frames of patch
+    ``k`` at ``times``. With ``fields``, the arrays ``fields(f)`` of frame ``f`` too, one
+    row per point of the patches' grids side by side (a shell's stresses). Returns the
+    ``.pvd`` file (written last)."""
+    _check_stem(stem)
+    t, X, faces, patch, keep = welded_motion(surfaces, rest_nets, times, nets, resolution)
     folder = _output_folder(directory)
     names = frame_file_names(stem, t.size)
     for f, name in enumerate(names):
         d = X[f + 1] - X[0]
-        write_mesh(folder / name, X[0], faces,
-                   {"displacement": d, "displacement_magnitude": np.linalg.norm(d, axis=1),
-                    "patch": patch.astype(float)})
+        data = {"displacement": d, "displacement_magnitude": np.linalg.norm(d, axis=1),
+                "patch": patch.astype(float)}
+        if fields is not None:
+            data.update({key: np.asarray(value)[keep] for key, value in fields(f).items()})
+        write_mesh(folder / name, X[0], faces, data)
     return write_text(folder / f"{stem}.pvd", pvd_text(list(zip(t.tolist(), names))))

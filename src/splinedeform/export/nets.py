@@ -148,7 +148,12 @@ def _check_header(path: Path, fmt: Any, version: Any) -> None:
 
 
 def _load_json_nets(path: Path) -> dict[str, Any]:
-    doc = load_json(path, "JSON control-net file")
+    return json_fields(load_json(path, "JSON control-net file"), path)
+
+
+def json_fields(doc: Any, path: Path) -> dict[str, Any]:
+    """The fields of one control net's JSON document ``doc`` (read from ``path``), as
+    :func:`read_control_net` takes them; refused where keys are missing."""
     if not isinstance(doc, dict) or "control_points" not in doc or "basis" not in doc:
         raise InputError(f"{path}: a control-net file needs the keys 'control_points' and "
                          f"'basis' (with 'u' and 'v': degree, cells, length, kind)")
@@ -162,13 +167,23 @@ def _load_json_nets(path: Path) -> dict[str, Any]:
 
 
 def _load_npz_nets(path: Path) -> dict[str, Any]:
+    return npz_fields(load_npz_arrays(path), path)
+
+
+def load_npz_arrays(path: Path) -> dict[str, NDArray[Any]]:
+    """Every array of a control-net ``.npz`` file (no pickles), refused where unreadable."""
     try:
         with open_input(path, "control-net file") as fh:
             check_array_file(fh, path)
             with np.load(fh, allow_pickle=False) as z:
-                data = {key: z[key] for key in z.files}
+                return {key: z[key] for key in z.files}
     except (OSError, ValueError, EOFError) as exc:
         raise InputError(f"{path}: not a valid .npz control-net file: {exc}") from None
+
+
+def npz_fields(data: Mapping[str, Any], path: Path) -> dict[str, Any]:
+    """The fields of one control net's ``.npz`` arrays ``data`` (read from ``path``), as
+    :func:`read_control_net` takes them; refused where arrays are missing."""
     missing = [f"{k}_{d}" for d in "uv" for k in _BASIS_KEYS if f"{k}_{d}" not in data]
     if "control_points" not in data or missing:
         raise InputError(f"{path}: a control-net .npz needs 'control_points' and "
@@ -317,6 +332,12 @@ def read_control_net(path: str | os.PathLike[str], frame: int = -1) -> Surface:
     if not source.exists():        # a pipe or device is refused on opening, naming it
         raise InputError(f"control-net file {source} does not exist")
     data = _load_json_nets(source) if suffix == ".json" else _load_npz_nets(source)
+    return surface_of(data, source, frame)
+
+
+def surface_of(data: Mapping[str, Any], source: Path, frame: int = -1) -> Surface:
+    """The surface of one control net's fields ``data`` (:func:`read_control_net`) at
+    ``frame``; ``source`` names the file in errors."""
     P = real_array(data["control_points"], f"{source}: control_points")
     if P.ndim == 3:
         P = P[None]

@@ -14,7 +14,9 @@ mesh (:func:`~.coupling.penalty_factors`)::
   ``K_α`` projected onto the finer edge's splines (a penalised mortar condition) and, where
   the energy bends, ``K_β``: :func:`~.coupling.interface_penalty`;
 * a ``C^0`` knot line inside a patch is the interface between its two sides, whose
-  displacement is continuous already: ``K_β`` only (:func:`~.coupling.c0_rotation_penalty`).
+  displacement is continuous already: ``K_β`` only (:func:`~.coupling.c0_rotation_penalty`);
+* a plate body's smooth conforming interfaces and C0 lines have their tangent continuity
+  tied exactly by the constraint map (:mod:`.coupling_ties`), and no ``K_β``.
 
 Each penalty's ends take the boundary condition of the edges they lie on (the crosspoints
 those hold, :data:`~.coupling.HELD`): an end on a clamped edge has its first two trace
@@ -25,7 +27,7 @@ A shell's edge kinds count as the preset that holds as much of the trace: ``diap
 
 from __future__ import annotations
 
-from typing import Mapping, Sequence
+from typing import Collection, Mapping, Sequence
 
 import scipy.sparse as sp
 
@@ -55,17 +57,19 @@ def bends(material: Material | ShellMaterial) -> bool:
 
 
 def c0_coupling(surface: Surface, material: Material | ShellMaterial,
-                edges: Mapping[str, str], offset: int = 0, size: int | None = None
-                ) -> sp.csr_matrix | None:
+                edges: Mapping[str, str], offset: int = 0, size: int | None = None,
+                exact: Collection[tuple[str, float]] = ()) -> sp.csr_matrix | None:
     """Sum of the rotation penalties across ``surface``'s C0 lines, or ``None`` if none.
 
     A line ``u = knot`` runs along ``v`` from edge ``v0`` to ``v1`` (a line ``v = knot``
     from ``u0`` to ``u1``); ``edges`` are the patch's edge conditions. The layout is
     :func:`~.coupling.c0_rotation_penalty`'s (scalar control points ``offset …`` of ``size``)
     for a plate, the interleaved one of :func:`~.coupling.shell_c0_rotation_penalty` for a
-    shell. ``None`` also where the energy does not bend.
+    shell. ``None`` also where the energy does not bend. The lines in ``exact``
+    (``(direction, knot)``, tied by the constraint map: :mod:`.coupling_ties`) are
+    left out.
     """
-    lines = coupling.c0_lines(surface)
+    lines = [line for line in coupling.c0_lines(surface) if line not in exact]
     if not lines or not bends(material):
         return None
     shell = isinstance(material, ShellMaterial)
@@ -92,17 +96,21 @@ def interface_ends(interface: Interface, presets: Mapping[tuple[int, str], str]
 
 def interface_coupling(patches: Sequence[Surface], interfaces: Sequence[Interface],
                        material: Material | ShellMaterial,
-                       presets: Mapping[tuple[int, str], str], offsets: Sequence[int]
-                       ) -> sp.csr_matrix | None:
+                       presets: Mapping[tuple[int, str], str], offsets: Sequence[int],
+                       exact: Collection[int] = ()) -> sp.csr_matrix | None:
     """Sum of the interfaces' penalties (module docstring), or ``None`` if there are none.
 
     Non-conforming interfaces: :func:`~.coupling.interface_penalty`; conforming ones (merged
-    by the constraint map) the rotation penalty alone, where the energy bends. ``offsets``
-    are the patches' first control points in the concatenation.
+    by the constraint map) the rotation penalty alone, where the energy bends, unless their
+    index is in ``exact`` (their tangent continuity tied by the constraint map too:
+    :mod:`.coupling_ties`). ``offsets`` are the patches' first control points in
+    the concatenation.
     """
     total = None
     shell = isinstance(material, ShellMaterial)
-    for interface in interfaces:
+    for number, interface in enumerate(interfaces):
+        if interface.conforming and number in exact:
+            continue
         ends = interface_ends(interface, presets)
         if not interface.conforming:
             K = coupling.interface_penalty(patches, interface, material, offsets, ends)

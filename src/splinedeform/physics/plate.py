@@ -32,7 +32,8 @@ from ..static_solve import solve_stiffness
 from ..surface import Surface
 from ..trim.model_matrices import trimmed_system
 from . import intrinsic
-from .coupling_model import c0_coupling
+from .coupling_model import bends, c0_coupling
+from .coupling_ties import tie_c0_lines
 
 Array = NDArray[np.float64]
 METHODS = ("analytic", "newmark", "radau3", "radau5", "radau7", "genalpha", "rk45", "dop853",
@@ -147,10 +148,14 @@ def surface_system(surface: Surface, material: Material, boundary: str | Mapping
     full = (intrinsic.matrices(surface, material, lumped) if physics == "intrinsic"
             else (trimmed.stiffness, trimmed.mass) if trimmed
             else patch_matrices(surface, material, physics, lumped)[2:] if general else None)
-    kinks = c0_coupling(surface, material, constraints.edges)
-    if kinks is not None:                  # the slopes tied across each C0 line
+    tied: set[tuple[str, float]] = set()
+    if not trimmed and bends(material):    # smooth C0 lines: C1 in the constraint map
+        constraints, tied = tie_c0_lines(surface, constraints)
+    kinks = c0_coupling(surface, material, constraints.edges, exact=tied)
+    if kinks is not None or tied:          # the slopes tied across each C0 line
         K, M = full if full is not None else full_matrices(gram_u, gram_v, material, lumped)
-        full, gram_u, gram_v = ((K + kinks).tocsr(), M), None, None
+        K = K if kinks is None else K + kinks
+        full, gram_u, gram_v = (K.tocsr(), M), None, None
     reduced = None if full is not None else reduced_matrices(gram_u, gram_v, material,
                                                              lumped, constraints)
     if reduced is None:                    # Tᵀ K T of the whole net's matrices

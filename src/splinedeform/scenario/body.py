@@ -8,12 +8,15 @@ and a :class:`~splinedeform.body.BodyModel`. What a body takes from a scenario:
   ``u0 = u1 = v0 = v1``, replaced edge by edge by ``[boundary.faces]``
   (``3 = {u0 = "clamped"}``, the file's face numbers; :func:`face_presets`); a free region
   or listed points are a single surface's;
-* ``surface.refine`` / ``surface.elevate``: every face alike, the same count in u and v
-  (:func:`refined_body`);
+* ``surface.refine`` / ``surface.elevate``: every face alike, in its own u and v; where
+  the counts differ in u and v, interfaces are made to conform again by exact elevation
+  and knot insertion (:func:`refined_body`);
 * ``[[load]]``: a uniform force or a pressure acts on every face, or on face ``face``
   only; a point load names its face (``face = k``, the file's face number) and ``at`` in
   that face's parameters;
-* ``[output]``: the formats of :data:`BODY_FORMATS`; probes are the faces' centres.
+* ``[output]``: the formats of :data:`BODY_FORMATS`; ``probes`` name their face
+  (``probe_faces``) or are points in space read on their nearest face
+  (:mod:`splinedeform.probes_body`); without them, each face's centre.
 """
 
 from __future__ import annotations
@@ -21,12 +24,14 @@ from __future__ import annotations
 from typing import Any, Sequence
 
 from ..body.body import Body
+from .schema_types import SHELL_EDGES
 from .spec import Scenario
 
 #: output formats written for a body (:mod:`splinedeform.outputs_body`)
-BODY_FORMATS = ("vtu", "obj", "stl", "ply", "3dm", "step", "iges", "images", "report")
-#: physics a body runs with (the shell's coupling across interfaces lands separately)
-BODY_PHYSICS = ("intrinsic", "parametric")
+BODY_FORMATS = ("vtu", "obj", "stl", "ply", "json", "npz", "3dm", "step", "iges", "images",
+                "gif", "mp4", "viewer", "report")
+#: physics a body runs with
+BODY_PHYSICS = ("intrinsic", "parametric", "shell")
 
 
 class FileBody(Body):
@@ -61,7 +66,9 @@ def is_body(surface: Any) -> bool:
 def body_from_cad(scenario: Scenario) -> tuple[Any, int, str | None]:
     """``(body, face, units)`` of ``surface.faces`` (``"all"`` when neither ``face`` nor
     ``faces`` is given): one face chosen gives no body and that face (read as ``face``
-    is); several give a :class:`FileBody` of their surfaces and the file's interfaces."""
+    is); several give a :class:`FileBody` of their surfaces and the file's interfaces, or,
+    where the file has no edges among them (plain surfaces, no Brep), the interfaces found
+    where their edges meet."""
     from ..cad_body import body_of, choose_faces, read_listing
     from ..errors import InputError
     from .build import _located
@@ -82,43 +89,83 @@ def body_from_cad(scenario: Scenario) -> tuple[Any, int, str | None]:
         return None, chosen[0], listing["units"]
     with _located(scenario, "surface.faces"):
         surfaces, topology, info = body_of(path, listing, chosen)
-    return (FileBody(surfaces, topology.interfaces, info["faces"], topology.counts),
-            chosen[0], info["units"])
+        if any(topology.counts.values()):
+            return (FileBody(surfaces, topology.interfaces, info["faces"], topology.counts),
+                    chosen[0], info["units"])
+        # plain surfaces, not a Brep or shell: the file has no edges, so where the faces
+        # touch is found from their geometry (:func:`splinedeform.body.topology.find_topology`)
+        return FileBody(surfaces, None, info["faces"], {}), chosen[0], info["units"]
 
 
 def refined_body(scenario: Scenario, body: FileBody) -> FileBody:
     """``body`` with every face elevated by ``surface.elevate`` degrees, then with
-    ``surface.refine`` knots inserted per span (:func:`splinedeform.refine.refine_surface`).
+    ``surface.refine`` knots inserted per span, each face in its own u and v
+    (:func:`splinedeform.refine.refine_surface`).
 
-    A shared edge may be a u edge on one face and a v edge on the other, so the counts must
-    be the same in u and v (else refused at the key): each side of an edge is then refined
-    alike (``k`` knots at equal distances in every span of its normalised knot vector,
-    which is symmetric under mirroring; degrees raised by ``p``), and an interface that
-    conformed conforms still. Each interface's ``conforming`` is checked again on the
-    refined faces (:func:`splinedeform.body.topology.conforming`)."""
+    A shared edge can be a u edge of one face and a v edge of its neighbour, so counts
+    that differ in u and v give the two sides of an edge different degrees or knots. Such
+    an interface that conformed is made to conform again, exactly: after the elevation the
+    side of lower degree is elevated along the edge until the degrees agree
+    (:func:`matched_degrees`), after the insertion each side gets the knots of the other
+    that it lacks (:func:`splinedeform.body.body.insert_missing_knots`, Boehm's
+    insertion), each repeated while a direction's new degree or knots reach other edges.
+    Each interface's ``conforming`` is checked again on the refined faces
+    (:func:`splinedeform.body.topology.conforming`)."""
     from dataclasses import replace
 
+    from ..body.body import MAX_PASSES, insert_missing_knots
     from ..body.topology import conforming
+    from ..errors import InputError
     from ..refine import refine_surface
     from .build import _located
 
     spec = scenario.surface
-    for key in ("elevate", "refine"):
-        u, v = getattr(spec, key)
-        if u != v:
-            raise scenario.error(f"surface.{key}", f"a body takes the same count in u and v "
-                                 f"(got u = {u}, v = {v}): a shared edge can be a u edge of "
-                                 "one face and a v edge of its neighbour, and both sides "
-                                 "must get the same knots; give one count, e.g. "
-                                 f"{key} = {max(u, v)}")
+    uneven = spec.elevate[0] != spec.elevate[1] or spec.refine[0] != spec.refine[1]
+    joined = [i for i in body.interfaces if i.conforming]
     key = "surface.elevate" if spec.elevate != (0, 0) else "surface.refine"
     with _located(scenario, key):
-        patches = [refine_surface(s, spec.elevate, spec.refine) for s in body]
+        patches = [refine_surface(s, spec.elevate) for s in body]
+        if uneven:
+            patches = matched_degrees(patches, joined)
+        patches = [refine_surface(s, (0, 0), spec.refine) for s in patches]
+        for _ in range(MAX_PASSES if uneven else 0):
+            if not insert_missing_knots(patches, joined):
+                break
+        else:
+            if uneven:
+                raise InputError(f"knot insertion did not make the refined faces conform "
+                                 f"again in {MAX_PASSES} rounds; give one count for u and v")
     tol = body.topology.tol
     interfaces = [replace(i, conforming=conforming(patches[i.a], i.edge_a, patches[i.b],
                                                    i.edge_b, i.reversed, tol))
                   if i.conforming else i for i in body.interfaces]
     return FileBody(patches, interfaces, body.faces, body.counts)
+
+
+def matched_degrees(patches: list[Any], interfaces: Sequence[Any]) -> list[Any]:
+    """``patches`` with the side of lower degree of each interface elevated along its
+    edge (:func:`splinedeform.refine.refine_surface`, exact) until both sides agree."""
+    from ..body.body import MAX_PASSES
+    from ..body.topology import edge_basis
+    from ..errors import InputError
+    from ..refine import refine_surface
+
+    patches = list(patches)
+    for _ in range(MAX_PASSES):
+        wanted: dict[tuple[int, int], int] = {}
+        for i in interfaces:
+            pa = edge_basis(patches[i.a], i.edge_a).degree
+            pb = edge_basis(patches[i.b], i.edge_b).degree
+            for p, edge, by in ((i.a, i.edge_a, pb - pa), (i.b, i.edge_b, pa - pb)):
+                axis = 1 if edge[0] == "u" else 0          # the direction along the edge
+                if by > 0:
+                    wanted[(p, axis)] = max(wanted.get((p, axis), 0), by)
+        if not wanted:
+            return patches
+        for (p, axis), by in wanted.items():
+            patches[p] = refine_surface(patches[p], (by, 0) if axis == 0 else (0, by))
+    raise InputError(f"degree elevation did not give the faces' edges common degrees in "
+                     f"{MAX_PASSES} rounds; give one count for u and v")
 
 
 def check_body_scenario(scenario: Scenario, body: FileBody) -> None:
@@ -138,13 +185,13 @@ def check_body_scenario(scenario: Scenario, body: FileBody) -> None:
         if key in raw:
             raise s.error(f"boundary.{key}", "applies to one surface, not to a body of "
                                              f"{len(body)} faces")
-    if s.output.probes:
-        raise s.error("output.probes", "applies to one surface; a body's probes are its "
-                                       "faces' centres")
     for ext in s.output.formats:
         if ext not in BODY_FORMATS:
             raise s.error("output.formats", f"{ext} is not written for a body of "
                           f"{len(body)} faces yet; a body writes {', '.join(BODY_FORMATS)}")
+    if s.output.animate_modes not in (None, (1,)):
+        raise s.error("output.animate_modes", "a body animates its lowest mode (as the "
+                      "gif / mp4 of a modes solve); its other modes are not animated yet")
     for i, spec in enumerate(s.loads, start=1):
         if spec.face is None:
             if spec.kind == "point":
@@ -156,10 +203,11 @@ def check_body_scenario(scenario: Scenario, body: FileBody) -> None:
             raise s.error(f"load[{i}].face", f"face {spec.face} is not in this body, whose "
                                              f"faces are {list(body.faces)}")
         if spec.at is not None:
-            _check_at(s, f"load[{i}].at", spec.at, body[patch])
+            check_at(s, f"load[{i}].at", spec.at, body[patch])
 
 
-def _check_at(scenario: Scenario, path: str, at: tuple[float, float], surface: Any) -> None:
+def check_at(scenario: Scenario, path: str, at: tuple[float, float], surface: Any) -> None:
+    """Refuse at ``path`` parameters ``at`` outside the domain of a body's face."""
     for x, basis, name in ((at[0], surface.basis_u, "u"), (at[1], surface.basis_v, "v")):
         if not basis.periodic and not -1e-12 <= x <= basis.length * (1 + 1e-12):
             raise scenario.error(path, f"{name} = {x:g} is outside the parameter domain "
@@ -168,7 +216,10 @@ def _check_at(scenario: Scenario, path: str, at: tuple[float, float], surface: A
 
 def check_single_surface_loads(scenario: Scenario, face: int | None) -> None:
     """``load.face`` on one surface: only the face it is (a CAD face), else refused;
-    ``boundary.faces`` is a body's, refused on one surface."""
+    ``boundary.faces`` and ``output.probe_faces`` are a body's, refused on one surface."""
+    if scenario.output.probe_faces is not None:
+        raise scenario.error("output.probe_faces", "names faces of a body of CAD faces; one "
+                             "surface's probes are [u, v] on it")
     if "faces" in scenario.raw.get("boundary", {}):
         raise scenario.error("boundary.faces", "names edges of the faces of a body of CAD "
                              "faces; one surface takes u0, u1, v0 and v1")
@@ -199,6 +250,10 @@ def face_presets(scenario: Scenario, body: FileBody) -> str | dict[tuple[int, st
                                  f"whose faces are {list(body.faces)}")
         for edge, preset in edges.items():
             where = f"boundary.faces.{key}.{edge}"
+            if preset in SHELL_EDGES and scenario.material.physics != "shell":
+                raise scenario.error(where, f"{preset!r} is an edge of the Kirchhoff–Love "
+                                     "shell only (material.physics = \"shell\"), not of "
+                                     f"physics {scenario.material.physics!r}")
             if (patch, edge) in joined:
                 other, side = joined[(patch, edge)]
                 raise scenario.error(where, f"edge {edge} of face {key} is an interface (it "
@@ -212,15 +267,26 @@ def face_presets(scenario: Scenario, body: FileBody) -> str | dict[tuple[int, st
 
 
 def body_model(scenario: Scenario, body: FileBody) -> Any:
-    """The :class:`~splinedeform.body.BodyModel` of a body scenario."""
+    """The model of a body scenario: a :class:`~splinedeform.body.BodyModel` (the thin plate
+    under tension), or under ``physics = "shell"`` a
+    :class:`~splinedeform.physics.shell_model.ShellModel` of the body (conforming interfaces
+    merged, the rest and every interface's rotation coupled, :mod:`..physics.shell_body`)."""
     from ..body.model import BodyModel
     from ..material import Material
     from .build import _located
 
     check_body_scenario(scenario, body)
+    boundary = face_presets(scenario, body)
+    if scenario.material.physics == "shell":
+        from ..physics.shell import ShellMaterial
+        from ..physics.shell_model import ShellModel
+
+        with _located(scenario, "material"):
+            shell = ShellMaterial(**scenario.material.shell())
+        with _located(scenario, "boundary"):
+            return ShellModel(body, shell, boundary)
     with _located(scenario, "material"):
         material = Material(**scenario.material.weights())
-    boundary = face_presets(scenario, body)
     with _located(scenario, "boundary"):
         return BodyModel(body, material, boundary=boundary,
                          mass_matrix=scenario.material.mass_matrix,
@@ -245,5 +311,6 @@ def describe_body(built: Any) -> list[tuple[str, str]]:
     rows = [("faces", f"{len(body)} ({', '.join(str(f) for f in body.faces)})"),
             ("control nets", f"{points} points in {len(body)} nets"),
             ("edges", ", ".join(f"{v} {k.replace('_', '-')}" for k, v in counts.items())),
-            ("free control points", str(built.model.n_free))]
+            (getattr(built.model, "unknowns_label", "free control points"),
+             str(built.model.n_free))]
     return rows + ([("length unit", built.units)] if built.units is not None else [])

@@ -276,6 +276,10 @@ def _free_points_mask(scenario: Scenario, shape: tuple[int, int]) -> Any:
 def _check_parameters(scenario: Scenario, surface: Any) -> None:
     """Point loads and probes must lie on the parameter domain (any value when periodic)."""
     bases = (surface.basis_u, surface.basis_v)
+    for i, probe in enumerate(scenario.output.probes, start=1):
+        if len(probe) != 2:
+            raise scenario.error(f"output.probes[{i}]", "a point [x, y, z] in space is a "
+                                 "probe of a body of CAD faces; one surface takes [u, v]")
     checks = [(f"load[{i}].at", spec.at) for i, spec in enumerate(scenario.loads, start=1)
               if spec.at is not None]
     checks += [(f"output.probes[{i}]", p) for i, p in enumerate(scenario.output.probes, start=1)]

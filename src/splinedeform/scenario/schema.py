@@ -92,8 +92,9 @@ class FreeRegion(_Table):
         json_schema_extra={"doc_default": 'whole range'})
 
 
-#: edge conditions a face of a body takes (:data:`splinedeform.body.constraints.BODY_PRESETS`)
-FacePreset = Literal["free", "pinned", "clamped"]
+#: edge conditions a face of a body takes (:data:`splinedeform.body.constraints.BODY_PRESETS`,
+#: and the shell's own under ``physics = "shell"``)
+FacePreset = Literal["free", "pinned", "clamped", "diaphragm", "symmetry"]
 #: a face of a body named in ``boundary.faces``: its number in the file
 FaceKey = Annotated[str, Field(pattern=r"^[0-9]+$")]
 
@@ -130,7 +131,8 @@ class Boundary(_Table):
         None, title="{k = {u0 = ...}}", description=(
             "body of CAD faces only: presets of single boundary edges, keyed by the face's "
             "number in the file (`[boundary.faces]` then `3 = { u0 = \"clamped\" }`): "
-            "`free`, `pinned` or `clamped`; they replace the one preset `u0 = u1 = v0 = v1` "
+            "`free`, `pinned` or `clamped`, and under physics `shell` also `diaphragm` or "
+            "`symmetry`; they replace the one preset `u0 = u1 = v0 = v1` "
             "on those edges; an edge another face meets (an interface) or a pole takes none"),
         json_schema_extra={"doc_default": "none"})
 
@@ -256,9 +258,18 @@ class Output(_Table):
     resolution: Annotated[int, Strict(), Field(ge=2, le=1024)] = Field(
         32, description=(
             "tessellation samples per direction for meshes, pictures, animation, viewer"))
-    probes: list[Pair] = Field([], title="[u, v] pairs", description=(
-            "points whose displacement is reported (`report`) and plotted (`probes.png`)"),
-        json_schema_extra={"doc_default": 'the domain centre'})
+    probes: list[Union[Pair, tuple[Real, Real, Real]]] = Field(
+        [], title="[u, v] pairs (a body: or [x, y, z] points)", description=(
+            "points whose displacement is reported (`report`) and plotted (`probes.png`); on "
+            "a body of CAD faces `[u, v]` of the face `probe_faces` names, or a point "
+            "`[x, y, z]` in space, read at the nearest point of its face (of `probe_faces`, "
+            "else of the face it is nearest to)"),
+        json_schema_extra={"doc_default": "the domain centre (a body: each face's centre)"})
+    probe_faces: Optional[list[Annotated[int, Strict(), Field(ge=0)]]] = Field(
+        None, title="face numbers", description=(
+            "body of CAD faces only: the face of each probe, one per entry of `probes` (the "
+            "file's face numbers, as `splinedeform faces FILE` lists them)"),
+        json_schema_extra={"doc_default": "a point's nearest face (required for `[u, v]`)"})
     time: Optional[Time] = Field(None, description="dynamic: the state written as OBJ / STL / PLY",
         json_schema_extra={"doc_default": 'the last frame'})
     warp: Union[Literal["auto"], Annotated[float, Strict(), Field(gt=0, le=1e6,

@@ -33,14 +33,17 @@ class _Refined(_Table):
             "knots inserted at equal distances into every knot span of the built or read "
             "surface (`{u = k, v = k}`, `[k_u, k_v]` or one `k` for both; Boehm's algorithm, "
             "rational surfaces in homogeneous coordinates): the geometry does not move, every "
-            "span becomes `k + 1`; on a body of CAD faces every face alike, one count for u "
-            "and v (so shared edges keep the same knots on both sides)"),
+            "span becomes `k + 1`; on a body of CAD faces every face alike, in its own u and "
+            "v, and where the counts differ in u and v each shared edge gets the knots of "
+            "its other side inserted, so that both sides keep the same knots"),
         json_schema_extra={"doc_default": "0"})
     elevate: Optional[Elevations] = Field(
         None, title="[p_u, p_v]", description=(
             "degrees added to the built or read surface before `refine` (exact degree "
             "elevation: same geometry, same continuity at every knot); not in a periodic "
-            "direction; on a body of CAD faces one count for u and v"),
+            "direction; on a body of CAD faces every face alike, and where the counts "
+            "differ in u and v the lower degree of each shared edge is raised to its other "
+            "side's"),
         json_schema_extra={"doc_default": "0"})
 
 

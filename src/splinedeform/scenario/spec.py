@@ -147,7 +147,8 @@ class OutputSpec:
 
     formats: tuple[str, ...] = ("report",)
     resolution: int = 32
-    probes: tuple[tuple[float, float], ...] = ()
+    probes: tuple[tuple[float, ...], ...] = ()
+    probe_faces: tuple[int, ...] | None = None
     time: float | None = None
     warp: str | float = "auto"
     camera: tuple[float, float] = (28.0, -60.0)

@@ -367,9 +367,10 @@ def _validate_output(raw: Mapping[str, Any], problems: _Problems,
             if k > solve.modes:
                 problems.add(f"output.animate_modes[{i}]",
                              f"mode {k} is not computed: solve.modes = {solve.modes}")
-    for i, (u, v) in enumerate(values.get("probes", ()), start=1):
-        if u < 0 or v < 0:
-            problems.add(f"output.probes[{i}]", f"parameters must be >= 0, got [{u:g}, {v:g}]")
+    for i, probe in enumerate(values.get("probes", ()), start=1):
+        if len(probe) == 2 and min(probe) < 0:
+            problems.add(f"output.probes[{i}]", "parameters must be >= 0, got "
+                                                f"[{probe[0]:g}, {probe[1]:g}]")
     return OutputSpec(**values)
 
 

@@ -33,7 +33,7 @@ Array = NDArray[np.float64]
 
 def transfer(old: SculptBasis, new: SculptBasis) -> Array:
     """``P = Φ_newᵀ T_newᵀ M T_old Φ_old`` with the new model's mass matrix, ``(k_new, k_old)``."""
-    if old.model.surface.shape != new.model.surface.shape:
+    if [s.shape for s in old.patches] != [s.shape for s in new.patches]:
         raise ValueError("a state is carried only between models of the same control net")
     M = new.model.M_full
     return np.asarray(new.phi_net.T @ (M @ old.phi_net))

@@ -47,7 +47,9 @@ def start(scenario: Any, host: str, port: int, browser: bool, resolution: int,
     say(f"sculpt: solving the modes of {scenario.title or scenario.name} ...")
     session = Session(scenario, resolution=resolution, modes=modes, save_path=save)
     basis = session.basis
-    say(f"sculpt: {basis.lam.size} of {basis.model.n_free} modes on {resolution}x{resolution} "
+    grid = f"{resolution}x{resolution}"
+    faces = f"{len(basis.samples)} faces of {grid}" if basis.is_body else grid
+    say(f"sculpt: {basis.lam.size} of {basis.model.n_free} modes on {faces} "
         f"samples in {session.timing:.2f} s; Save writes {session.save_path.resolve()}")
     sock = bind(host, port)
     url = url_of(sock)

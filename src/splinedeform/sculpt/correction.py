@@ -47,7 +47,7 @@ class StaticCorrection:
         self.phi = phi                                   # reduced modes (n_free, k)
         self.complete = basis.lam.size == basis.model.n_free
         self._T = basis.model.constraints.T
-        self._samples = basis.samples_u.size * basis.samples_v.size
+        self._samples = basis.sample_count
         self._factor: Any = None                         # factor of K_r and the sample
         self._E: Any = None                              # evaluation: at the first grab
         self._cache: dict[int, Array] = {}
@@ -59,11 +59,11 @@ class StaticCorrection:
     def _prepare(self) -> None:
         model = self.basis.model
         self._factor = spla.splu(model.matrices()[2])
-        uu, vv = np.meshgrid(self.basis.samples_u, self.basis.samples_v, indexing="ij")
-        self._E = model.surface.evaluation_matrix(uu.ravel(), vv.ravel())
+        self._E = self.basis.sample_matrix()
 
     def column(self, index: int) -> Array:
-        """``r_a`` for the sample point ``index`` (row-major over the ``(ru, rv)`` grid)."""
+        """``r_a`` for the sample point ``index`` (row-major over the ``(ru, rv)`` grid, patch
+        after patch)."""
         if index in self._cache:
             return self._cache[index]
         if self.complete:
@@ -136,9 +136,7 @@ def offline_data(basis: SculptBasis) -> dict[str, Any] | None:
     order = reverse_cuthill_mckee(K, symmetric_mode=True)
     lower = sp.tril(K[order][:, order], format="csr")
     lower.sort_indices()
-    uu, vv = np.meshgrid(basis.samples_u, basis.samples_v, indexing="ij")
-    G = sp.csr_matrix(model.surface.evaluation_matrix(uu.ravel(), vv.ravel())
-                      @ model.constraints.T)[:, order]
+    G = sp.csr_matrix(basis.sample_matrix() @ model.constraints.T)[:, order]
     G.sort_indices()
     return {"n": int(K.shape[0]),
             "k_indptr": _b64(lower.indptr, "<i4"), "k_indices": _b64(lower.indices, "<i4"),

@@ -21,13 +21,23 @@ def _b64(array: np.ndarray, dtype: str = "<f4") -> str:
 
 def payload(basis: SculptBasis) -> dict[str, Any]:
     """JSON-ready modal data: ``lam``, ``damping`` (float64), ``phi`` (float32, sample-major
-    ``(ru*rv, k)``), rest positions of the samples (float32 ``(ru*rv, 3)``) and the grid."""
-    surf = basis.model.surface
-    uu, vv = np.meshgrid(basis.samples_u, basis.samples_v, indexing="ij")
-    rest = surf.evaluate(uu.ravel(), vv.ravel())
+    ``(S, k)``), rest positions of the samples (float32 ``(S, 3)``) and the grid.
+
+    The samples of a body's patches follow each other (``S = P ru rv``): ``grid`` is then
+    ``[P ru, rv]``, ``u`` the patches' u samples one after the other and ``faces`` per patch
+    its ``v`` samples, control net shape and periodic directions, so the page draws each
+    patch as its own grid (no triangle joins two patches).
+    """
+    rest = np.concatenate([s.evaluate(*np.meshgrid(u, v, indexing="ij")).reshape(-1, 3)
+                           for s, (u, v) in zip(basis.patches, basis.samples)])
+    ru, rv = basis.grid
     return {"modes": int(basis.lam.size),
-            "grid": [int(basis.samples_u.size), int(basis.samples_v.size)],
-            "u": basis.samples_u.tolist(), "v": basis.samples_v.tolist(),
+            "grid": [len(basis.samples) * ru, rv],
+            "u": np.concatenate([u for u, _ in basis.samples]).tolist(),
+            "v": basis.samples[0][1].tolist(),
+            "faces": [{"v": v.tolist(), "net": list(s.shape),
+                       "periodic": [bool(s.basis_u.periodic), bool(s.basis_v.periodic)]}
+                      for s, (_, v) in zip(basis.patches, basis.samples)],
             "lam": _b64(basis.lam, "<f8"), "damping": _b64(basis.damping, "<f8"),
             "phi": _b64(basis.phi_samples), "rest": _b64(rest)}
 

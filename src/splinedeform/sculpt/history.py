@@ -8,7 +8,9 @@ solved again. A new re-solve or bake after an undo drops what could have been re
 Bake makes the current shape the rest shape: the control net ``P + d`` with
 ``d = T Φ_net q`` (the page's modal displacement ``q``, ``(k, 3)``) becomes the model's
 initial surface, written as a control-net file beside the save file, whose knot vectors it
-keeps (:func:`baked_scenario`); the modes are then solved again on it.
+keeps (:func:`baked_scenario`); the modes are then solved again on it. A body's faces are
+written together as one STEP shell, sewn where they meet, so that the file read back has
+the body's shared edges (:func:`splinedeform.export.body.write_body_step`).
 """
 
 from __future__ import annotations
@@ -69,26 +71,56 @@ class History:
         return self.future.pop()
 
 
-def baked_net(basis: SculptBasis, q: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The control net ``P + T Φ_net q`` of the modal state ``q`` (``3 k`` numbers,
-    mode-major), ``(n_u, n_v, 3)``."""
-    surface = basis.model.surface
+def baked_nets(basis: SculptBasis, q: NDArray[np.float64]) -> list[NDArray[np.float64]]:
+    """Per patch the control net ``P + T Φ_net q`` of the modal state ``q`` (``3 k``
+    numbers, mode-major), each ``(n_u, n_v, 3)``."""
     q = np.asarray(q, dtype=float).ravel()
     if q.size != 3 * basis.lam.size:
         raise InputError(f"q must hold 3 coordinates for each of the {basis.lam.size} modes "
                          f"({3 * basis.lam.size} numbers), got {q.size}")
-    d = np.asarray(basis.phi_net @ q.reshape(-1, 3)).reshape(surface.control_points.shape)
-    return surface.control_points + d
+    return basis.split_net(basis.rest_net() + basis.phi_net @ q.reshape(-1, 3))
 
 
-def baked_scenario(scenario: Scenario, basis: SculptBasis, net: NDArray[np.float64],
+def baked_net(basis: SculptBasis, q: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The control net ``P + T Φ_net q`` of a single surface's modal state ``q``,
+    ``(n_u, n_v, 3)`` (:func:`baked_nets`)."""
+    net, = baked_nets(basis, q)
+    return net
+
+
+def baked_scenario(scenario: Scenario, basis: SculptBasis, nets: list[NDArray[np.float64]],
                    folder: Path, stem: str) -> tuple[Scenario, Path]:
-    """``scenario`` on the surface of control net ``net`` (same bases), written to
-    ``folder/stem.json``; the scenario reads it from ``folder`` (its directory then)."""
+    """``scenario`` on the surface of control nets ``nets`` (same bases), written to
+    ``folder/stem.json`` (one surface) or ``folder/stem.step`` (a body: every face in one
+    shell, in the body's unit, read back with ``faces = "all"``); the scenario reads it
+    from ``folder`` (its directory then)."""
     from ..export import write_control_nets
 
-    surface = basis.model.surface
-    path, = write_control_nets(folder, stem, surface, [0.0], net[None], formats=("json",))
     moved = dataclasses.replace(scenario, directory=folder.resolve())
+    if basis.is_body:
+        return _baked_body(moved, basis, nets, folder / f"{stem}.step")
+    surface = basis.model.surface
+    path, = write_control_nets(folder, stem, surface, [0.0], nets[0][None], formats=("json",))
     table: dict[str, Any] = {"shape": "file", "path": path.name}
     return with_overrides(moved, {"surface": table}, origin="sculpt bake"), path
+
+
+def _baked_body(scenario: Scenario, basis: SculptBasis, nets: list[NDArray[np.float64]],
+                path: Path) -> tuple[Scenario, Path]:
+    """The body's faces with ``nets`` as one sewn STEP shell (patch ``p`` its face ``p``;
+    the refinement already done, so none asked again) and ``scenario`` on it: the faces
+    named by ``boundary.faces`` and by loads renumbered to the new file's."""
+    from ..export.body import write_body_step
+
+    faces = list(getattr(basis.model.body, "faces", range(len(basis.patches))))
+    write_body_step(path, basis.patches, nets, basis.units, shell=True)
+    number = {face: patch for patch, face in enumerate(faces)}
+    overrides: dict[str, Any] = {"surface": {"shape": "cad", "path": path.name, "faces": "all"}}
+    named = scenario.raw.get("boundary", {}).get("faces")
+    if named:
+        overrides["boundary.faces"] = {str(number[int(k)]): v for k, v in named.items()}
+    loads = scenario.raw.get("load")
+    if loads:
+        overrides["load"] = [{**t, "face": number[int(t["face"])]} if "face" in t else t
+                             for t in loads]
+    return with_overrides(scenario, overrides, origin="sculpt bake"), path

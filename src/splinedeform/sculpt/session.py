@@ -4,15 +4,17 @@ The session keeps the scenario it was started from; a new material or boundary i
 as overrides of that scenario (validated by the scenario reader, so a value the physics
 refuses is named like a key of a file) and the model is rebuilt from it. "Save" writes
 the same scenario with the pushes as ``[[load]]`` point forces with step profiles, so
-``splinedeform run`` replays the session; a surface read from a file (``file``, ``cad``) is
-named relative to the saved scenario, copied beside it when it lies outside its folder.
+``splinedeform run`` replays the session (:mod:`.save`).
+
+A scenario of several CAD faces (``shape = "cad"``, ``faces = "all"``) opens as a body: the
+modes are those of its :class:`~splinedeform.body.BodyModel`, sampled face by face
+(:mod:`.modal`); a grab lands on the face under the pointer, whose number the saved load
+names; bake and export keep every face (:mod:`.history`, :mod:`.shape_files`).
 """
 
 from __future__ import annotations
 
-import dataclasses
 from contextlib import contextmanager
-import shutil
 import threading
 import time
 from pathlib import Path
@@ -22,21 +24,18 @@ import numpy as np
 
 from ..errors import InputError, ScenarioError
 from ..scenario import build, free_region_mask, scenario_to_toml, with_overrides
-from ..scenario.body import is_body
 from ..scenario.spec import Scenario
 from .carry import transfer
 from .correction import StaticCorrection, offline_data, static_correction
 from .export import _b64, payload
-from .grabs import chain_tables, grab_chains
-from .history import BasisState, History, baked_net, baked_scenario
-from .messages import BakeMessage, ExportMessage, PushMessage, ResolveMessage, SaveMessage
+from .history import BasisState, History, baked_nets, baked_scenario
+from .messages import BakeMessage, ExportMessage, ResolveMessage, SaveMessage
 from .modal import SculptBasis, sculpt_basis
+from .save import check_index, face_numbers, net_words, portable, session_scenario
 from .wording import in_page_words, page_field  # noqa: F401  (page_field: re-exported)
 
 MATERIAL_FIELDS = ("mass", "damping", "rayleigh", "w10", "w01", "w20", "w11", "w02")
 EDGE_NAMES = ("u0", "u1", "v0", "v1")
-MAX_PROBES = 8
-"""Grabbed points written as probes of the saved scenario (the first ones)."""
 
 
 class Busy(RuntimeError):
@@ -97,13 +96,10 @@ class Session:
         start = time.perf_counter()
         self._stage("assembling the matrices", start)
         built = build(scenario)
-        if is_body(built.surface):
-            raise scenario.error("surface.faces", f"sculpting opens one surface, not yet a body "
-                                 f"of {len(built.surface)} faces: choose one with face = k")
         model = built.model
         k = None if self.modes is None or self.modes >= model.n_free else int(self.modes)
         self._stage(f"computing {k or model.n_free} modes", start)
-        basis = sculpt_basis(model, self.resolution, k)
+        basis = sculpt_basis(model, self.resolution, k, built.units)
         self._stage("static correction", start)
         correction = static_correction(basis)
         old = getattr(self, "basis", None)
@@ -169,9 +165,9 @@ class Session:
             with self._state_lock:
                 self._check_version(message.version)
                 basis, scenario = self.basis, self.scenario
-            net = baked_net(basis, np.asarray(message.q, dtype=float))
+            nets = baked_nets(basis, np.asarray(message.q, dtype=float))
             folder = self.save_path.parent
-            baked, path = baked_scenario(scenario, basis, net, folder,
+            baked, path = baked_scenario(scenario, basis, nets, folder,
                                          f"{self.save_path.stem}-baked-{self._versions + 1}")
             try:
                 if message.free_points is not None:   # a pin: the set less the pinned point
@@ -229,26 +225,36 @@ class Session:
     # -- what the page receives ------------------------------------------------------------
     def payload(self) -> dict[str, Any]:
         """The modal data (see :func:`.export.payload`) plus the control net, the current
-        material and boundary, and what the server offers."""
+        material and boundary, and what the server offers; a body's adds ``body`` (its
+        faces' numbers and unit) and has one preset for every boundary edge, no free set."""
         basis, model = self.basis, self.basis.model
         data = payload(basis)
-        surf = model.surface
         s = self.scenario
+        net_rest = basis.rest_net()
         data.update(
             version=self.version, title=s.title or s.name, n_free=int(model.n_free),
             complete=bool(self.correction.complete),
-            net_shape=list(surf.shape), periodic=[bool(surf.basis_u.periodic),
-                                                  bool(surf.basis_v.periodic)],
-            phi_net=_b64(basis.phi_net), net_rest=_b64(surf.control_points.reshape(-1, 3)),
+            phi_net=_b64(basis.phi_net), net_rest=_b64(net_rest),
             material={k: getattr(s.material, k) for k in MATERIAL_FIELDS},
             boundary={e: getattr(s.boundary, e) for e in EDGE_NAMES},
-            free_region={k: getattr(s.boundary, f"free_{k}") for k in "uv"}
-            if s.boundary.free_u is not None or s.boundary.free_v is not None else None,
             free_mask=_b64(self._free_mask(), "u1"),
             still_mask=_b64(self._still_mask(), "u1"),
-            greville=[surf.basis_u.greville().tolist(), surf.basis_v.greville().tolist()],
-            domain=[float(surf.basis_u.length), float(surf.basis_v.length)],
             solve_seconds=round(self.timing, 4), server=True)
+        if basis.is_body:
+            data.update(net_shape=[int(net_rest.shape[0]), 1], periodic=[False, False],
+                        free_region=None, greville=[[], []], body={
+                            "faces": face_numbers(basis), "units": basis.units})
+            data["domain"] = [float(basis.patches[0].basis_u.length),
+                              float(basis.patches[0].basis_v.length)]
+            return data
+        surf = model.surface
+        data.update(
+            net_shape=list(surf.shape), periodic=[bool(surf.basis_u.periodic),
+                                                  bool(surf.basis_v.periodic)],
+            free_region={k: getattr(s.boundary, f"free_{k}") for k in "uv"}
+            if s.boundary.free_u is not None or s.boundary.free_v is not None else None,
+            greville=[surf.basis_u.greville().tolist(), surf.basis_v.greville().tolist()],
+            domain=[float(surf.basis_u.length), float(surf.basis_v.length)])
         return data
 
     def page_payload(self) -> dict[str, Any]:
@@ -260,6 +266,8 @@ class Session:
     def _free_mask(self) -> np.ndarray:
         """The moving set the scenario names (box or list), row-major, True = free; the
         edge presets may hold some of these points too (:meth:`_still_mask` says which)."""
+        if self.basis.is_body:                  # a body: every face's net moves
+            return np.ones(self.basis.phi_net.shape[0], bool)
         fixed = free_region_mask(self.scenario, self.basis.model.surface)
         shape = self.basis.model.surface.shape
         return np.ones(shape[0] * shape[1], bool) if fixed is None else ~np.ravel(fixed)
@@ -283,7 +291,7 @@ class Session:
         """``r_a`` of sample ``index`` on basis ``version`` (see :mod:`.correction`)."""
         with self._state_lock:
             self._check_version(version)
-            self._check_index(index, "index")
+            check_index(self.basis, index, "index")
             correction = self.correction
         return correction.column(index)
 
@@ -292,96 +300,23 @@ class Session:
             raise InputError(f"the page shows basis {version} but the server has {self.version} "
                              "(re-solved meanwhile); reload the page")
 
-    def _check_index(self, index: int, what: str) -> None:
-        count = self.basis.samples_u.size * self.basis.samples_v.size
-        if not 0 <= index < count:
-            raise InputError(f"{what} = {index} is not a sample point (0 .. {count - 1})")
-
     # -- save --------------------------------------------------------------------------------
     def to_scenario(self, message: SaveMessage) -> Scenario:
-        """The session as a scenario: each grab one piecewise point load (:mod:`.grabs`),
-        probes at the grabbed points."""
+        """The session as a scenario: each grab one piecewise point load (:mod:`.save`)."""
         self._check_version(message.version)
-        for n, push in enumerate(message.pushes, start=1):
-            self._check_push(push, n)
-        loads, probes = [], []
-        for chain in grab_chains(message.pushes):
-            at = self._sample_point(chain[0].index)
-            loads += chain_tables(chain, at)
-            if at not in probes and len(probes) < MAX_PROBES:
-                probes.append(at)
-        if not loads:
-            raise InputError("nothing to save: every push of the session has zero force")
-        overrides: dict[str, Any] = {
-            "load": loads,
-            "title": f"sculpted: {self.scenario.title or self.scenario.name}",
-            "solve": {"kind": "dynamic", "method": "analytic", "t_end": message.t_end,
-                      "frames": 101, "modes": min(6, self.basis.model.n_free)},
-            "output": {"formats": ["report", "images", "viewer"],
-                       "resolution": min(self.resolution, 64)},
-        }
-        if probes:
-            overrides["output"]["probes"] = probes
-        return with_overrides(self.scenario, overrides, origin="sculpt save")
-
-    def _check_push(self, push: PushMessage, n: int) -> None:
-        self._check_index(push.index, f"pushes[{n}].index")
-        if push.t_off is not None and not push.t_off > push.t_on:
-            raise InputError(f"pushes[{n}]: t_off = {push.t_off} must be after t_on = {push.t_on}")
-
-    def _sample_point(self, index: int) -> list[float]:
-        """``[u, v]`` of sample ``index`` (row-major over the sample grid)."""
-        rv = self.basis.samples_v.size
-        return [float(self.basis.samples_u[index // rv]), float(self.basis.samples_v[index % rv])]
+        return session_scenario(self.scenario, self.basis, message, self.resolution)
 
     def save(self, message: SaveMessage) -> tuple[Path, str]:
         """Write the session scenario to :attr:`save_path` (atomically); return it and its text."""
         from ..export import write_text
 
         scenario = self.to_scenario(message)
-        model = self.basis.model
         header = [f"# Saved by splinedeform sculpt: {len(message.pushes)} force steps in "
-                  f"{len(scenario.loads)} piecewise loads on "
-                  f"{model.surface.shape[0]}x{model.surface.shape[1]} control points.",
+                  f"{len(scenario.loads)} piecewise loads on {net_words(self.basis)}.",
                   "# splinedeform run replays it with every mode"
                   + ("." if self.correction.complete else
-                     f" (the page kept {self.basis.lam.size} of {model.n_free} and added the "
-                     "static part of the others)."), ""]
-        text = "\n".join(header) + scenario_to_toml(self._portable(scenario))
+                     f" (the page kept {self.basis.lam.size} of {self.basis.model.n_free} and "
+                     "added the static part of the others)."), ""]
+        text = "\n".join(header) + scenario_to_toml(portable(scenario, self.save_path))
         path = write_text(self.save_path, text)
         return path, text
-
-    def _portable(self, scenario: Scenario) -> Scenario:
-        """``scenario`` with its surface file (if any) named relative to the save file's
-        folder, which ``splinedeform run`` reads without ``--allow-outside-paths``: the
-        file as it is when it lies in that folder or below, else a copy beside the save."""
-        from ..export import write_with
-
-        source = scenario.surface.path
-        if source is None:
-            return scenario
-        source = Path(source).resolve()
-        folder = self.save_path.parent.resolve()
-        if not source.is_relative_to(folder):
-            target = folder / source.name
-            if target.exists() and not _same_file(target, source):
-                target = folder / f"{self.save_path.stem}-{source.name}"
-            if not (target.exists() and _same_file(target, source)):
-                write_with(target, lambda tmp: shutil.copyfile(source, tmp))
-            source = target
-        relative = Path(source.relative_to(folder).as_posix())
-        return dataclasses.replace(scenario,
-                                   surface=dataclasses.replace(scenario.surface, path=relative))
-
-
-def _same_file(a: Path, b: Path) -> bool:
-    """Whether two regular files hold the same bytes (anything else in their place, such as
-    a named pipe, is not the same file and is never read)."""
-    from ..input_files import MAX_TEXT_BYTES, open_input
-
-    if not (a.is_file() and b.is_file()) or a.stat().st_size != b.stat().st_size:
-        return False
-    with open_input(a, "file", MAX_TEXT_BYTES * 32) as fa, \
-            open_input(b, "file", MAX_TEXT_BYTES * 32) as fb:
-        return fa.read() == fb.read()
-

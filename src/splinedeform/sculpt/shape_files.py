@@ -8,6 +8,11 @@ write_obj` (the surface sampled on the page's grid, vertex normals) and
 :func:`splinedeform.export.nets.write_control_nets` (the project's net file, which
 ``shape = "file"`` reads back). Each is written to a private temporary folder and its
 bytes returned; nothing is written beside the save.
+
+A body keeps every face: the ``.3dm`` holds one named NURBS surface per face in the body's
+unit (:func:`splinedeform.export.body.write_body_3dm`), the OBJ one mesh welded across the
+shared edges (:func:`splinedeform.export.body.write_body_mesh`), the net file one net per
+face (``stem-face-k.json``, bundled as ``.zip``).
 """
 
 from __future__ import annotations
@@ -19,7 +24,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from .history import baked_net
+from .history import baked_nets
 from .modal import SculptBasis
 
 #: format -> (suffix, media type)
@@ -36,22 +41,56 @@ def file_stem(title: str) -> str:
 def shape_file(basis: SculptBasis, q: NDArray[np.float64], fmt: str, title: str
                ) -> tuple[bytes, str, str]:
     """``(content, file name, media type)`` of the shape of modal state ``q`` in ``fmt``."""
+    nets = baked_nets(basis, q)
+    stem = file_stem(title) + "-shape"
+    with tempfile.TemporaryDirectory(prefix="splinedeform-shape-") as folder:
+        if basis.is_body:
+            path = _body_file(basis, nets, fmt, Path(folder), stem, title)
+            media = "application/zip" if path.suffix == ".zip" else SHAPE_FORMATS[fmt][1]
+        else:
+            path = _surface_file(basis, nets[0], fmt, Path(folder), stem, title)
+            media = SHAPE_FORMATS[fmt][1]
+        return path.read_bytes(), path.name, media
+
+
+def _surface_file(basis: SculptBasis, net: NDArray[np.float64], fmt: str, folder: Path,
+                  stem: str, title: str) -> Path:
     from ..cad import patch_from_surface, write_3dm
     from ..export.mesh import write_obj
     from ..export.nets import write_control_nets
 
-    suffix, media = SHAPE_FORMATS[fmt]
-    net = baked_net(basis, q)
     surface = basis.model.surface
-    stem = file_stem(title) + "-shape"
-    with tempfile.TemporaryDirectory(prefix="splinedeform-shape-") as folder:
-        path = Path(folder) / f"{stem}{suffix}"
-        if fmt == "3dm":
-            write_3dm(path, [patch_from_surface(surface, net)], names=[title])
-        elif fmt == "obj":
-            res = (basis.samples_u.size, basis.samples_v.size)
-            vertices, faces = surface.tessellate(res, control_points=net)
-            write_obj(path, vertices, faces)
-        else:
-            write_control_nets(folder, stem, surface, [0.0], net[None], formats=("json",))
-        return path.read_bytes(), path.name, media
+    path = folder / f"{stem}{SHAPE_FORMATS[fmt][0]}"
+    if fmt == "3dm":
+        write_3dm(path, [patch_from_surface(surface, net)], names=[title], units=basis.units)
+    elif fmt == "obj":
+        vertices, faces = surface.tessellate(basis.grid, control_points=net)
+        write_obj(path, vertices, faces)
+    else:
+        write_control_nets(folder, stem, surface, [0.0], net[None], formats=("json",))
+    return path
+
+
+def _body_file(basis: SculptBasis, nets: list[NDArray[np.float64]], fmt: str, folder: Path,
+               stem: str, title: str) -> Path:
+    import zipfile
+
+    from ..export.body import write_body_3dm, write_body_mesh
+    from ..export.nets import write_control_nets
+
+    patches = basis.patches
+    faces = list(getattr(basis.model.body, "faces", range(len(patches))))
+    path = folder / f"{stem}{SHAPE_FORMATS[fmt][0]}"
+    if fmt == "3dm":
+        write_body_3dm(path, patches, nets, [f"{title} face {f}" for f in faces], basis.units)
+    elif fmt == "obj":
+        write_body_mesh(path, patches, nets, None, basis.grid[0])
+    else:
+        path = folder / f"{stem}.zip"
+        with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as bundle:
+            for face, surface, net in zip(faces, patches, nets):
+                name = f"{stem}-face-{face}"
+                written, = write_control_nets(folder, name, surface, [0.0], net[None],
+                                              formats=("json",))
+                bundle.write(written, written.name)
+    return path

@@ -75,7 +75,7 @@ def modal_force(basis: SculptBasis, pushes: Sequence[Push], t: float) -> Array:
     f = np.zeros((basis.lam.size, 3))
     for push in pushes:
         if push.t_on <= t < push.t_off:
-            f += basis.participation(push.u, push.v)[:, None] * np.asarray(push.force)[None, :]
+            f += basis.participation(push.u, push.v, push.patch)[:, None] * np.asarray(push.force)[None, :]
     return f
 
 

@@ -7,10 +7,11 @@
 * :mod:`.animation` — GIF / MP4, drawn and encoded frame by frame;
 * :mod:`.gif` — the GIF's one palette (the colour bar's ramp held exactly) and its writer;
 * :mod:`.warp` — the warp factor of the pictures (``output.warp``);
-* :mod:`.viewer` — ``viewer.html``.
+* :mod:`.viewer` — ``viewer.html``; :mod:`.viewer_body` — the one of a body.
 """
 
-from .animation import ANIMATION_PIXELS, animation_frames, mp4_available, write_animation
+from .animation import (ANIMATION_PIXELS, animation_frames, mp4_available, write_animation,
+                        write_body_animation)
 from .colour import COLORMAP, LIGHT, MODE_COLORMAP, colormap_table, displacement_colors, shade
 from .figures import COLORBAR_INCHES, DPI, PANEL_INCHES, RENDERER_VERSION
 from .plots import mode_geometry, plot_modes, plot_probes
@@ -22,4 +23,4 @@ __all__ = ["ANIMATION_PIXELS", "COLORBAR_INCHES", "COLORMAP", "DPI", "LIGHT", "M
            "content_security_policy", "displacement_colors",
            "mode_geometry", "mp4_available", "plot_modes", "plot_probes", "render_body_surfaces", "render_surfaces",
            "script_json", "shade", "vertex_checksum", "viewer_data", "viewer_html",
-           "write_animation", "write_viewer"]
+           "write_animation", "write_body_animation", "write_viewer"]

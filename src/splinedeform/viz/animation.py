@@ -8,7 +8,7 @@ samples), not the whole film, and the progress counts frames written.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -51,12 +51,12 @@ class _FrameDrawer:
     fixed view, and its title.
     """
 
-    def __init__(self, surface: Surface, rest_net: ArrayLike, times: ArrayLike, nets: ArrayLike,
-                 resolution: int, warp: float, camera: tuple[float, float],
-                 bar_levels: int | None = None, label: str = "t") -> None:
-        self.t, P = check_frames(surface, times, nets)
-        self.X, self.mag, self.faces = _displaced_meshes(surface, rest_net, list(P), resolution,
-                                                         warp)
+    def __init__(self, t: NDArray[np.float64], meshes: tuple[NDArray[np.float64],
+                 NDArray[np.float64], NDArray[np.int64]], warp: float,
+                 camera: tuple[float, float], bar_levels: int | None = None,
+                 label: str = "t") -> None:
+        self.t = t
+        self.X, self.mag, self.faces = meshes       # drawn vertices, |d| and faces per frame
         self.vmax = float(self.mag.max())
         self.caption, self.label = warp_caption(warp), str(label)
         width, height = ANIMATION_PIXELS
@@ -104,7 +104,9 @@ def animation_frames(surface: Surface, rest_net: ArrayLike, times: ArrayLike, ne
     ``camera`` is the view ``(elevation, azimuth)`` in degrees; each frame is titled
     ``"{label} = {time}"``.
     """
-    draw = _FrameDrawer(surface, rest_net, times, nets, resolution, warp, camera, None, label)
+    t, P = check_frames(surface, times, nets)
+    draw = _FrameDrawer(t, _displaced_meshes(surface, rest_net, list(P), resolution, warp),
+                        warp, camera, None, label)
     images = []
     for f in range(len(draw)):
         images.append(draw(f))
@@ -125,6 +127,38 @@ def write_animation(path: str | os.PathLike[str], surface: Surface, rest_net: Ar
     The GIF's palette holds the colour bar's :data:`~splinedeform.viz.gif.RAMP_LEVELS`
     colours exactly (see :mod:`splinedeform.viz.gif`).
     """
+    target = _checked_target(path, fps, warp)
+    t, P = check_frames(surface, times, nets)
+    draw = _FrameDrawer(t, _displaced_meshes(surface, rest_net, list(P), resolution,
+                                             float(warp)), float(warp), camera,
+                        RAMP_LEVELS if target.suffix.lower() == ".gif" else None, label)
+    return _write_film(target, draw, fps, progress)
+
+
+def write_body_animation(path: str | os.PathLike[str], patches: Sequence[Surface],
+                         rest_nets: Sequence[ArrayLike], times: ArrayLike,
+                         nets: Sequence[ArrayLike], resolution: int = 32,
+                         progress: Progress = None, fps: float = 15.0, warp: float = 1.0,
+                         camera: tuple[float, float] = CAMERA, label: str = "t") -> Path:
+    """:func:`write_animation` of a body: ``nets[k]`` ``(F, n_u, n_v, 3)`` are patch ``k``'s
+    frames, every frame drawn as one welded mesh of the whole body
+    (:func:`.surfaces.body_displaced_meshes`)."""
+    from .surfaces import body_displaced_meshes
+
+    target = _checked_target(path, fps, warp)
+    if len(nets) != len(patches) or len(rest_nets) != len(patches) or not patches:
+        raise InputError(f"a body of {len(patches)} patch(es) needs as many rest nets and "
+                         f"frame sets, got {len(rest_nets)} and {len(nets)}")
+    checked = [check_frames(s, times, P) for s, P in zip(patches, nets)]
+    meshes = body_displaced_meshes(patches, rest_nets, [P for _, P in checked], resolution,
+                                   float(warp))
+    draw = _FrameDrawer(checked[0][0], meshes, float(warp), camera,
+                        RAMP_LEVELS if target.suffix.lower() == ".gif" else None, label)
+    return _write_film(target, draw, fps, progress)
+
+
+def _checked_target(path: str | os.PathLike[str], fps: float, warp: float) -> Path:
+    """The animation's file, its suffix, ``fps`` and ``warp`` checked."""
     target = Path(path)
     suffix = target.suffix.lower()
     if suffix not in (".gif", ".mp4"):
@@ -136,10 +170,11 @@ def write_animation(path: str | os.PathLike[str], surface: Surface, rest_net: Ar
     if suffix == ".mp4" and not mp4_available():
         raise InputError("MP4 needs an ffmpeg encoder: install the extra `video` "
                          "(pip install 'splinedeform[video]') or write a .gif")
-    check_frames(surface, times, nets)
-    draw = _FrameDrawer(surface, rest_net, times, nets, resolution, float(warp), camera,
-                        RAMP_LEVELS if suffix == ".gif" else None, label)
+    return target
 
+
+def _write_film(target: Path, draw: _FrameDrawer, fps: float, progress: Progress) -> Path:
+    """Every frame of ``draw`` encoded into ``target`` (GIF or MP4, by the suffix)."""
     def frames() -> Iterator[NDArray[np.uint8]]:
         for f in range(len(draw)):
             yield cache.pop(f) if f in cache else draw(f)
@@ -147,7 +182,7 @@ def write_animation(path: str | os.PathLike[str], surface: Surface, rest_net: Ar
                 progress(f + 1, len(draw))
 
     cache: dict[int, NDArray[np.uint8]] = {}
-    if suffix == ".gif":
+    if target.suffix.lower() == ".gif":
         return write_with(target, lambda tmp: _write_gif(tmp, draw, cache, frames(), fps))
     return write_with(target, lambda tmp: _write_mp4(tmp, frames(), fps))
 

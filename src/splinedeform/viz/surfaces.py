@@ -149,8 +149,6 @@ def render_body_surfaces(path: str | os.PathLike[str], patches: Sequence[Surface
     ``r × r`` grids and welded where they meet (:func:`splinedeform.export.welded_body`),
     so a panel is one mesh of the whole body coloured by ``|x - x_rest|``.
     """
-    from ..export.body import welded_body
-
     target = Path(path)
     if target.suffix.lower() != ".png":
         raise InputError(f"render_body_surfaces writes PNG; got {target.name!r}")
@@ -159,13 +157,25 @@ def render_body_surfaces(path: str | os.PathLike[str], patches: Sequence[Surface
                          f"panel(s) and {len(titles)} title(s)")
     if not (isinstance(warp, (int, float)) and np.isfinite(warp) and warp > 0):
         raise InputError(f"warp must be finite and > 0, got {warp!r}")
-    frames = [np.stack([np.asarray(rest, dtype=float)] + [np.asarray(panel[k], dtype=float)
-                                                          for panel in nets])
-              for k, rest in enumerate(rest_nets)]
-    X, faces, _ = welded_body(patches, frames, resolution)
+    frames = [np.stack([np.asarray(panel[k], dtype=float) for panel in nets])
+              for k in range(len(rest_nets))]
+    X, mag, faces = body_displaced_meshes(patches, rest_nets, frames, resolution, float(warp))
+    return _render(target, X, mag, faces, [str(t) for t in titles], float(warp), camera)
+
+
+def body_displaced_meshes(patches: Sequence[Surface], rest_nets: Sequence[ArrayLike],
+                          frames: Sequence[ArrayLike], resolution: int, warp: float = 1.0
+                          ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+    """:func:`_displaced_meshes` of a body: ``frames[k]`` ``(F, n_u, n_v, 3)`` are patch
+    ``k``'s nets; the patches' grids welded where they meet at rest and in every frame
+    (:func:`splinedeform.export.body.welded_body`), so each frame is one mesh."""
+    from ..export.body import welded_body
+
+    stacked = [np.concatenate([np.asarray(rest, dtype=float)[None], np.asarray(P, dtype=float)])
+               for rest, P in zip(rest_nets, frames)]
+    X, faces, _ = welded_body(patches, stacked, resolution)
     d = X[1:] - X[0]
-    return _render(target, X[0] + float(warp) * d, np.linalg.norm(d, axis=-1), faces,
-                   [str(t) for t in titles], float(warp), camera)
+    return X[0] + warp * d, np.linalg.norm(d, axis=-1), faces
 
 
 def _render(target: Path, X: NDArray[np.float64], mag: NDArray[np.float64],

@@ -44,16 +44,17 @@
     hudBox.textContent = "t = " + t.toFixed(2) + (paused ? " (paused)" : "") +
       "   " + (mean > 0 ? (1000 / mean).toFixed(0) : "-") + " fps, " + work.toFixed(1) + " ms per frame" +
       "\n" + K + (data.complete ? " modes (all)" : " of " + data.n_free + " modes" +
-      (online || data.offline ? " + static correction" : "")) + ", " + ru + "×" + rv + " samples, max |d| = " + (dmax > 0 ? dmax.toPrecision(3) : "0") +
+      (online || data.offline ? " + static correction" : "")) + ", " + (data.body ? faceList.length + " faces of " + faceRows : ru) + "×" + rv + " samples, max |d| = " + (dmax > 0 ? dmax.toPrecision(3) : "0") +
       (grab || extra.length ? "\n" + grabWords() : "");
   }
 
   // the grab in words: where on the surface (its parameters) and the force held there
   function grabWords() {
-    const g = grab || extra[extra.length - 1], n = g.index, u = data.u[Math.floor(n / rv)], v = data.v[n % rv], F = g.force;
+    const g = grab || extra[extra.length - 1], at = sampleAt(g.index), F = g.force;
     const how = g !== grab || !pointer ? "holding" : grabMode.value === "normal" ? "pushing" : "pulling";
     const others = grab ? extra.length : extra.length - 1;
-    return how + " the point at u = " + u.toPrecision(3) + ", v = " + v.toPrecision(3) +
+    return how + " the point at u = " + at.u.toPrecision(3) + ", v = " + at.v.toPrecision(3) +
+      (data.body ? " of face " + at.number : "") +
       (F ? " with |F| = " + Math.hypot(F[0], F[1], F[2]).toPrecision(3) : "") +
       (others > 0 ? " (+ " + others + " more held; Esc lets go of all)" : "");
   }
@@ -91,16 +92,19 @@
       input.addEventListener("input", () => { out.value = String(Number(Number(input.value).toPrecision(3))); });
       materialBox.appendChild(label);
     }
-    for (const edge of EDGES) {
+    // a body: one preset for every boundary edge (an edge no other face meets); its faces
+    // move as one net, so no free region, painting or pin (one surface's)
+    for (const edge of data.body ? ["u0"] : EDGES) {
       const label = document.createElement("label");
       label.innerHTML = '<span class="name"></span><select></select>';
-      label.querySelector(".name").textContent = edge;
+      label.querySelector(".name").textContent = data.body ? "edges" : edge;
       const select = label.querySelector("select");
       select.id = "boundary-" + edge;
+      if (data.body) select.title = "every edge of the body that no other face meets";
       // a periodic direction has no edges: nothing to choose there
       const periodic = data.periodic && data.periodic[edge[0] === "u" ? 0 : 1];
       if (periodic) { select.disabled = true; select.title = "periodic in " + edge[0] + ": no edge"; }
-      for (const preset of periodic ? ["free"] : ["free", "pinned", "clamped", "pole"]) {
+      for (const preset of periodic ? ["free"] : data.body ? ["free", "pinned", "clamped"] : ["free", "pinned", "clamped", "pole"]) {
         const option = document.createElement("option");
         option.value = option.textContent = preset;
         select.appendChild(option);
@@ -115,6 +119,11 @@
       '<label><span class="name">u from</span><input id="region-u0" type="number" step="any"> to <input id="region-u1" type="number" step="any"></label>' +
       '<label><span class="name">v from</span><input id="region-v0" type="number" step="any"> to <input id="region-v1" type="number" step="any"></label>';
     boundaryBox.appendChild(box);
+    box.style.display = data.body ? "none" : "";
+    for (const id of ["paint", "brush", "paint-all", "paint-none", "apply"]) document.getElementById(id).disabled = Boolean(data.body);
+    grabMode.querySelector('option[value="pin"]').disabled = Boolean(data.body);
+    if (data.body && paintBox.checked) setPaint(false);
+    if (data.body && grabMode.value === "pin") grabMode.value = "spring";
     box.querySelectorAll("input[type=number]").forEach((input) => { input.style.width = "60px"; });
     document.getElementById("region-on").checked = Boolean(data.free_region);
     box.addEventListener("input", boxToMask);
@@ -152,7 +161,7 @@
     releaseAll();                     // the held pushes end now (as when the new modes arrive)
     const material = {}, boundary = {};
     for (const key of WEIGHTS) material[key] = Number(document.getElementById("material-" + key).value);
-    for (const edge of EDGES) boundary[edge] = document.getElementById("boundary-" + edge).value;
+    for (const edge of EDGES) boundary[edge] = document.getElementById("boundary-" + (data.body ? "u0" : edge)).value;
     const started = performance.now();
     const poll = setInterval(async () => {
       try {
@@ -212,7 +221,7 @@
   // push list with it (Save records the pushes since the last re-solve).
   let lastSwitch = null, carriedMotion = false;
   function load(d) {
-    const sameGrid = d.grid[0] === ru && d.grid[1] === rv;
+    const sameGrid = layoutOf(d) === layoutOf(data);
     releaseAll();
     propagate(q, v, f, t - tEvent, q, v);
     tEvent = t;
@@ -303,7 +312,10 @@
     setPaused, reset, save, resolve, bake() { return bake(); }, pin, undo, redo, hold, release: releaseAll,
     get grabs() { return allGrabs().map((g) => ({ index: g.index, force: g.force && g.force.slice(), held: Boolean(g.anchor || g.fixed) })); },
     netPosition(k) { return [netRest[3 * k] + netDisp[3 * k], netRest[3 * k + 1] + netDisp[3 * k + 1], netRest[3 * k + 2] + netDisp[3 * k + 2]]; },
-    uv(n) { return [data.u[Math.floor(n / rv)], data.v[n % rv]]; },
+    uv(n) { const at = sampleAt(n); return [at.u, at.v]; },
+    face(n) { return sampleAt(n).number; },
+    get faceCount() { return faceList.length; },
+    triangleCount() { return geometry.index.count / 3; },
     nearestNet(n) { return nearestNetPoint(data.u[Math.floor(n / rv)], data.v[n % rv]); },
     get grabView() { return grabEnds && { point: grabEnds.point.slice(), pointer: grabEnds.pointer && grabEnds.pointer.slice(),
                                           marker: grabMarker.visible, spring: springLine.visible }; },

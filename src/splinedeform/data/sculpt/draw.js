@@ -68,23 +68,31 @@
     // two triangles per grid cell, in bands of 8 cells across: a triangle's vertices were
     // mostly used by the triangles just before it, which the vertex cache of a software
     // renderer keeps; 16-bit indices when they suffice
-    const faces = new (N <= 65536 ? Uint16Array : Uint32Array)((ru - 1) * (rv - 1) * 6);
+    // (face by face: no triangle joins two faces of a body)
+    const faces = new (N <= 65536 ? Uint16Array : Uint32Array)(faceList.length * (faceRows - 1) * (rv - 1) * 6);
     let m = 0;
-    for (let j0 = 0; j0 + 1 < rv; j0 += 8) for (let i = 0; i + 1 < ru; i++) {
-      for (let j = j0; j < Math.min(j0 + 8, rv - 1); j++) {
-        const a = i * rv + j, b = (i + 1) * rv + j;
-        faces[m++] = a; faces[m++] = b; faces[m++] = b + 1;
-        faces[m++] = a; faces[m++] = b + 1; faces[m++] = a + 1;
+    for (let lo = 0; lo < ru; lo += faceRows) {
+      for (let j0 = 0; j0 + 1 < rv; j0 += 8) for (let i = lo; i + 1 < lo + faceRows; i++) {
+        for (let j = j0; j < Math.min(j0 + 8, rv - 1); j++) {
+          const a = i * rv + j, b = (i + 1) * rv + j;
+          faces[m++] = a; faces[m++] = b; faces[m++] = b + 1;
+          faces[m++] = a; faces[m++] = b + 1; faces[m++] = a + 1;
+        }
       }
     }
     geometry.setIndex(new THREE.BufferAttribute(faces, 1));
     surfaceMesh = new THREE.Mesh(geometry, surfaceMaterial);
     surfaceMesh.frustumCulled = false;     // the surface stays in view: no bounding sphere per frame
     scene.add(surfaceMesh);
-    const [nu, nv] = data.net_shape, [wrapU, wrapV] = data.periodic, segments = [];
-    for (let k = 0; k < nu; k++) for (let l = 0; l < nv; l++) {
-      if (k + 1 < nu || wrapU) segments.push(k * nv + l, ((k + 1) % nu) * nv + l);
-      if (l + 1 < nv || wrapV) segments.push(k * nv + l, k * nv + (l + 1) % nv);
+    const segments = [];
+    let start = 0;                   // each face's net: its own lines, none between faces
+    for (const face of faceList) {
+      const [nu, nv] = face.net, [wrapU, wrapV] = face.periodic;
+      for (let k = 0; k < nu; k++) for (let l = 0; l < nv; l++) {
+        if (k + 1 < nu || wrapU) segments.push(start + k * nv + l, start + ((k + 1) % nu) * nv + l);
+        if (l + 1 < nv || wrapV) segments.push(start + k * nv + l, start + k * nv + (l + 1) % nv);
+      }
+      start += nu * nv;
     }
     netGeometry = new THREE.BufferGeometry();
     netPositions = new THREE.BufferAttribute(new Float32Array(NN * 3), 3);
@@ -216,10 +224,12 @@
     }
   }
   // normals of the sample grid: x_u × x_v by differences along the grid (one-sided at the
-  // edges), the same orientation as the faces; cheaper than three.js' per-face accumulation
+  // edges of each face), the same orientation as the faces; cheaper than three.js' per-face
+  // accumulation
   function gridNormals(pos, out) {
     for (let i = 0; i < ru; i++) {
-      const i0 = i > 0 ? i - 1 : i, i1 = i + 1 < ru ? i + 1 : i;
+      const lo = i - (i % faceRows), hi = lo + faceRows - 1;
+      const i0 = i > lo ? i - 1 : i, i1 = i < hi ? i + 1 : i;
       for (let j = 0; j < rv; j++) {
         const j0 = j > 0 ? j - 1 : j, j1 = j + 1 < rv ? j + 1 : j;
         const a = 3 * (i1 * rv + j), b = 3 * (i0 * rv + j), c = 3 * (i * rv + j1), d = 3 * (i * rv + j0);
@@ -246,11 +256,16 @@
       }
       return true;
     };
-    // edge = [count along it, sample index (m) on the edge, on the next row inwards]
-    const edges = [[rv, (m) => at(0, m), (m) => at(1, m)], [rv, (m) => at(ru - 1, m), (m) => at(ru - 2, m)],
-                   [ru, (m) => at(m, 0), (m) => at(m, 1)], [ru, (m) => at(m, rv - 1), (m) => at(m, rv - 2)]];
+    // edge = [count along it, sample index (m) on the edge, on the next row inwards], for
+    // each face (rows lo … hi)
+    const edges = [];
+    for (let lo = 0; lo < ru; lo += faceRows) {
+      const hi = lo + faceRows - 1;
+      edges.push([rv, (m) => at(lo, m), (m) => at(lo + 1, m)], [rv, (m) => at(hi, m), (m) => at(hi - 1, m)],
+                 [faceRows, (m) => at(lo + m, 0), (m) => at(lo + m, 1)], [faceRows, (m) => at(lo + m, rv - 1), (m) => at(lo + m, rv - 2)]);
+    }
     for (const [count, edge, inner] of edges) {
-      if (ru < 2 || rv < 2 || !collapsed(count, edge)) continue;
+      if (faceRows < 2 || rv < 2 || !collapsed(count, edge)) continue;
       let nx = 0, ny = 0, nz = 0, ox = 0, oy = 0, oz = 0;
       for (let m = 0; m + 1 < count; m++) {
         const a = edge(m), b = inner(m), c = edge(m + 1), d = inner(m + 1);

@@ -29,7 +29,7 @@
   }
   function restore(state) {
     releaseAll();
-    const sameGrid = state.data.grid[0] === ru && state.data.grid[1] === rv;
+    const sameGrid = layoutOf(state.data) === layoutOf(data);
     data = state.data;
     unpack(data);
     allocate();
@@ -118,6 +118,7 @@
   }
   // pin the control point nearest (Greville points, parameter domain) to sample n
   function pin(n) {
+    if (data.body) { showMessage("pinning a control point is for one surface; a body's faces move as one net"); return Promise.resolve(null); }
     const cu = data.u[Math.floor(n / rv)], cv = data.v[n % rv];
     return bake(nearestNetPoint(cu, cv));
   }

@@ -39,8 +39,14 @@
   // the free set (1 = free, row-major over the net, what Apply sends) and where it came from:
   // "box" (the u/v box of the panel), "points" (a list: the scenario's or painted)
   let freeMask, freeSource, gU, gV, stillMask;
+  // the faces: a body's samples are face after face, rows p·faceRows … (p+1)·faceRows - 1 of
+  // the (ru, rv) grid for face p, and its control points the next nu·nv of the net; a single
+  // surface is one face
+  let faceList, faceRows;
   function unpack(d) {
     K = d.modes; [ru, rv] = d.grid; N = ru * rv;
+    faceList = d.faces || [{ v: d.v, net: d.net_shape, periodic: d.periodic }];
+    faceRows = ru / faceList.length;
     lam = decode(d.lam, Float64Array); damp = decode(d.damping, Float64Array);
     phi = decode(d.phi, Float32Array); rest = decode(d.rest, Float32Array);
     phiNet = decode(d.phi_net, Float32Array); netRest = decode(d.net_rest, Float32Array);
@@ -51,6 +57,13 @@
     [gU, gV] = d.greville;
   }
   unpack(data);
+  // sample n: its face p (the file's face number of a body), and (u, v) on that face
+  function sampleAt(n) {
+    const p = Math.floor(n / (faceRows * rv));
+    return { face: p, number: data.body ? data.body.faces[p] : p, u: data.u[Math.floor(n / rv)], v: faceList[p].v[n % rv] };
+  }
+  // what fixes the page's geometry: the sample grid and each face's net
+  const layoutOf = (d) => JSON.stringify([d.grid, (d.faces || []).map((face) => face.net), d.net_shape, d.periodic]);
 
   // -- modal state: (q, q', f) per mode and coordinate at the last event tEvent --------------
   // q(τ) = f/λ + e^{-στ}(a C + (b + σ a) S), q'(τ) = e^{-στ}(b C - (λ a + σ b) S),
