@@ -51,7 +51,7 @@ def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
              function_samples: int = 400, modes: int | str | None = None,
              omega_max: float | None = None, eigensolver: str = "auto",
              tolerance: float | None = None, times: ArrayLike | None = None,
-             _of_static: bool = False) -> ModalSolution:
+             check_spectrum: bool = True, _of_static: bool = False) -> ModalSolution:
     """Closed-form modal solution; ``modes``/``omega_max`` truncate with mode acceleration,
     ``tolerance`` chooses the number of modes (:mod:`~splinedeform.solvers.mode_count`).
 
@@ -85,11 +85,11 @@ def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
             report = {}                  # all modes: the auto eigen-solution resolves them
     if report and report["modes"] < model.n_free:
         modes, eigensolver = report["modes"], "sparse"
-    basis = model.modal_basis(eigensolver, modes, omega_max)
+    basis = model.modal_basis(eigensolver, modes, omega_max, check_spectrum)
     start = time.perf_counter()
     M, _, K = model.matrices()
     lam = basis.lam
-    c = model.material.damping / model.material.mass + model.material.rayleigh * lam
+    c = model.formulation.damping_rate + model.formulation.rayleigh * lam
     jumps = [(t_j, basis.project(F)) for t_j, F in spatial[0]]
     harmonics = [(w, phase, basis.project(F)) for w, phase, F in spatial[1]]
     response = ModalResponse(lam, c, basis.project(M @ d0), basis.project(M @ v0),
@@ -185,12 +185,12 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
         return {"tolerance": tolerance, "modes": model.n_free, "bound": 0.0}
     at = (np.linspace(0.0, t_end, DEFAULT_TIMES) if times is None
           else np.asarray(times, dtype=float).ravel())
-    m = model.material
+    physics = model.formulation
     M, _, K = model.matrices()
     krylov = _KRYLOV.get(model)
     if krylov is None:
         krylov = _KRYLOV[model] = BlockLanczos(K, M)
-    gamma, beta, c_inf = m.damping / m.mass, m.rayleigh, pointwise_factor(model)
+    gamma, beta, c_inf = physics.damping_rate, physics.rayleigh, pointwise_factor(model)
     out_of_reach = model.n_free > modal_basis.DENSE_MAX    # all modes cannot be had
     basis, correction, report = mode_select.automatic_basis(
         K, M, spatial[0], gamma, beta, at, tolerance, krylov=krylov, pointwise=c_inf,
@@ -239,7 +239,7 @@ def _largest_below(basis: Any, correction: Any, report: dict[str, Any], jumps: l
                          for g, part in zip(coef, correction.jump_parts)], axis=0)
     _, p, c = np.unravel_index(int(np.argmax(np.abs(statics))), statics.shape)
     lam = basis.lam
-    zero = np.zeros((lam.size, 3))
+    zero = np.zeros((lam.size, statics.shape[-1]))       # 3 coordinates, or 1 column
     response = ModalResponse(lam, gamma + beta * lam, zero, zero,
                              [(t_j, basis.project(merged[t_j])) for t_j in order], [])
     row = basis.phi[p]                          # a DenseBasis (automatic_basis)
@@ -261,7 +261,7 @@ def pointwise_factor(model: Model) -> float:
             gu, gv = (np.diag(np.linalg.inv(g[0].toarray())) for g in (model.gram_u,
                                                                        model.gram_v))
             inverse = np.kron(gu, gv) / model.material.mass
-        _POINTWISE[model] = mode_select.pointwise_bound(M, model.constraints.T, inverse)
+        _POINTWISE[model] = mode_select.pointwise_bound(M, model.T, inverse)
     return _POINTWISE[model]
 
 def truncation_request(model: Model, modes: int | None, omega_max: float | None

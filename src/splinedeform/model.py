@@ -9,6 +9,13 @@ For every coordinate alike (DESIGN.md §1.5)::
 with exact 1-D Gram matrices ``G_a``; constraints ``d = T d_free`` reduce them to
 ``M_r = Tᵀ M T`` etc. Data flows one way: surface + material + boundary → model →
 static / modes / dynamic solutions.
+
+The model owns static, modes and dynamics for every physics: what differs between the
+plate and the Kirchhoff–Love shell (unknowns per control point, damping, load fields, rigid
+modes, the static solve's refusals, the eigensolvers' guard, read-out) is the
+:class:`~splinedeform.physics.formulation.Formulation` in ``model.formulation``
+(:class:`~splinedeform.physics.plate.PlateFormulation` here, the shell's in
+:class:`splinedeform.ShellModel`).
 """
 
 from __future__ import annotations
@@ -21,15 +28,13 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
-from .assembly import (ReducedFactors, _largest, check_bending, full_matrices,
-                       gram_matrices, patch_matrices, reduced_factors, reduced_matrices)
-from .boundary import Constraints, build_constraints
-from .errors import InputError, SingularSystemError
+from .assembly import ReducedFactors, _largest, check_bending, full_matrices
+from .boundary import Constraints
+from .errors import InputError
 from .loads import Load, as_load, static_time
 from .material import Material, check_scales
-from .physics import intrinsic
-from .physics.coupling_model import bends, c0_coupling
-from .physics.coupling_ties import tie_c0_lines
+from .physics.formulation import Formulation, damping
+from .physics.plate import METHODS, surface_system
 from . import modal_solve
 from .modal_solve import check_count as _check_count
 from .solution import ModalSolution, Readout, SampledSolution, StaticSolution
@@ -39,12 +44,9 @@ from .solvers.forcing import ReducedForcing
 from .solvers.system import KroneckerFactors, Reduction
 from .surface import Surface
 from .threads import owned
-from .static_solve import check_options, solve_stiffness  # noqa: F401
-from .trim.model_matrices import trimmed_system
+from .static_solve import check_options
 
 Array = NDArray[np.float64]
-METHODS = ("analytic", "newmark", "radau3", "radau5", "radau7", "genalpha", "rk45", "dop853",
-           "radau", "bdf")
 STEP_METHODS = ("newmark", "radau3", "radau5", "radau7", "genalpha")   # take a step dt
 
 
@@ -87,6 +89,8 @@ class Model:
     9
     """
 
+    #: the patches of a body (``None``: one surface, :attr:`surface`)
+    patches: tuple[Surface, ...] | None = None
     #: the reduced 1-D Gram matrices and the constructor's boundary and fixed points, for
     #: :meth:`with_material` (None on a model built otherwise, as a body of patches)
     _factors: ReducedFactors | None = None
@@ -106,53 +110,20 @@ class Model:
         self.mass_matrix = mass_matrix
         self.rest = rest
         self.physics = physics
-        trimmed = None if surface.trim is None else trimmed_system(
-            surface, material, boundary, mass_matrix == "lumped", physics, fixed, rest)
-        self.constraints: Constraints = trimmed.constraints if trimmed else build_constraints(
-            surface.basis_u, surface.basis_v, boundary,
-            None if fixed is None else np.asarray(fixed), surface.control_points)
-        if self.constraints.n_free == 0:
-            error = InputError(
-                f"no free coordinate: the boundary {self.constraints.edges} fixes every one of "
-                f"the {surface.shape[0]} x {surface.shape[1]} control points (cells "
-                f"{surface.basis_u.cells} x {surface.basis_v.cells}, degree "
-                f"{surface.basis_u.degree}), so nothing can move; free an edge, or use more cells "
-                "(surface.cells; a CAD or control net surface: insert knots with surface.refine)")
-            error.key = "boundary"  # type: ignore[attr-defined]
-            raise error
-        lumped = mass_matrix == "lumped"
-        general = surface.net_weights is not None         # weights that do not factor
-        self.gram_u, self.gram_v = (None, None) if general else gram_matrices(surface)
-        # K and M on the whole net: assembled here only where the constrained matrices are
-        # made from them, else when first asked for (K_full, M_full)
-        self._full: tuple[sp.csr_matrix, sp.csr_matrix] | None = (
-            intrinsic.matrices(surface, material, lumped) if physics == "intrinsic"
-            else (trimmed.stiffness, trimmed.mass) if trimmed
-            else patch_matrices(surface, material, physics, lumped)[2:] if general else None)
-        tied: set[tuple[str, float]] = set()
-        if not trimmed and bends(material):    # smooth C0 lines: C1 in the constraint map
-            self.constraints, tied = tie_c0_lines(surface, self.constraints)
-        kinks = c0_coupling(surface, material, self.constraints.edges, exact=tied)
-        if kinks is not None or tied:          # the slopes tied across each C0 line
-            K, M = self._full_matrices()
-            K = K if kinks is None else K + kinks
-            self._full, self.gram_u, self.gram_v = (K.tocsr(), M), None, None
+        system = surface_system(surface, material, boundary, fixed, mass_matrix, physics, rest)
+        self.constraints: Constraints = system.constraints
+        self.formulation: Formulation = system.formulation
+        self.gram_u, self.gram_v = system.gram_u, system.gram_v
+        # K and M on the whole net: assembled only where the constrained matrices are made
+        # from them, else when first asked for (K_full, M_full)
+        self._full: tuple[sp.csr_matrix, sp.csr_matrix] | None = system.full
+        self._K, self._M, self._C = system.reduced
         # the reduced 1-D Gram matrices, kept for models of other materials (with_material)
-        self._factors = None if physics == "intrinsic" or trimmed or kinks is not None or \
-            tied or general else reduced_factors(self.gram_u, self.gram_v, self.constraints)
+        self._factors = system.factors
         self._arguments = {"boundary": boundary, "fixed": fixed}
-        reduced = None if self._factors is None else reduced_matrices(
-            self.gram_u, self.gram_v, material, lumped, self.constraints, self._factors)
-        if reduced is None:
-            T = self.constraints.T
-            K, M = self._full_matrices()
-            self._K, self._M = (T.T @ K @ T).tocsc(), (T.T @ M @ T).tocsc()
-            self._C: sp.csc_matrix | None = None
-        else:
-            self._K, self._M, self._C = reduced
         self._finish(start)
-        if trimmed:
-            self._rigid = (trimmed.rigid_modes,)
+        if system.rigid_modes is not None:      # a trimmed net's, counted on its region
+            self._rigid = (system.rigid_modes,)
 
     @property
     def shares_geometry(self) -> bool:
@@ -171,9 +142,8 @@ class Model:
         and the caches."""
         material = self.material
         if getattr(self, "_C", None) is None:
-            self._C = ((material.damping / material.mass) * self._M
-                       + material.rayleigh * self._K).tocsc()
-        if self._M.nnz:
+            self._C = damping(self.formulation, self._M, self._K)
+        if self._M.nnz and isinstance(material, Material):
             check_scales(material, _largest(self._K), _largest(self._M))
         self._eigen: tuple[Array, Array] | None = None
         self._bases: dict[tuple, modal_basis.ModalBasis] = {}
@@ -198,9 +168,20 @@ class Model:
 
     # -- layout --------------------------------------------------------------------
     @property
+    def T(self) -> sp.csr_matrix:
+        """The constraint map ``d = T d_free`` (rows: the formulation's unknowns)."""
+        return self.constraints.T
+
+    @property
     def n_free(self) -> int:
-        """Number of free coordinates (moving control points per coordinate)."""
-        return self.constraints.n_free
+        """Number of free coordinates (moving control points per coordinate, or the
+        shell's free unknowns)."""
+        return int(self.T.shape[1])
+
+    @property
+    def unknowns_label(self) -> str:
+        """How summaries name :attr:`n_free`."""
+        return self.formulation.unknowns_label
 
     def matrices(self) -> tuple[sp.csc_matrix, sp.csc_matrix, sp.csc_matrix]:
         """Reduced ``(M_r, C_r, K_r)``, each ``(n_free, n_free)``, shared by x, y and z."""
@@ -208,34 +189,38 @@ class Model:
 
     def to_full(self, d_free: Array) -> Array:
         """Full displacement net ``T d_free`` as ``(n_u, n_v, 3)`` (or ``(n_u, n_v)`` for a scalar field)."""
-        full = self.constraints.T @ d_free
+        full = self.T @ d_free
         return np.asarray(full).reshape(self.surface.shape + np.shape(d_free)[1:])
 
     @property
     def reduction(self) -> Reduction:
         """The constraint map and load offset the solvers reduce loads with."""
-        rest = self._reduce_force(np.zeros((self.constraints.T.shape[0], 3))) \
+        rest = self._reduce_force(np.zeros((self.T.shape[0], 3))) \
             if self.rest == "none" else None
         return self._reduction(rest)
 
     def _reduction(self, rest: Array | None) -> Reduction:
-        """:class:`Reduction` of ``T`` with the surface loads are evaluated on."""
-        return Reduction(self.constraints.T, self.surface, rest)
+        """:class:`Reduction` of ``T`` with the formulation's load fields."""
+        return self.formulation.reduction(self.T, rest)
 
     @property
     def readout(self) -> Readout:
         """What a solution of this model needs to read out its free coordinates."""
-        return Readout(self.surface, self.constraints.T, self._M, self._K)
+        return self.formulation.readout(self.T, self._M, self._K)
 
-    def load_vector(self, load: Load, t: float = 0.0) -> Array:
-        """Reduced generalised force ``Tᵀ (F(t) [- K p0 when rest='none'])``, shape ``(n_free, 3)``."""
-        F = as_load(load).vector(self.surface, t)
-        return self._reduce_force(F)
+    def load_vector(self, load: Load | None, t: float = 0.0) -> Array:
+        """Reduced generalised force ``Tᵀ (F(t) [- K p0 when rest='none'])``: ``(n_free, 3)``
+        (one unknown per control point) or ``(n_free,)`` (three, interleaved)."""
+        reduction = self._reduction(None)
+        F = sum((term.profile(t) * reduction.field(term, t) for term in as_load(load).terms()),
+                np.zeros((self.T.shape[0], reduction.columns)))
+        F_r = self._reduce_force(F)
+        return F_r if reduction.columns == 3 else F_r[:, 0]
 
     def _reduce_force(self, F_full: Array) -> Array:
         if self.rest == "none":
             F_full = F_full - self.K_full @ self._rest_net()
-        return np.asarray(self.constraints.T.T @ F_full)
+        return np.asarray(self.T.T @ F_full)
 
     def _rest_net(self) -> Array:
         """The rest control points ``p0`` as rows ``(n_points, 3)`` of ``T``'s layout."""
@@ -250,29 +235,29 @@ class Model:
         the time ``t`` at which its equilibrium is wanted; it is never taken at ``t = 0``
         silently.
 
+        The solve and its refusals are the formulation's
+        (:meth:`~splinedeform.physics.formulation.Formulation.static_displacement`): the
+        plate's band Cholesky, the shell's nested dissection with its free rigid motions
+        removed by ``Rᵀ M_r d = 0``.
+
         Raises
         ------
         SingularSystemError
-            When the surface is unconstrained (rigid motions have no stiffness) or the
-            weights leave some deformation without energy.
+            When the surface is unconstrained (rigid motions have no stiffness), the
+            weights leave some deformation without energy, or a shell's load does work on
+            a rigid motion its boundary leaves free.
         """
         start = time.perf_counter()
-        if self.constraints.unconstrained:
-            raise SingularSystemError(
-                "static solve of an unconstrained surface: every edge is free and no control "
-                "point is fixed, so rigid translations cost no energy and K is singular. "
-                "Fix an edge (boundary='clamped' or e.g. {'u0': 'pinned'}) or some control "
-                "points (fixed=mask)")
         F = self.load_vector(as_load(load), static_time(as_load(load), t))
         d = self._solve_stiffness(F)
         return StaticSolution(self.readout, d, F, {"static": time.perf_counter() - start})
 
     def _solve_stiffness(self, F: Array) -> Array:
-        return solve_stiffness(self, F)
+        return self.formulation.static_displacement(self, F)
 
     # -- modes -------------------------------------------------------------------------
     @owned
-    def eigen(self, k: int | None = None) -> tuple[Array, Array]:
+    def eigen(self, k: int | None = None, check_spectrum: bool = True) -> tuple[Array, Array]:
         """Lowest ``k`` (default all) eigenpairs of ``K_r φ = λ M_r φ`` with ``Φᵀ M_r Φ = I``.
 
         Ascending ``λ`` (round-off negatives clipped to 0) and explicit ``Φ`` of shape
@@ -282,13 +267,18 @@ class Model:
         up to ``DENSE_MAX`` (see :mod:`splinedeform.solvers.modal_basis`). A few modes
         (``k <= n/10``, ``n >= 400``) of a net whose modes are not yet known come from
         sparse Lanczos too unless the separable factors apply: ``O(n k²)`` against the
-        ``O(n³)`` of all modes. Cached (:mod:`splinedeform.spectrum`).
+        ``O(n³)`` of all modes. Cached (:mod:`splinedeform.spectrum`). Each computed pair
+        is checked by the formulation's guard (the plate: the condition number; the shell:
+        each pair's residual, :mod:`splinedeform.solvers.eigen_trust`) and refused if not
+        resolved; ``check_spectrum=False`` skips the check (at the caller's risk).
         """
-        return spectrum.eigen(self, None if k is None else _check_count(k, self.n_free))
+        return spectrum.eigen(self, None if k is None else _check_count(k, self.n_free),
+                              check_spectrum)
 
     @owned
     def modal_basis(self, eigensolver: str = "auto", modes: int | None = None,
-                    omega_max: float | None = None) -> modal_basis.ModalBasis:
+                    omega_max: float | None = None, check_spectrum: bool = True
+                    ) -> modal_basis.ModalBasis:
         """Modes as a :class:`~splinedeform.solvers.modal_basis.ModalBasis` (cached).
 
         Parameters
@@ -297,8 +287,10 @@ class Model:
             See :func:`~splinedeform.solvers.modal_basis.choose`.
         modes, omega_max : optional
             Keep only the lowest ``modes`` modes, or those with ``ω <= omega_max``.
+        check_spectrum : bool
+            See :meth:`eigen`.
         """
-        return spectrum.modal_basis_of(self, eigensolver, modes, omega_max)
+        return spectrum.modal_basis_of(self, eigensolver, modes, omega_max, check_spectrum)
 
     def kronecker_factors(self) -> KroneckerFactors:
         """The reduced 1-D Gram factors of ``M_r`` and ``K_r`` (:mod:`splinedeform.spectrum`)."""
@@ -308,20 +300,26 @@ class Model:
     def rigid_modes(self) -> int | None:
         """Dimension of ``null K_r`` (motions without energy) from the weights and the
         constraints, not from eigenvalues (:func:`~splinedeform.solvers.rigid.rigid_count`);
-        ``None`` where no structure is known (intrinsic plate without tension)."""
+        ``None`` where no structure is known (intrinsic plate without tension); the
+        formulation's basis of ``null K_r`` where it has one (the shell's free rigid
+        motions)."""
+        basis = self.formulation.rigid_basis
+        if basis is not None:
+            return int(basis.shape[1])
         if self._rigid is None:
             self._rigid = (spectrum.rigid_count(self),)
         return self._rigid[0]
 
-    def frequencies(self, k: int = 6) -> Array:
+    def frequencies(self, k: int = 6, check_spectrum: bool = True) -> Array:
         """Lowest ``k`` undamped angular frequencies ``ω_i = √λ_i``, ascending."""
-        return np.sqrt(self.eigen(k)[0])
+        return np.sqrt(self.eigen(k, check_spectrum)[0])
 
-    def modes(self, k: int = 6) -> tuple[Array, Array]:
-        """Lowest ``k`` frequencies and mode shapes as scalar fields on the net ``(k, n_u, n_v)``."""
-        lam, phi = self.eigen(k)
-        shapes = np.asarray(self.constraints.T @ phi).T.reshape((phi.shape[1],) + self.surface.shape)
-        return np.sqrt(lam), shapes
+    def modes(self, k: int = 6, check_spectrum: bool = True) -> tuple[Array, Any]:
+        """Lowest ``k`` frequencies and mode shapes: scalar fields on the net
+        ``(k, n_u, n_v)`` (one unknown per control point; x, y and z move alike) or control
+        net displacements ``(k, n_u, n_v, 3)`` (the shell); a body's: a list, one per patch."""
+        lam, phi = self.eigen(k, check_spectrum)
+        return np.sqrt(lam), self.readout.mode_shapes(phi)
 
     # -- dynamics ------------------------------------------------------------------------
     def initial_state(self, displacement: ArrayLike | None, velocity: ArrayLike | None
@@ -331,24 +329,21 @@ class Model:
                 self._to_free(velocity, "initial_velocity"))
 
     def _to_free(self, net: ArrayLike | None, what: str) -> Array:
+        """Free coordinates ``(n_free, columns)`` of a displacement net (a body's: a list),
+        by least squares ``Tᵀ T d_free = Tᵀ d``; refused where ``d`` is not in ``range T``."""
+        readout = self.readout
         if net is None:
-            return np.zeros((self.n_free, 3))
-        flat = self._flatten_net(net, what)
+            return np.zeros((self.n_free, readout.columns))
+        flat = readout.rows(net, what)
         if not np.all(np.isfinite(flat)):
             raise InputError(f"{what} must be finite")
-        T = self.constraints.T
-        free = spla.spsolve((T.T @ T).tocsc(), T.T @ flat).reshape(-1, 3)
+        T = self.T
+        free = np.asarray(spla.spsolve((T.T @ T).tocsc(), T.T @ flat)).reshape(
+            -1, flat.shape[1])
         if np.linalg.norm(T @ free - flat) > 1e-9 * max(np.linalg.norm(flat), 1e-300):
-            raise InputError(f"{what} moves control points that the boundary conditions fix")
+            raise InputError(f"{what} moves control points that the boundary conditions fix "
+                             "or tie")
         return free
-
-    def _flatten_net(self, net: ArrayLike, what: str) -> Array:
-        """A net ``(n_u, n_v, 3)`` as rows ``(n_points, 3)``; the shape checked."""
-        arr = np.asarray(net, dtype=float)
-        if arr.shape != self.surface.shape + (3,):
-            raise InputError(f"{what} must have shape (n_u, n_v, 3) = "
-                             f"{self.surface.shape + (3,)}, got {arr.shape}")
-        return arr.reshape(-1, 3)
 
     @owned
     def dynamic(self, load: Load | None, t_end: float, method: str = "analytic",
@@ -393,6 +388,9 @@ class Model:
         """
         if method not in METHODS:
             raise InputError(f"unknown method {method!r}; choose one of {METHODS}")
+        if method not in self.formulation.methods:
+            raise InputError(f"the {self.physics} model's dynamic solve takes the methods "
+                             f"{self.formulation.methods}, got {method!r}")
         try:
             t_end = float(t_end)
         except (TypeError, ValueError):

@@ -1,7 +1,10 @@
 """Read-out of a state in free coordinates: the rest surface (or a body's patches) and the
 constraint map ``d = T d_free``, with the reduced ``M`` and ``K`` for the energies.
 
-Control points are ``p = p_rest + T d_free`` (three coordinates share ``T``); a body's rows of
+Control points are ``p = p_rest + T d_free``. With one unknown per control point
+(``per_point = 1``, the plate) the three coordinates share ``T`` and a state is
+``(..., n_free, 3)``; with three (``per_point = 3``, the shell) the rows of ``T`` are the
+interleaved components (row ``3k + c``) and a state is ``(..., n_free)``. A body's rows of
 ``T`` are its patches' control points, patch after patch, each row-major.
 """
 
@@ -11,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from .errors import InputError
 from .surface import Surface
@@ -20,14 +23,35 @@ Array = NDArray[np.float64]
 
 
 class _Energies:
-    """The reduced matrices of the energies, ``M`` and ``K``."""
+    """The reduced matrices of the energies, ``M`` and ``K``, and the layout of a state."""
 
     M: sp.spmatrix
     K: sp.spmatrix
+    T: sp.spmatrix
+    per_point: int
 
     def matrices(self) -> tuple[sp.spmatrix, sp.spmatrix]:
         """``(M, K)``."""
         return self.M, self.K
+
+    @property
+    def columns(self) -> int:
+        """Columns of a state for the solvers: 3 coordinates sharing ``T``, or 1."""
+        return 3 // self.per_point
+
+    def from_columns(self, d: Array) -> Array:
+        """A solver's state ``(..., n_free, columns)`` in this layout (see the module docstring)."""
+        return d if self.per_point == 1 else d[..., 0]
+
+    def _rows(self, arr: Array) -> Array:
+        """A net ``(n_u, n_v, 3)`` as rows of ``T`` ``(N, 3)`` or interleaved ``(3N, 1)``."""
+        return arr.reshape(-1, 3) if self.per_point == 1 else arr.reshape(-1, 1)
+
+    def stresses(self, displacement: object, u: ArrayLike, v: ArrayLike,
+                 at_poles: str = "raise", patch: int | None = None) -> object:
+        """Stresses belong to the physics that has them (the shell)."""
+        raise InputError("stresses are the Kirchhoff–Love shell's (physics 'shell'); the "
+                         "plate under tension has none")
 
 
 @dataclass(frozen=True)
@@ -48,16 +72,44 @@ class Readout(_Energies):
     T: sp.spmatrix
     M: sp.spmatrix
     K: sp.spmatrix
+    per_point: int = 1
 
     def nets(self, d_free: Array, rest: bool = True) -> Array:
-        """``[p_rest +] T d_free``: ``(..., n_free, 3)`` → ``(..., n_u, n_v, 3)``."""
-        net = _expand(self.T, d_free).reshape(d_free.shape[:-2] + self.surface.shape + (3,))
+        """``[p_rest +] T d_free``: a state (module docstring) → ``(..., n_u, n_v, 3)``."""
+        full = _expand(self.T, d_free, self.per_point)
+        net = full.reshape(full.shape[:-2] + self.surface.shape + (3,))
         rest_points = self.surface.control_points
         if rest and net.dtype == np.result_type(net, rest_points):
             net += rest_points                          # a new array: added in place
         elif rest:
             net = rest_points + net
         return net
+
+    def rows(self, net: ArrayLike, what: str) -> Array:
+        """A displacement net ``(n_u, n_v, 3)`` as rows of ``T`` (:meth:`_rows`); the
+        shape checked."""
+        arr = np.asarray(net, dtype=float)
+        if arr.shape != self.surface.shape + (3,):
+            raise InputError(f"{what} must have shape (n_u, n_v, 3) = "
+                             f"{self.surface.shape + (3,)}, got {arr.shape}")
+        return self._rows(arr)
+
+    def deformed(self, nets: Array, name: str) -> Surface:
+        """The surface's bases with the control net ``nets``."""
+        return self.surface.with_control_points(nets, name=name)
+
+    def patch(self, nets: Array, patch: int | None) -> tuple[Surface, Array]:
+        """The rest surface and ``nets`` (a single surface: ``patch`` None or 0)."""
+        if patch not in (None, 0):
+            raise InputError(f"a single surface has no patch {patch!r}")
+        return self.surface, nets
+
+    def mode_shapes(self, phi: Array) -> Array:
+        """Mode shapes of ``phi (n_free, k)``: scalar fields ``(k, n_u, n_v)`` on the net
+        (one unknown per point), control net displacements ``(k, n_u, n_v, 3)`` (three)."""
+        if self.per_point == 3:
+            return self.nets(np.asarray(phi).T, rest=False)
+        return np.asarray(self.T @ phi).T.reshape((phi.shape[1],) + self.surface.shape)
 
 
 @dataclass(frozen=True)
@@ -69,15 +121,40 @@ class BodyReadout(_Energies):
     T: sp.spmatrix
     M: sp.spmatrix
     K: sp.spmatrix
+    per_point: int = 1
 
     def nets(self, d_free: Array, rest: bool = True) -> list[Array]:
         """Per patch ``[p_rest +] T d_free``: a list of ``(..., n_u, n_v, 3)``."""
-        full = _expand(self.T, d_free)
+        full = _expand(self.T, d_free, self.per_point)
         sizes = [s.shape[0] * s.shape[1] for s in self.surfaces]
         parts = np.split(full, np.cumsum(sizes)[:-1], axis=-2)
-        lead = d_free.shape[:-2]
+        lead = full.shape[:-2]
         return [(s.control_points if rest else 0.0) + part.reshape(lead + s.shape + (3,))
                 for s, part in zip(self.surfaces, parts)]
+
+    def rows(self, net: ArrayLike, what: str) -> Array:
+        """A list of per-patch displacement nets as rows of ``T``, patch after patch."""
+        if not isinstance(net, (list, tuple)) or len(net) != len(self.surfaces):
+            raise InputError(f"{what} of a body is a list of {len(self.surfaces)} nets, one "
+                             "per patch")
+        rows = []
+        for p, (part, surface) in enumerate(zip(net, self.surfaces)):
+            arr = np.asarray(part, dtype=float)
+            if arr.shape != surface.shape + (3,):
+                raise InputError(f"{what}[{p}] must have shape {surface.shape + (3,)}, got "
+                                 f"{arr.shape}")
+            rows.append(self._rows(arr))
+        return np.concatenate(rows)
+
+    def mode_shapes(self, phi: Array) -> list[Array]:
+        """Mode shapes per patch: each ``(k, n_u, n_v)`` (one unknown per point) or
+        ``(k, n_u, n_v, 3)`` (three)."""
+        if self.per_point == 3:
+            return self.nets(np.asarray(phi).T, rest=False)
+        full = np.asarray(self.T @ phi).T
+        sizes = [s.shape[0] * s.shape[1] for s in self.surfaces]
+        parts = np.split(full, np.cumsum(sizes)[:-1], axis=1)
+        return [part.reshape((phi.shape[1],) + s.shape) for part, s in zip(parts, self.surfaces)]
 
     def deformed(self, nets: list[Array], name: str) -> list[Surface]:
         """Each patch's bases with its control net."""
@@ -103,12 +180,18 @@ class BodyReadout(_Energies):
         return np.asarray(E @ flat).reshape(F, 3)
 
 
-def _expand(T: sp.spmatrix, d_free: Array) -> Array:
-    """``T d_free`` for ``d_free`` of shape ``(..., n_free, 3)`` → ``(..., n_points, 3)``.
+def _expand(T: sp.spmatrix, d_free: Array, per_point: int = 1) -> Array:
+    """``T d_free`` → ``(..., n_points, 3)`` for ``d_free`` of shape ``(..., n_free, 3)``
+    (``per_point = 1``) or ``(..., n_free)`` (``per_point = 3``, interleaved rows).
 
-    Where ``T`` only selects points (one entry 1 per column, as for clamped or fixed
-    control points) the product is a gather of rows of ``d_free``, with no transposed
-    copies of it."""
+    Where ``T`` (one unknown per point) only selects points (one entry 1 per column, as for
+    clamped or fixed control points) the product is a gather of rows of ``d_free``, with
+    no transposed copies of it."""
+    if per_point == 3:
+        lead = d_free.shape[:-1]
+        flat = np.moveaxis(d_free, -1, 0).reshape(T.shape[1], -1)
+        full = np.asarray(T @ flat).reshape((T.shape[0],) + lead)
+        return np.moveaxis(full, 0, -1).reshape(lead + (-1, 3))
     lead = d_free.shape[:-2]
     rows = _selected_rows(T)
     if rows is not None:                # gather each point's free row, zero the others

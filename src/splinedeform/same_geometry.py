@@ -12,6 +12,7 @@ fixed points that leave no rectangle) is built anew.
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 from .assembly import check_bending, reduced_matrices
 from .errors import InputError
@@ -39,6 +40,7 @@ def with_material(model: Model, material: Material) -> Model:
     new.mass_matrix, new.rest, new.physics = model.mass_matrix, model.rest, model.physics
     new.constraints, new.gram_u, new.gram_v = model.constraints, model.gram_u, model.gram_v
     new._factors, new._arguments, new._full = model._factors, model._arguments, None
+    new.formulation = replace(model.formulation, material=material)
     reduced = reduced_matrices(model.gram_u, model.gram_v, material,
                                model.mass_matrix == "lumped", model.constraints,
                                model._factors)

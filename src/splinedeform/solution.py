@@ -72,22 +72,6 @@ def _check_times(t: ArrayLike, t_end: float | None = None) -> tuple[Array, bool]
     return np.atleast_1d(arr), arr.ndim == 0
 
 
-def _deformed(readout: Any, nets: Any, name: str) -> Any:
-    """The deformed surface of ``nets`` (a body's: a list of its deformed patches)."""
-    if isinstance(readout, BodyReadout):
-        return readout.deformed(nets, name)
-    return readout.surface.with_control_points(nets, name=name)
-
-
-def _patch(readout: Any, nets: Any, patch: int | None) -> tuple[Surface, Array]:
-    """The rest surface and nets of ``patch`` (a single surface: ``None`` or 0)."""
-    if isinstance(readout, BodyReadout):
-        return readout.patch(nets, patch)
-    if patch not in (None, 0):
-        raise InputError(f"a single surface has no patch {patch!r}")
-    return readout.surface, nets
-
-
 class _Displaced:
     """Shared read-out of a state in free coordinates."""
 
@@ -122,14 +106,23 @@ class StaticSolution(_Displaced):
 
     def surface(self) -> Any:
         """The deformed surface (a body's: a list of its deformed patches)."""
-        return _deformed(self.readout, self.control_points(), "static")
+        return self.readout.deformed(self.control_points(), "static")
 
     @owned
     def displacement(self, u: ArrayLike, v: ArrayLike, patch: int | None = None) -> Array:
         """Displacement ``d(u, v)`` of surface points, shape ``S + (3,)`` (of ``patch`` for
         a body)."""
-        rest, net = _patch(self.readout, self._full(self.d_free, rest=False), patch)
+        rest, net = self.readout.patch(self._full(self.d_free, rest=False), patch)
         return rest.derivative(u, v, control_points=net)
+
+    def net_displacement(self) -> Any:
+        """Displacement of the control points ``(n_u, n_v, 3)`` (a body's: one per patch)."""
+        return self._full(self.d_free, rest=False)
+
+    def stresses(self, u: ArrayLike, v: ArrayLike, patch: int | None = None) -> Any:
+        """Resultants, stresses and von Mises at ``(u, v)`` (of ``patch`` on a body), where
+        the physics has them (:mod:`splinedeform.physics.shell_stress`)."""
+        return self.readout.stresses(self.net_displacement(), u, v, patch=patch)
 
     @owned
     def energy(self) -> Energy:
@@ -163,7 +156,8 @@ class Solution(_Displaced):
 
     @owned
     def state(self, t: ArrayLike) -> tuple[Array, Array]:
-        """Free displacements and velocities at times ``t`` (F,), each ``(F, n_free, 3)``."""
+        """Free displacements and velocities at times ``t`` (F,), each ``(F, n_free, 3)``
+        (one unknown per control point) or ``(F, n_free)`` (three, :mod:`.readout`)."""
         raise NotImplementedError
 
     @owned
@@ -182,7 +176,7 @@ class Solution(_Displaced):
 
     def surface(self, t: float) -> Any:
         """The deformed surface at time ``t`` (a body's: a list of its deformed patches)."""
-        return _deformed(self.readout, self.control_points(float(t)), f"t={float(t):g}")
+        return self.readout.deformed(self.control_points(float(t)), f"t={float(t):g}")
 
     @owned
     def displacement(self, t: ArrayLike, u: ArrayLike, v: ArrayLike,
@@ -190,7 +184,7 @@ class Solution(_Displaced):
         """Displacement of surface points: ``S + (3,)`` for scalar ``t``, ``(F,) + S + (3,)``
         else (of ``patch`` for a body)."""
         times, scalar = _check_times(t)
-        rest, nets = _patch(self.readout, self.control_points(times), patch)
+        rest, nets = self.readout.patch(self.control_points(times), patch)
         nets = nets - rest.control_points
         u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
         E = rest.evaluation_matrix(u, v)
@@ -232,6 +226,16 @@ class Solution(_Displaced):
         flat = np.moveaxis(nets.reshape(count, -1, 3), 0, 1).reshape(E.shape[1], -1)
         return np.moveaxis(np.asarray(E @ flat).reshape(ru, rv, count, 3), 2, 0)
 
+    def stresses(self, t: float, u: ArrayLike, v: ArrayLike, patch: int | None = None) -> Any:
+        """Resultants, stresses and von Mises at time ``t`` (a number) and ``(u, v)`` (of
+        ``patch`` on a body), where the physics has them."""
+        times, scalar = _check_times(t)
+        if not scalar:
+            raise InputError(f"stresses are read at one time at a time, got {times.size} times")
+        net = self._full(self.state(times)[0], rest=False)
+        net = [n[0] for n in net] if isinstance(net, list) else net[0]
+        return self.readout.stresses(net, u, v, patch=patch)
+
     @owned
     def energy(self, t: ArrayLike) -> Energy:
         """Kinetic, strain and load-work energies at ``t`` (see the module docstring)."""
@@ -240,7 +244,8 @@ class Solution(_Displaced):
         d, v = self.state(times)
         kinetic = 0.5 * _quadratic(M, v)
         strain = 0.5 * _quadratic(K, d)
-        work = np.array([np.sum(self._force_free(ti) * di) for ti, di in zip(times, d)])
+        work = np.array([np.sum(np.reshape(self._force_free(ti), di.shape) * di)
+                         for ti, di in zip(times, d)])
         if scalar:
             return Energy(kinetic[0], strain[0], work[0])
         return Energy(kinetic, strain, work)
@@ -252,10 +257,10 @@ def _first(nets: Any) -> Any:
 
 
 def _quadratic(A: sp.spmatrix, x: Array) -> Array:
-    """``Σ_c x_cᵀ A x_c`` for each frame of ``x`` (F, n, 3)."""
-    F, n, _ = x.shape
-    flat = np.moveaxis(x, 1, 0).reshape(n, -1)
-    return np.sum(flat * (A @ flat), axis=0).reshape(F, 3).sum(axis=1)
+    """``Σ_c x_cᵀ A x_c`` for each frame of ``x`` (F, n, 3), or ``xᵀ A x`` of (F, n)."""
+    F, n = x.shape[:2]
+    flat = np.moveaxis(x.reshape(F, n, -1), 1, 0).reshape(n, -1)
+    return np.sum(flat * (A @ flat), axis=0).reshape(F, -1).sum(axis=1)
 
 
 class ModalSolution(Solution):
@@ -312,10 +317,10 @@ class ModalSolution(Solution):
 
     def _own(self, times: Array, velocities: bool) -> tuple[Array, Array | None]:
         """``d`` (and ``v``) at ``times`` from this solution's own basis and correction."""
-        n = self.basis.n_free
-        d = np.zeros((times.size, n, 3))
-        v = np.zeros((times.size, n, 3)) if velocities else None
-        active = getattr(self.response, "active", np.arange(3))   # coordinates that move
+        n, columns = self.basis.n_free, self.readout.columns
+        d = np.zeros((times.size, n, columns))
+        v = np.zeros((times.size, n, columns)) if velocities else None
+        active = getattr(self.response, "active", np.arange(columns))   # columns that move
         i = 0
         for part in self._chunks(times):
             span = slice(i, i + part.size)
@@ -341,13 +346,13 @@ class ModalSolution(Solution):
         times, _ = _check_times(t)
         d, v = self._displacements(times, True)
         assert v is not None
-        return d, v
+        return self.readout.from_columns(d), self.readout.from_columns(v)
 
     @owned
     def control_points(self, t: ArrayLike) -> Array:
         """Control net at ``t``: ``(n_u, n_v, 3)`` for a number, ``(F, n_u, n_v, 3)`` for an array."""
         times, scalar = _check_times(t)
-        nets = self._full(self._displacements(times, False)[0])
+        nets = self._full(self.readout.from_columns(self._displacements(times, False)[0]))
         return _first(nets) if scalar else nets
 
     def modal(self, t: ArrayLike) -> tuple[Array, Array]:

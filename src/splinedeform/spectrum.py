@@ -122,19 +122,20 @@ def eigen_advice(model: Model) -> str:
     return advice
 
 
-def eigen(model: Model, k: int | None) -> tuple[Array, Array]:
+def eigen(model: Model, k: int | None, check_spectrum: bool = True) -> tuple[Array, Array]:
     """See :meth:`splinedeform.Model.eigen` (``k`` already checked)."""
     n = model.n_free
     strategy = choose(model, "auto", truncated=k is not None and k <= n // 2)
     few = k is not None and n >= 400 and k <= n // 10
-    if (strategy == "dense" and few and not any(key[1:] == (None, None) for key in model._bases)
+    if (strategy == "dense" and few and not any(key[1:3] == (None, None) for key in model._bases)
             and separable_reason(model) is not None):
         strategy = "sparse"
     if strategy == "sparse":
-        sparse = modal_basis_of(model, "sparse", modes=k)
+        sparse = modal_basis_of(model, "sparse", k, None, check_spectrum)
         assert isinstance(sparse, modal_basis.DenseBasis)
         return sparse.lam, sparse.phi
-    basis = modal_basis_of(model, "auto" if strategy == "dense" else strategy)
+    basis = modal_basis_of(model, "auto" if strategy == "dense" else strategy, None, None,
+                           check_spectrum)
     if isinstance(basis, modal_basis.DenseBasis):
         return basis.lam[:k], basis.phi[:, :k]
     if k is None and n > modal_basis.DENSE_MAX:
@@ -145,34 +146,46 @@ def eigen(model: Model, k: int | None) -> tuple[Array, Array]:
     return basis.lam[order], basis.columns(order)
 
 
+def eigen_options(model: Model, check_spectrum: bool = True) -> dict[str, Any]:
+    """The eigensolvers' ``guard``, ``advice`` (and ``order``) from the model's formulation
+    (:meth:`~splinedeform.physics.formulation.Formulation.eigen_options`)."""
+    options = model.formulation.eigen_options(model.matrices()[2], check_spectrum)
+    options.setdefault("advice", eigen_advice(model))
+    return options
+
+
 def modal_basis_of(model: Model, eigensolver: str = "auto", modes: int | None = None,
-                   omega_max: float | None = None) -> modal_basis.ModalBasis:
+                   omega_max: float | None = None, check_spectrum: bool = True
+                   ) -> modal_basis.ModalBasis:
     """See :meth:`splinedeform.Model.modal_basis` (cached in ``model._bases``)."""
     truncated = modes is not None or omega_max is not None
     strategy = choose(model, eigensolver, truncated)
-    key = (strategy, modes, omega_max)
+    key = (strategy, modes, omega_max) + (() if check_spectrum else (False,))
     if key in model._bases:
         return model._bases[key]
     start = time.perf_counter()
     M, _, K = model.matrices()
+    options = eigen_options(model, check_spectrum)
     if strategy == "sparse":
         basis: modal_basis.ModalBasis = modal_basis.sparse_basis(
-            K, M, modes, omega_max, model.rigid_modes, eigen_advice(model))
+            K, M, modes, omega_max, model.rigid_modes, **options)
     elif truncated:
-        basis = modal_basis.truncate(modal_basis_of(model, eigensolver), modes, omega_max)
+        basis = modal_basis.truncate(modal_basis_of(model, eigensolver, None, None,
+                                                    check_spectrum), modes, omega_max)
     else:
         try:
-            basis = _complete_basis(model, strategy)
+            basis = _complete_basis(model, strategy, options)
         except UnresolvedSpectrum:
             if eigensolver != "auto" or separable_reason(model) is not None:
                 raise
-            basis = _complete_basis(model, "separable")   # resolves each direction apart
+            basis = _complete_basis(model, "separable", options)   # each direction apart
     model._bases[key] = basis
     model.timings["eigen"] = time.perf_counter() - start
     return basis
 
 
-def _complete_basis(model: Model, strategy: str) -> modal_basis.ModalBasis:
+def _complete_basis(model: Model, strategy: str, options: dict[str, Any]
+                    ) -> modal_basis.ModalBasis:
     if strategy == "separable":
         reason = separable_reason(model)
         if reason is not None:
@@ -184,6 +197,7 @@ def _complete_basis(model: Model, strategy: str) -> modal_basis.ModalBasis:
                                             eigen_advice(model))
     else:
         M, _, K = model.matrices()
-        basis = modal_basis.dense_basis(K, M, model.rigid_modes, eigen_advice(model))
+        basis = modal_basis.dense_basis(K, M, model.rigid_modes, options["advice"],
+                                        options["guard"])
     model._eigen = (basis.lam, basis.phi)
     return basis

@@ -23,20 +23,20 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 from scipy.sparse.csgraph import connected_components
 
 from ..assembly import check_bending, patch_matrices
 from ..errors import InputError
-from ..loads import Load, Point, as_load
+from ..loads import Point
 from ..material import Material
 from ..model import Model, check_options
-from ..readout import BodyReadout
 from ..solvers.rigid import UnresolvedSpectrum, count_by_gap
 from ..solvers.system import Reduction
 from ..surface import Surface
 from ..physics.coupling_curves import curve_penalty
 from ..physics.coupling_model import bends, c0_coupling, interface_coupling
+from ..physics.plate import PlateFormulation
 from ..trim.model_matrices import trimmed_system
 from .body import Body
 from .constraints import boundary_presets, build_body_constraints
@@ -180,6 +180,9 @@ class BodyModel(Model):
                       for p, s in enumerate(self.patches)]
         for penalty in (c for c in couplings if c is not None):
             K = (K + penalty).tocsr()
+        self.formulation = PlateFormulation(physics, material, patches=self.patches,
+                                            reduction_type=BodyReduction,
+                                            unconstrained=self.constraints.unconstrained)
         self._full = (K, M)
         T = self.constraints.T
         self._K = (T.T @ K @ T).tocsc()
@@ -188,9 +191,6 @@ class BodyModel(Model):
         self._finish(start)
 
     # -- layout ------------------------------------------------------------------------
-    def _reduction(self, rest: Array | None) -> BodyReduction:
-        return BodyReduction(self.constraints.T, self.patches, rest)
-
     def to_full(self, d_free: Array) -> list[Array]:  # type: ignore[override]
         """Per patch the full displacement net ``T d_free``: ``(n_u, n_v, 3)`` (or
         ``(n_u, n_v)`` for a scalar field) each."""
@@ -199,41 +199,8 @@ class BodyModel(Model):
         return [part.reshape(s.shape + np.shape(d_free)[1:])
                 for part, s in zip(parts, self.patches)]
 
-    @property
-    def readout(self) -> BodyReadout:  # type: ignore[override]
-        return BodyReadout(self.patches, self.constraints.T, self._M, self._K)
-
-    def load_vector(self, load: Load, t: float = 0.0) -> Array:
-        """Reduced ``Tᵀ (F(t) [- K p0 when rest='none'])`` of all patches, ``(n_free, 3)``."""
-        reduction = self._reduction(None)
-        F = sum((term.profile(t) * reduction.field(term, t) for term in as_load(load).terms()),
-                np.zeros((self.constraints.T.shape[0], 3)))
-        return self._reduce_force(F)
-
     def _rest_net(self) -> Array:
         return np.concatenate([s.control_points.reshape(-1, 3) for s in self.patches])
-
-    def _flatten_net(self, net: ArrayLike, what: str) -> Array:
-        """A list of per-patch nets ``(n_u, n_v, 3)`` as rows ``(N, 3)``."""
-        if not isinstance(net, (list, tuple)) or len(net) != len(self.patches):
-            raise InputError(f"{what} of a body is a list of {len(self.patches)} nets, one "
-                             "per patch")
-        rows = []
-        for p, (part, surface) in enumerate(zip(net, self.patches)):
-            arr = np.asarray(part, dtype=float)
-            if arr.shape != surface.shape + (3,):
-                raise InputError(f"{what}[{p}] must have shape {surface.shape + (3,)}, got "
-                                 f"{arr.shape}")
-            rows.append(arr.reshape(-1, 3))
-        return np.concatenate(rows)
-
-    def modes(self, k: int = 6) -> tuple[Array, list[Array]]:  # type: ignore[override]
-        """Lowest ``k`` frequencies and mode shapes per patch, each ``(k, n_u, n_v)``."""
-        lam, phi = self.eigen(k)
-        full = np.asarray(self.constraints.T @ phi).T
-        parts = np.split(full, self.constraints.offsets[1:-1], axis=1)
-        return np.sqrt(lam), [part.reshape((phi.shape[1],) + s.shape)
-                              for part, s in zip(parts, self.patches)]
 
     @property
     def rigid_modes(self) -> int | None:

@@ -29,7 +29,6 @@ from typing import Mapping, Sequence
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
 from scipy.sparse.csgraph import connected_components
 
@@ -173,23 +172,3 @@ def patch_index(count: int, patch: int | None) -> int:
                          f"[0, {count - 1}], got {patch!r}")
     return int(patch)
 
-
-def free_coordinates(T: sp.spmatrix, shapes: Sequence[tuple[int, int]],
-                     nets: Sequence[object], names: Sequence[str]) -> Array:
-    """``d_free`` with ``T d_free`` the given displacement nets (one per patch), by least
-    squares ``Tᵀ T d_free = Tᵀ d``; refused where ``d`` is not in ``range T``."""
-    rows = []
-    for net, shape, name in zip(nets, shapes, names):
-        arr = np.asarray(net, dtype=float)
-        if arr.shape != tuple(shape) + (3,):
-            raise InputError(f"{name} must have shape (n_u, n_v, 3) = {tuple(shape) + (3,)}, "
-                             f"got {arr.shape}")
-        if not np.all(np.isfinite(arr)):
-            raise InputError(f"{name} must be finite")
-        rows.append(arr.ravel())
-    flat = np.concatenate(rows)
-    free = spla.spsolve((T.T @ T).tocsc(), T.T @ flat)
-    if np.linalg.norm(T @ free - flat) > 1e-9 * max(np.linalg.norm(flat), 1e-300):
-        raise InputError(f"{names[0].split('[')[0]} moves displacement components that the "
-                         "boundary conditions fix or tie")
-    return np.asarray(free)

@@ -21,7 +21,7 @@ class ReducedForcing:
     ``reduction`` gives ``T``, the surface the load fields are evaluated on and
     ``F_rest = −Tᵀ K p0`` for a model without rest shape (else 0). Spatial vectors of loads
     whose field does not change in time are computed once.
-    Callable: ``forcing(t) -> (n_free, 3)``.
+    Callable: ``forcing(t) -> (n_free, columns)`` (``columns`` of the reduction).
     """
 
     def __init__(self, reduction: Reduction, load: Load):
@@ -41,7 +41,7 @@ class ReducedForcing:
         return self.reduction.reduce(self.reduction.field(self.terms[i], t))
 
     def __call__(self, t: float) -> Array:
-        out = np.zeros((self.reduction.n_free, 3)) if self._rest is None else self._rest.copy()
+        out = np.zeros((self.reduction.n_free, self.reduction.columns)) if self._rest is None else self._rest.copy()
         for i, term in enumerate(self.terms):
             scale = float(term.profile(t))
             if scale:

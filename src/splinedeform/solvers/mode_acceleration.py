@@ -89,7 +89,9 @@ def mode_acceleration(basis: ModalBasis, K: sp.spmatrix, M: sp.spmatrix,
         parts.append(part)
         omitted.append(_m_norm(M, part) / max(_m_norm(M, full), 1e-300))
         residual.append(float(np.linalg.norm(K @ full - F) / max(np.linalg.norm(F), 1e-300)))
-    jump_parts = np.array(parts[:times.size]) if times.size else np.zeros((0, basis.n_free, 3))
+    columns = parts[0].shape[-1] if parts else 3          # 3 coordinates, or 1 (the shell)
+    jump_parts = (np.array(parts[:times.size]) if times.size
+                  else np.zeros((0, basis.n_free, columns)))
     harmonic_parts = [(omega, phase, part) for (omega, phase, _), part
                       in zip(harmonics, parts[times.size:])]
     return (StaticCorrection(times, jump_parts, harmonic_parts),

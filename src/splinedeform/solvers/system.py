@@ -85,6 +85,8 @@ class Reduction:
     T: sp.spmatrix
     surface: Any
     rest_force: Array | None = None
+    columns = 3
+    """Columns of a force: the 3 coordinates sharing ``T``, or 1 (interleaved rows)."""
 
     @property
     def n_free(self) -> int:

@@ -95,8 +95,8 @@ class ModalReadout:
         self.built = built
         self.basis = model.modal_basis("auto", None, None)
         self.lam = np.maximum(self.basis.lam, 0.0)
-        material = model.material
-        self.c = material.damping / material.mass + material.rayleigh * self.lam
+        physics = model.formulation
+        self.c = physics.damping_rate + physics.rayleigh * self.lam
         self._maps: dict[Any, Array] = {}
         self._responses: dict[Any, Array] = {}
 
