@@ -28,7 +28,6 @@ from numpy.typing import NDArray
 
 from .cad import SEAM_TOL, WEIGHT_TOL, weight_factors
 from .cad_trims import trim_summary
-from .errors import InputError
 from .knots import KnotVectorBasis
 from .quadrature import gauss_points
 

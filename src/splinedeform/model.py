@@ -25,7 +25,6 @@ from typing import Any, Mapping
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
 from .assembly import ReducedFactors, _largest, check_bending, full_matrices
@@ -37,6 +36,7 @@ from .physics.formulation import Formulation, damping
 from .physics.plate import METHODS, surface_system
 from . import modal_solve
 from .modal_solve import check_count as _check_count
+from .readout import free_coordinates
 from .solution import ModalSolution, Readout, SampledSolution, StaticSolution
 from . import spectrum
 from .solvers import modal_basis, numeric
@@ -325,25 +325,8 @@ class Model:
     def initial_state(self, displacement: ArrayLike | None, velocity: ArrayLike | None
                       ) -> tuple[Array, Array]:
         """Free coordinates of an initial displacement/velocity of the control net."""
-        return (self._to_free(displacement, "initial_displacement"),
-                self._to_free(velocity, "initial_velocity"))
-
-    def _to_free(self, net: ArrayLike | None, what: str) -> Array:
-        """Free coordinates ``(n_free, columns)`` of a displacement net (a body's: a list),
-        by least squares ``Tᵀ T d_free = Tᵀ d``; refused where ``d`` is not in ``range T``."""
-        readout = self.readout
-        if net is None:
-            return np.zeros((self.n_free, readout.columns))
-        flat = readout.rows(net, what)
-        if not np.all(np.isfinite(flat)):
-            raise InputError(f"{what} must be finite")
-        T = self.T
-        free = np.asarray(spla.spsolve((T.T @ T).tocsc(), T.T @ flat)).reshape(
-            -1, flat.shape[1])
-        if np.linalg.norm(T @ free - flat) > 1e-9 * max(np.linalg.norm(flat), 1e-300):
-            raise InputError(f"{what} moves control points that the boundary conditions fix "
-                             "or tie")
-        return free
+        return (free_coordinates(self.readout, self.T, displacement, "initial_displacement"),
+                free_coordinates(self.readout, self.T, velocity, "initial_velocity"))
 
     @owned
     def dynamic(self, load: Load | None, t_end: float, method: str = "analytic",

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
 from .errors import InputError
@@ -216,3 +217,19 @@ def _selected_rows(T: sp.spmatrix) -> NDArray[np.int64] | None:
         return None
     rows = np.asarray(C.indices)
     return rows if np.unique(rows).size == rows.size else None
+
+
+def free_coordinates(readout: Readout | BodyReadout, T: sp.spmatrix, net: ArrayLike | None,
+                     what: str) -> Array:
+    """Free coordinates ``(n_free, columns)`` of a displacement net (a body's: a list), by
+    least squares ``Tᵀ T d_free = Tᵀ d``; refused where ``d`` is not in ``range T``."""
+    if net is None:
+        return np.zeros((T.shape[1], readout.columns))
+    flat = readout.rows(net, what)
+    if not np.all(np.isfinite(flat)):
+        raise InputError(f"{what} must be finite")
+    free = np.asarray(spla.spsolve((T.T @ T).tocsc(), T.T @ flat)).reshape(-1, flat.shape[1])
+    if np.linalg.norm(T @ free - flat) > 1e-9 * max(np.linalg.norm(flat), 1e-300):
+        raise InputError(f"{what} moves control points that the boundary conditions fix "
+                         "or tie")
+    return free
