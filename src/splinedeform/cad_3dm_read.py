@@ -79,7 +79,9 @@ def _objects(model: Any, r3: Any) -> list[tuple[int, Any, Any]]:
 
 def list_3dm_arrays(path: Path) -> dict[str, Any]:
     """Every face of a ``.3dm`` file: its object (index, name, layer, kind), whether it is
-    trimmed, closed and periodic in the file, and its NURBS arrays (run in the child)."""
+    trimmed, closed and periodic in the file, whether its Brep marks it ``reversed``
+    (``BrepFace.OrientationIsReversed``: its normal is ``-(S_u × S_v)``), and its NURBS
+    arrays (run in the child)."""
     r3 = _rhino3dm()
     model = r3.File3dm.Read(str(path))
     if model is None:
@@ -95,7 +97,8 @@ def list_3dm_arrays(path: Path) -> dict[str, Any]:
                "layer": layers[layer] if 0 <= layer < len(layers) else None}
         members = list(geometry.Faces) if isinstance(geometry, r3.Brep) else [geometry]
         for number, member in enumerate(members):
-            entry = {**own, "member": number}
+            entry = {**own, "member": number, "reversed": kind != "surface"
+                     and bool(member.OrientationIsReversed)}
             try:
                 surface = member.UnderlyingSurface() if kind != "surface" else member
                 entry["trimmed"] = kind != "surface" and _is_trimmed(geometry, member)

@@ -116,8 +116,9 @@ def read_body(path: str | os.PathLike, faces: FaceChoice = "all"
         shared, boundary, seam, non-manifold and off-side edges.
     info : dict
         ``units`` (the file's), ``faces`` (the file face number of each surface),
-        ``names`` (object name of each, or None), ``trimmed`` (file face numbers taken
-        untrimmed) and ``skipped`` (``{face number: why}``).
+        ``names`` (object name of each, or None), ``reversed`` (whether each is marked
+        reversed in its Brep: its outward normal is ``-(S_u × S_v)``), ``trimmed`` (file
+        face numbers taken untrimmed) and ``skipped`` (``{face number: why}``).
     """
     path = Path(path)
     listing = read_listing(path)
@@ -158,6 +159,7 @@ def body_of(path: Path, listing: dict[str, Any], chosen: list[int]
     topology = body_topology(patches, listing["edges"], kept)
     info = {"units": listing["units"], "faces": kept,
             "names": [listing["faces"][k].get("name") for k in kept],
+            "reversed": [bool(listing["faces"][k].get("reversed")) for k in kept],
             "trimmed": trimmed, "skipped": skipped}
     return surfaces, topology, info
 

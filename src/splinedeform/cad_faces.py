@@ -4,9 +4,9 @@ Every object of a ``.3dm``, STEP or IGES file that holds surfaces (a Brep, a pla
 an extrusion read as its Brep: wall and caps) and each of its faces, numbered as
 ``shape = "cad"``'s ``face`` counts them, with what decides how it can be deformed: its
 degrees and net size, its weights (``1``, a product ``a_i b_j`` or general), whether it is
-trimmed and closed or periodic in the file, its ``C^0`` knots (an interior knot repeated
-``n`` times), its degenerate edges (a row of the net that is one point, a pole) and the
-area of its untrimmed surface,
+trimmed and closed or periodic in the file, whether its Brep marks it reversed, its
+``C^0`` knots (an interior knot repeated ``n`` times), its degenerate edges (a row of the
+net that is one point, a pole) and the area of its untrimmed surface,
 
 .. math:: A = \\int\\!\\!\\int |S_u \\times S_v| \\, du\\, dv,
           \\quad S_u = (N_u - S\\, W_u) / W,
@@ -43,9 +43,10 @@ def read_faces(path: str | os.PathLike) -> dict[str, Any]:
     """``{"file", "units", "faces": [...]}``: every face of a CAD file (see the module
     docstring); one dict per face with ``face``, ``object``, ``name``, ``layer``, ``kind``,
     ``degrees``, ``net``, ``weights``, ``trimmed``, ``closed``, ``periodic``, ``c0_knots``,
-    ``degenerate``, ``area`` (of the untrimmed surface) and ``trimmed_area`` (inside the
-    face's loops, by OpenCASCADE; None for ``.3dm``), or ``error`` for a face that cannot
-    be read. Knot values are the file's parameters. ``topology`` holds the counts of
+    ``degenerate``, ``area`` (of the untrimmed surface), ``reversed`` (marked reversed in
+    its Brep: ``TopAbs_REVERSED``, ``BrepFace.OrientationIsReversed``) and
+    ``trimmed_area`` (inside the face's loops, by OpenCASCADE; None for ``.3dm``), or
+    ``error`` for a face that cannot be read. Knot values are the file's parameters. ``topology`` holds the counts of
     shared, boundary, seam, non-manifold and off-side edges of the whole file and its
     interfaces (:mod:`splinedeform.cad_topology`)."""
     from .cad_body import patches_of, read_listing
@@ -80,6 +81,7 @@ def _describe(number: int, entry: dict[str, Any]) -> dict[str, Any]:
             "periodic": [bool(c) for c in entry["periodic"]],
             "c0_knots": {d: [float(x) for x in b.c0_knots] for d, b in zip("uv", bases)},
             "degenerate": degenerate_edges(points), "area": whole,
+            "reversed": bool(entry.get("reversed")),
             "trimmed_area": None if inside is None else abs(float(inside)),
             **loops}
 
@@ -153,6 +155,10 @@ def faces_text(listing: dict[str, Any]) -> str:
              "  ".join(h.ljust(wd) for h, wd in zip(head, widths)).rstrip()]
     lines += ["  ".join(c.ljust(wd) for c, wd in zip(r, widths)).rstrip() for r in rows]
     lines += [line for f in listing["faces"] if (line := loop_names_line(f))]
+    turned = [str(f["face"]) for f in listing["faces"] if f.get("reversed")]
+    if turned:
+        lines.append(f"reversed in their Brep (outward normal -(S_u × S_v)): face(s) "
+                     f"{', '.join(turned)}")
     if "topology" in listing:
         lines.append(topology_line(listing["topology"]))
     return "\n".join(lines) + "\n"

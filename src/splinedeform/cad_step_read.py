@@ -308,8 +308,10 @@ def list_step_arrays(path: Path) -> dict[str, Any]:
 
 def faces_listing(path: Path, reader: Any, faces: list[Any], units: str | None
                   ) -> dict[str, Any]:
-    """What :func:`list_step_arrays` returns, of a file already read."""
-    from OCP.TopAbs import TopAbs_FACE
+    """What :func:`list_step_arrays` returns, of a file already read; ``reversed`` is
+    whether the face's orientation in the shape is ``TopAbs_REVERSED`` (its normal is
+    ``-(S_u × S_v)``)."""
+    from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS_Iterator
 
@@ -338,7 +340,8 @@ def faces_listing(path: Path, reader: Any, faces: list[Any], units: str | None
         owner = owners[number]
         kind = (children[owner] if owner is not None else shape).ShapeType().name
         entry: dict[str, Any] = {"object": owner, "name": None, "layer": None,
-                                 "kind": kind.split("_")[-1].lower()}
+                                 "kind": kind.split("_")[-1].lower(),
+                                 "reversed": bool(face.Orientation() == TopAbs_REVERSED)}
         source = f"{path} face {number}"
         try:
             if bad_weights:

@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .errors import InputError
+from .knots import RationalBasis
 from .quadrature import gauss_points, integrals
 from .rational import weight_field
 from .surface import Surface
@@ -308,7 +309,8 @@ def project(surface: Surface, values: Callable[[NDArray, NDArray], NDArray],
 
 @dataclass(frozen=True)
 class Pressure(Load):
-    """Pressure ``q`` along the initial normal: ``f = q x0_u × x0_v`` (exact quadrature)."""
+    """Pressure ``q`` along the initial normal: ``f = q x0_u × x0_v`` (exact quadrature of
+    polynomial directions; :data:`RATIONAL_POINTS` more points where one is rational)."""
 
     q: float
     profile: Profile = field(default_factory=Constant)
@@ -321,8 +323,11 @@ class Pressure(Load):
         def area_normal(U: NDArray, V: NDArray) -> NDArray:
             return self.q * np.cross(surface.derivative(U, V, 1, 0),
                                      surface.derivative(U, V, 0, 1))
-        # integrand degree per direction <= 3n - 1: n + 1 + ceil(n/2) points are exact
+        # integrand degree per direction <= 3n - 1: n + 1 + ceil(n/2) points are exact;
+        # a rational direction's integrand is not a polynomial: RATIONAL_POINTS more
         extra = (max(surface.basis_u.degree, surface.basis_v.degree) + 1) // 2
+        if any(isinstance(b, RationalBasis) for b in (surface.basis_u, surface.basis_v)):
+            extra = max(extra, RATIONAL_POINTS)
         return project(surface, area_normal, extra)
 
 

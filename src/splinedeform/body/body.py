@@ -45,6 +45,10 @@ class Body:
     trim_interfaces : list of TrimInterface, optional
         Trim loops of two faces that meet along one curve; found geometrically
         (:func:`~.trimmed.find_trim_interfaces`) if not given.
+    orientation : sequence of {+1, -1}, optional
+        Per patch the sign ``s`` that makes ``s x_u × x_v`` the body's normal (a CAD face
+        marked reversed in its Brep has ``-1``); a pressure pushes along it. Default
+        ``+1`` for every patch. The parametrisations are left as they are.
 
     Trimmed faces (``surface.trim``) meet along their trim curves: pairs of loops tracing
     one curve are found geometrically (:mod:`.trimmed`), :attr:`trim_interfaces`.
@@ -61,8 +65,10 @@ class Body:
 
     def __init__(self, patches: Sequence[Surface], interfaces: Sequence[Interface] | None = None,
                  tol: float | None = None,
-                 trim_interfaces: Sequence[TrimInterface] | None = None):
+                 trim_interfaces: Sequence[TrimInterface] | None = None,
+                 orientation: Sequence[int] | None = None):
         self.patches: tuple[Surface, ...] = tuple(patches)
+        self.orientation: tuple[int, ...] = _orientation(orientation, len(self.patches))
         found = without_trimmed_edges(self.patches, find_topology(self.patches, tol))
         if interfaces is None:
             self.topology = found
@@ -121,7 +127,7 @@ class Body:
             if not insert_missing_knots(patches, [
                     i for i, aligned in zip(topology.interfaces, topology.aligned)
                     if aligned and not i.conforming]):
-                return Body(patches, None, self.topology.tol)
+                return Body(patches, None, self.topology.tol, orientation=self.orientation)
         raise InputError(f"knot insertion did not make the interfaces conform in {MAX_PASSES} "
                          "rounds; refine the patches to common knots")
 
@@ -142,6 +148,17 @@ def insert_missing_knots(patches: list[Surface], interfaces: Sequence[Interface]
     for (p, direction), values in wanted.items():
         patches[p] = insert_knots_at(patches[p], direction, _distinct(values))
     return bool(wanted)
+
+
+def _orientation(signs: Sequence[int] | None, count: int) -> tuple[int, ...]:
+    """``signs`` checked as one ``+1`` or ``-1`` per patch (``+1`` each when None)."""
+    if signs is None:
+        return (1,) * count
+    out = tuple(signs)
+    if len(out) != count or any(isinstance(s, bool) or s not in (1, -1) for s in out):
+        raise InputError(f"orientation must be one sign, +1 or -1, per patch ({count}), "
+                         f"got {list(out)!r}")
+    return tuple(int(s) for s in out)
 
 
 def _given(patches: tuple[Surface, ...], interfaces: list[Interface], found: Topology

@@ -3,6 +3,10 @@
 A body's load vector is the patches' vectors, patch after patch; a load acts on every patch
 unless it is wrapped in :class:`OnPatch`. A point load names parameters ``(u, v)`` of one
 patch, so on a body it must be (``OnPatch(Point(u, v, force), patch=i)``).
+
+A pressure pushes along ``s x_u × x_v`` on each patch, ``s`` the body's
+:attr:`~splinedeform.body.Body.orientation` of that patch (:func:`along_normal`): on a
+closed Brep the outward normal of every face, also where a face is marked reversed.
 """
 
 from __future__ import annotations
@@ -13,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
-from ..loads import Load, Profile
+from ..loads import Load, Pressure, Profile
 from ..surface import Surface
 
 
@@ -56,3 +60,10 @@ class OnPatch(Load):
     def field_vector(self, surface: Surface, t: float = 0.0) -> NDArray[np.float64]:
         """The wrapped load's vector on ``surface`` (the patch it acts on)."""
         return self.load.field_vector(surface, t)
+
+
+def along_normal(term: Load) -> bool:
+    """Whether a load term pushes along its patch's normal ``x_u × x_v`` (a pressure,
+    on every patch or on one), so that a patch the body turns over takes it with the
+    opposite sign."""
+    return isinstance(term.load if isinstance(term, OnPatch) else term, Pressure)

@@ -17,7 +17,8 @@ conforming interfaces and poles and applies the edge conditions of boundary edge
 from __future__ import annotations
 
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
+from functools import partial
 from typing import Any, Mapping, Sequence
 
 import numpy as np
@@ -41,7 +42,7 @@ from ..trim.model_matrices import trimmed_system
 from .body import Body
 from .constraints import boundary_presets, build_body_constraints
 from .interface import EDGES
-from .loads import OnPatch
+from .loads import OnPatch, along_normal
 from .trimmed import edge_boundary, face_boundary, loop_presets, with_trimmed_faces
 
 Array = NDArray[np.float64]
@@ -50,21 +51,29 @@ PROBE_LIMIT = 1500
 its dense spectrum (:attr:`BodyModel.rigid_modes`): a few seconds of ``eigh``."""
 
 
+@dataclass(frozen=True)
 class BodyReduction(Reduction):
     """:class:`~splinedeform.solvers.system.Reduction` of a body: a load's vector is the
-    patches' vectors, patch after patch; :class:`.OnPatch` loads act on their patch only."""
+    patches' vectors, patch after patch; :class:`.OnPatch` loads act on their patch only.
+    ``signs`` is the body's :attr:`~.Body.orientation` (empty: ``+1`` on every patch): a
+    pressure's vector on patch ``p`` is ``signs[p] ∫ q (x_u × x_v) N_k``
+    (:func:`.loads.along_normal`)."""
+
+    signs: tuple[int, ...] = ()
 
     def field(self, term: Any, t: float = 0.0) -> Array:
         parts = []
+        turned = along_normal(term)
         for p, surface in enumerate(self.surface):
             if isinstance(term, OnPatch):
-                parts.append(term.load.field_vector(surface, t) if term.patch == p
-                             else np.zeros((surface.shape[0] * surface.shape[1], 3)))
+                part = (term.load.field_vector(surface, t) if term.patch == p
+                        else np.zeros((surface.shape[0] * surface.shape[1], 3)))
             elif isinstance(term, Point):
                 raise InputError("a point load on a body needs its patch: "
                                  "splinedeform.body.OnPatch(Point(u, v, force), patch=i)")
             else:
-                parts.append(term.field_vector(surface, t))
+                part = term.field_vector(surface, t)
+            parts.append(-part if turned and self.signs and self.signs[p] < 0 else part)
         return np.concatenate(parts)
 
 
@@ -180,8 +189,9 @@ class BodyModel(Model):
                       for p, s in enumerate(self.patches)]
         for penalty in (c for c in couplings if c is not None):
             K = (K + penalty).tocsr()
+        reduction = partial(BodyReduction, signs=body.orientation)
         self.formulation = PlateFormulation(physics, material, patches=self.patches,
-                                            reduction_type=BodyReduction,
+                                            reduction_type=reduction,
                                             unconstrained=self.constraints.unconstrained)
         self._full = (K, M)
         T = self.constraints.T

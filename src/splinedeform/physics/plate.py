@@ -16,7 +16,7 @@ are counted from the weights and the constraints (:mod:`splinedeform.spectrum`),
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 import numpy as np
 import scipy.sparse as sp
@@ -53,7 +53,7 @@ class PlateFormulation:
     material: Material
     surface: Any = None
     patches: tuple | None = None
-    reduction_type: type = Reduction
+    reduction_type: Callable[..., Reduction] = Reduction
     unconstrained: bool = False
     edges: Any = None
 

@@ -157,11 +157,12 @@ def merge_columns(Tb: sp.csr_matrix, pairs: NDArray[np.int64]
                          shape=(n, int(new.max(initial=-1)) + 1)), rest
 
 
-def body_field(patches: Sequence[Surface], term: object, t: float = 0.0) -> Array:
+def body_field(patches: Sequence[Surface], term: object, t: float = 0.0,
+               signs: tuple[int, ...] = ()) -> Array:
     """One load term's force on every patch, patch after patch, interleaved ``(3N,)``
     (:class:`~splinedeform.body.model.BodyReduction`: :class:`~splinedeform.body.OnPatch`
-    terms act on their patch only)."""
-    return np.asarray(BodyReduction(None, patches).field(term, t)).ravel()
+    terms act on their patch only, a pressure along ``signs[p] x_u × x_v``)."""
+    return np.asarray(BodyReduction(None, patches, None, tuple(signs)).field(term, t)).ravel()
 
 
 def patch_index(count: int, patch: int | None) -> int:

@@ -17,6 +17,7 @@ does work on a free rigid motion has no equilibrium and is refused, naming the m
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any, Mapping, Sequence
 
 import numpy as np
@@ -40,15 +41,19 @@ from .shell_solve import dissection_ranks, static_displacement, unknown_order
 Array = NDArray[np.float64]
 
 
+@dataclass(frozen=True)
 class ShellReduction(Reduction):
-    """Load fields of the shell on the interleaved rows of ``T``, one column ``(3N, 1)``."""
+    """Load fields of the shell on the interleaved rows of ``T``, one column ``(3N, 1)``;
+    on a body, ``signs`` is its :attr:`~splinedeform.body.Body.orientation`
+    (:func:`.shell_body.body_field`)."""
 
+    signs: tuple[int, ...] = ()
     columns = 1
 
     def field(self, term: Any, t: float = 0.0) -> Array:
         if isinstance(self.surface, Surface):
             return np.asarray(term.field_vector(self.surface, t)).reshape(-1, 1)
-        return body_field(self.surface, term, t)[:, None]
+        return body_field(self.surface, term, t, self.signs)[:, None]
 
 
 class ShellFormulation:
@@ -127,7 +132,9 @@ class ShellFormulation:
         return self.material.rayleigh
 
     def reduction(self, T: sp.spmatrix, rest: Array | None) -> ShellReduction:
-        return ShellReduction(T, self.surface if self.patches is None else self.patches, rest)
+        if self.patches is None:
+            return ShellReduction(T, self.surface, rest)
+        return ShellReduction(T, self.patches, rest, self.body.orientation)
 
     def readout(self, T: sp.spmatrix, M_r: sp.spmatrix, K_r: sp.spmatrix) -> Any:
         if self.patches is None:

@@ -45,11 +45,16 @@ class FileBody(Body):
         The file's face number of each patch.
     counts : dict
         The file's edge counts (shared, boundary, seam, non_manifold, off_sides).
+    orientation : sequence of {+1, -1}, optional
+        Per patch ``-1`` where the file's Brep marks the face reversed
+        (:attr:`~splinedeform.body.Body.orientation`: a pressure pushes along the Brep's
+        normal).
     """
 
     def __init__(self, patches: Sequence[Any], interfaces: Sequence[Any],
-                 faces: Sequence[int], counts: dict[str, int]):
-        super().__init__(patches, interfaces)
+                 faces: Sequence[int], counts: dict[str, int],
+                 orientation: Sequence[int] | None = None):
+        super().__init__(patches, interfaces, orientation=orientation)
         self.faces = tuple(int(f) for f in faces)
         self.counts = dict(counts)
 
@@ -89,12 +94,13 @@ def body_from_cad(scenario: Scenario) -> tuple[Any, int, str | None]:
         return None, chosen[0], listing["units"]
     with _located(scenario, "surface.faces"):
         surfaces, topology, info = body_of(path, listing, chosen)
+        signs = [-1 if r else 1 for r in info["reversed"]]
         if any(topology.counts.values()):
-            return (FileBody(surfaces, topology.interfaces, info["faces"], topology.counts),
-                    chosen[0], info["units"])
+            return (FileBody(surfaces, topology.interfaces, info["faces"], topology.counts,
+                             signs), chosen[0], info["units"])
         # plain surfaces, not a Brep or shell: the file has no edges, so where the faces
         # touch is found from their geometry (:func:`splinedeform.body.topology.find_topology`)
-        return FileBody(surfaces, None, info["faces"], {}), chosen[0], info["units"]
+        return FileBody(surfaces, None, info["faces"], {}, signs), chosen[0], info["units"]
 
 
 def refined_body(scenario: Scenario, body: FileBody) -> FileBody:
@@ -139,7 +145,7 @@ def refined_body(scenario: Scenario, body: FileBody) -> FileBody:
     interfaces = [replace(i, conforming=conforming(patches[i.a], i.edge_a, patches[i.b],
                                                    i.edge_b, i.reversed, tol))
                   if i.conforming else i for i in body.interfaces]
-    return FileBody(patches, interfaces, body.faces, body.counts)
+    return FileBody(patches, interfaces, body.faces, body.counts, body.orientation)
 
 
 def matched_degrees(patches: list[Any], interfaces: Sequence[Any]) -> list[Any]:

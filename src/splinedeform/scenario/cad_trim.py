@@ -193,4 +193,4 @@ def with_body_trims(scenario: Any, body: Any, caught: list[warnings.WarningMessa
         return body
     gone = {p for p, s in enumerate(patches) if edgeless(s)}
     interfaces = [i for i in body.interfaces if not {i.a, i.b} & gone]
-    return FileBody(patches, interfaces, body.faces, body.counts)
+    return FileBody(patches, interfaces, body.faces, body.counts, body.orientation)
