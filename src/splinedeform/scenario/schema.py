@@ -203,7 +203,8 @@ class PressureLoad(_OnFace):
     kind: Literal["pressure"]
     q: Real = Field(description=(
             "pressure; the force density is `q x0_u × x0_v`, so a positive `q` pushes along the "
-            "normal `x_u × x_v`"),
+            "normal `x_u × x_v` (on a body's face marked reversed in its Brep, along "
+            "`-(x_u × x_v)`: the Brep's outward normal)"),
         json_schema_extra={"doc_default": 'required for `pressure`'})
 
 
