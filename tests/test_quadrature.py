@@ -47,7 +47,9 @@ def test_gram_is_symmetric_psd_and_equals_brute_force(basis, order):
     reference = brute_force_gram(basis, order)
     scale = np.abs(reference).max()
     np.testing.assert_allclose(G, reference, atol=1e-12 * scale)
-    np.testing.assert_array_equal(G, G.T)
+    # the Gram matrix sums products b_i b_j, symmetric up to the order of the sums:
+    # round-off of a few ulps of its largest entry
+    np.testing.assert_allclose(G, G.T, rtol=0, atol=1e-14 * scale)
     assert np.linalg.eigvalsh(G).min() > -1e-12 * scale
 
 
