@@ -7,7 +7,6 @@ not), writes every requested format atomically, and writes the manifest last.
 
 from __future__ import annotations
 
-import tomllib
 from contextlib import AbstractContextManager
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
@@ -16,8 +15,6 @@ import numpy as np
 
 from .mode_outputs import animated_modes, mode_file_names, mode_frames
 from .outputs_body import body_outputs, write_body_files
-from .run_report import solution_timings, add_energies_and_probes, mode_table, solver_section
-from .scenario import scenario_to_toml
 from .scenario.body import is_body
 
 if TYPE_CHECKING:
@@ -326,33 +323,23 @@ def make_report(result: RunResult) -> dict[str, Any]:
         from .outputs_body import body_report
 
         return body_report(result)
-    s, surface = result.scenario, result.built.surface
-    report: dict[str, Any] = {
-        "inputs": {"source": s.source, **tomllib.loads(scenario_to_toml(s))},
-        "surface": {"shape": s.surface.shape, "net": f"{surface.shape[0]} x {surface.shape[1]}",
-                    "degree": [surface.basis_u.degree, surface.basis_v.degree],
-                    "knots": [surface.basis_u.kind, surface.basis_v.kind],
-                    "domain": [list(d) for d in surface.domain],
-                    "units": result.built.units or "none",
-                    "fit_error": surface.fit_error,
-                    _unknowns(result.built.model): result.n_free},
-        "solver": solver_section(result),
-        "timings": {**solution_timings(result), **result.timings},
-    }
-    from .export.shell_fields import is_shell, mode_maxima, stress_report
+    from .export.shell_fields import mode_maxima, stress_report
+    from .run_report import assemble_report
 
-    shell = is_shell(result.built.model)
-    if result.omegas is not None:
-        report["modes"] = mode_table(result.omegas)
-        if shell and result.shell_modes is not None:
-            report["modes"].update(mode_maxima(result.built.model, result.shell_modes,
-                                               s.output.resolution))
-    frame_label = add_energies_and_probes(report, result)
-    if shell:
-        report.update(stress_report(result.built.model, result.rest_net, result.times,
-                                    result.nets, s.output.resolution, result.probe_points,
-                                    frame_label))
-    return report
+    surface = result.built.surface
+    geometry = {"shape": result.scenario.surface.shape,
+                "net": f"{surface.shape[0]} x {surface.shape[1]}",
+                "degree": [surface.basis_u.degree, surface.basis_v.degree],
+                "knots": [surface.basis_u.kind, surface.basis_v.kind],
+                "domain": [list(d) for d in surface.domain],
+                "units": result.built.units or "none",
+                "fit_error": surface.fit_error,
+                _unknowns(result.built.model): result.n_free}
+    return assemble_report(
+        result, "surface", geometry, mode_maxima,
+        lambda label: stress_report(result.built.model, result.rest_net, result.times,
+                                    result.nets, result.scenario.output.resolution,
+                                    result.probe_points, label))
 
 
 def summary_rows(result: RunResult) -> list[tuple[str, str]]:

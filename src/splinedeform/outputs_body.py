@@ -21,7 +21,6 @@
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -195,32 +194,19 @@ def _warp(result: RunResult) -> float:
 def body_report(result: RunResult) -> dict[str, Any]:
     """The content of ``report.json`` / ``report.md`` of a body: inputs, the body (unit,
     faces, topology counts, nets), solver, timings, energies, modes and the faces' centres."""
-    from .run_report import solution_timings, add_energies_and_probes, mode_table, solver_section
-    from .scenario import scenario_to_toml
+    from .run_report import assemble_report
 
     s, body = result.scenario, result.built.surface
     faces = list(getattr(body, "faces", range(len(body))))
-    report: dict[str, Any] = {
-        "inputs": {"source": s.source, **tomllib.loads(scenario_to_toml(s))},
-        "body": {"shape": s.surface.shape, "units": result.built.units or "none",
-                 "faces": faces, "patches": len(body),
-                 "topology": getattr(body, "counts", None) or body.summary(),
-                 "interfaces": len(body.interfaces),
-                 "nets": [f"{p.shape[0]} x {p.shape[1]}" for p in body],
-                 "degrees": [[p.basis_u.degree, p.basis_v.degree] for p in body],
-                 "free control points": result.n_free},
-        "solver": solver_section(result),
-        "timings": {**solution_timings(result), **result.timings},
-    }
-    shell = is_shell(result.built.model)
-    if result.omegas is not None:
-        report["modes"] = mode_table(result.omegas)
-        if shell and result.shell_modes is not None:
-            report["modes"].update(body_mode_maxima(result.built.model, result.shell_modes,
-                                                    s.output.resolution))
-    label = add_energies_and_probes(report, result)
-    if shell:
-        report.update(body_stress_report(result.built.model, faces, result.rest_net,
+    geometry = {"shape": s.surface.shape, "units": result.built.units or "none",
+                "faces": faces, "patches": len(body),
+                "topology": getattr(body, "counts", None) or body.summary(),
+                "interfaces": len(body.interfaces),
+                "nets": [f"{p.shape[0]} x {p.shape[1]}" for p in body],
+                "degrees": [[p.basis_u.degree, p.basis_v.degree] for p in body],
+                "free control points": result.n_free}
+    return assemble_report(
+        result, "body", geometry, body_mode_maxima,
+        lambda label: body_stress_report(result.built.model, faces, result.rest_net,
                                          result.times, result.nets, s.output.resolution,
                                          result.probe_points, result.probe_patches, label))
-    return report

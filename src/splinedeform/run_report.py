@@ -3,7 +3,7 @@ make_report`) and a body (:func:`splinedeform.outputs_body.body_report`)."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
@@ -43,3 +43,34 @@ def add_energies_and_probes(report: dict[str, Any], result: RunResult) -> str:
 def solution_timings(result: RunResult) -> dict[str, float]:
     timings = getattr(result.solution, "timings", None) or {}
     return {f"solver: {k}": float(v) for k, v in timings.items()}
+
+
+def assemble_report(result: RunResult, name: str, geometry: dict[str, Any],
+                    maxima: Callable[[Any, Any, int], dict[str, Any]],
+                    stresses: Callable[[str], dict[str, Any]]) -> dict[str, Any]:
+    """``report.json``'s content: the inputs, ``name`` (the surface's or the body's
+    ``geometry``), solver, timings, modes, energies and probes; for a shell also each
+    mode's largest von Mises, ``maxima(model, shell_modes, resolution)``, and the stresses,
+    ``stresses(frame_label)``."""
+    import tomllib
+
+    from .export.shell_fields import is_shell
+    from .scenario import scenario_to_toml
+
+    s = result.scenario
+    report: dict[str, Any] = {
+        "inputs": {"source": s.source, **tomllib.loads(scenario_to_toml(s))},
+        name: geometry,
+        "solver": solver_section(result),
+        "timings": {**solution_timings(result), **result.timings},
+    }
+    shell = is_shell(result.built.model)
+    if result.omegas is not None:
+        report["modes"] = mode_table(result.omegas)
+        if shell and result.shell_modes is not None:
+            report["modes"].update(maxima(result.built.model, result.shell_modes,
+                                          s.output.resolution))
+    label = add_energies_and_probes(report, result)
+    if shell:
+        report.update(stresses(label))
+    return report
