@@ -1,7 +1,7 @@
 """Outputs of a body: every patch's deformed net in one file.
 
-* ``.3dm``: one NURBS surface per patch, named, in the body's unit
-  (:func:`splinedeform.cad.write_3dm`);
+* ``.3dm``: one Brep, a face per patch, its edges joined where the patches meet, in the
+  body's unit (:func:`splinedeform.cad.write_3dm`, :mod:`splinedeform.cad_brep_3dm`);
 * STEP / IGES: one B-spline face per patch in one file, sewn into a shell where the
   patches meet (:func:`splinedeform.cad_step.write_step`);
 * a welded mesh (``.vtu``, ``.vtk``, ``.obj``, ``.stl``, ``.ply``): each patch sampled on
@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 from pathlib import Path
 
 import numpy as np
@@ -56,13 +57,24 @@ def body_patches(surfaces: Sequence[Surface], nets: Sequence[ArrayLike],
 
 def write_body_3dm(path: str | os.PathLike, surfaces: Sequence[Surface],
                    nets: Sequence[ArrayLike], names: Sequence[str] | None = None,
-                   units: str | None = None) -> Path:
-    """Every patch with its net as a named NURBS surface of one ``.3dm`` file, in
-    ``units`` (the file's ``ModelUnitSystem``); names default to the surfaces' names."""
+                   units: str | None = None, body: Any = None, name: str = "body") -> Path:
+    """Every patch with its net as a face of one Brep named ``name`` in a ``.3dm`` file,
+    its edges joined where the patches meet, in ``units`` (the file's
+    ``ModelUnitSystem``); the faces' names (default: the surfaces') are the Brep's user
+    strings ``splinedeform.face k``. The topology is ``body``'s (a
+    :class:`~splinedeform.body.Body` of ``surfaces``), found from the surfaces when not
+    given; where no Brep can be formed, one named NURBS surface per patch, with a warning
+    (:func:`splinedeform.cad.write_3dm`)."""
+    from ..body import Body
     from ..cad import write_3dm
+    from ..cad_brep_3dm import BrepTopology
 
     names = [s.name for s in surfaces] if names is None else list(names)
-    return write_3dm(path, body_patches(surfaces, nets, units), names=names, units=units)
+    patches = body_patches(surfaces, nets, units)
+    topology = BrepTopology.of(Body(surfaces) if body is None else body, name)
+    trims = [getattr(s, "trim", None) for s in surfaces]
+    return write_3dm(path, patches, names=names, units=units, body=topology,
+                     trims=trims if any(t is not None for t in trims) else None)
 
 
 def write_body_step(path: str | os.PathLike, surfaces: Sequence[Surface],
