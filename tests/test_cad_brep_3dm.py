@@ -224,6 +224,30 @@ def test_a_trimmed_face_keeps_its_loops(tmp_path):
     assert abs(area - domain.outer.signed_area) <= 1e-9
 
 
+def test_two_trimmed_faces_meeting_along_a_circle_share_one_edge(tmp_path):
+    """The unit square as a disc face and a face of the square less the disc (two
+    trimmed patches of different cells): the disc's loop and the ring's hole are one
+    closed edge, run opposite ways (both faces keep their normals), and only the square's
+    four sides are naked, as the body's boundary says."""
+    circle = CircleLoop((0.5, 0.5), 0.3)
+    square = PolygonLoop([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    disc = sd.shapes.plane(cells=(3, 3), degree=3, knots="open")
+    ring = sd.shapes.plane(cells=(4, 4), degree=3, knots="open")
+    body = sd.Body([disc.with_trim(TrimDomain(circle)),
+                    ring.with_trim(TrimDomain(square, (circle,)))])
+    assert len(body.trim_interfaces) == 1 and body.summary()["boundary"] == 4
+    brep, _, _ = only_brep(write_body_3dm(tmp_path / "split.3dm", list(body),
+                                          [s.control_points for s in body], body=body))
+    assert_clean(brep)
+    counts = trims_per_edge(brep)
+    assert len(brep.Faces) == 2 and counts.count(1) == 4 and counts.count(2) == 1
+    (disc_trim,) = list(brep.Faces[0].OuterLoop.Trims)
+    (hole,) = [lp for lp in brep.Faces[1].Loops if str(lp.LoopType).endswith("Inner")]
+    (hole_trim,) = list(hole.Trims)
+    assert disc_trim.EdgeIndex == hole_trim.EdgeIndex
+    assert disc_trim.IsReversed != hole_trim.IsReversed
+
+
 def test_a_brep_that_cannot_be_formed_falls_back_to_one_surface_per_face(tmp_path):
     """An interface that joins a plate's side u0 to its own side v0 makes the corner
     (0, 0) both ends of one open edge: openNURBS refuses it, and the file holds the

@@ -41,14 +41,18 @@ def box(tmp_path_factory):
 
 
 def test_3dm_holds_every_face_in_the_file_unit(box, tmp_path):
+    from splinedeform.cad import FACE_NAME
+
     surfaces, _, nets, units = box
     path = write_body_3dm(tmp_path / "body.3dm", surfaces, nets, units=units)
     model = r3.File3dm.Read(str(path))
     assert str(model.Settings.ModelUnitSystem).endswith("Inches")
-    objects = list(model.Objects)
-    assert [o.Attributes.Name for o in objects] == [s.name for s in surfaces]
-    for obj, P in zip(objects, nets):
-        srf = obj.Geometry
+    (obj,) = list(model.Objects)                       # one Brep, its faces named
+    assert isinstance(obj.Geometry, r3.Brep) and obj.Geometry.IsValid
+    assert [obj.Attributes.GetUserString(f"{FACE_NAME}{k}") for k in range(6)] == \
+        [s.name for s in surfaces]
+    for face, P in zip(obj.Geometry.Faces, nets):
+        srf = face.UnderlyingSurface().ToNurbsSurface()
         got = np.array([[[srf.Points[i, j].X, srf.Points[i, j].Y, srf.Points[i, j].Z]
                           for j in range(srf.Points.CountV)] for i in range(srf.Points.CountU)])
         # weights 1: the numbers written, read back as doubles (1e-12 of the size for the

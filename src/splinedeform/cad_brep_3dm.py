@@ -31,16 +31,17 @@ seam of its face (``u0`` with ``u1``).
 from __future__ import annotations
 
 from collections.abc import Sequence
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from .body.interface import Interface
+from .body.interface import Interface, TrimInterface
 from .cad import NurbsPatch
 from .cad_on_archive import BrepRecord, Nurbs, brep_bytes, decode
-from .errors import InputError
+from .errors import InputError, InputWarning
 from .knots import KnotVectorBasis
 
 Array = NDArray[np.float64]
@@ -152,14 +153,24 @@ def corner_point(patch: NurbsPatch, corner: tuple[int, int]) -> Array:
 
 def body_record(patches: Sequence[NurbsPatch], interfaces: Sequence[Interface],
                 poles: Sequence[Side], orientation: Sequence[int],
-                trims: Sequence[Any] | None = None) -> BrepRecord:
+                trims: Sequence[Any] | None = None, holed: Sequence[int] = (),
+                trim_interfaces: Sequence[TrimInterface] = ()) -> BrepRecord:
     """The Brep of a body (module docstring); ``trims`` (one per patch, None where
-    untrimmed) are the faces' trim loops (:func:`splinedeform.cad_brep_trims.trim_loops`)."""
+    untrimmed) are the faces' trim domains (:mod:`splinedeform.cad_brep_trims`), those of
+    the faces ``holed`` their rectangle less holes (its sides the outer loop, joined by
+    the interfaces); two loops of a trim interface, each one trim, are one closed edge."""
+    from .cad_brep_trims import add_trim_loops
+
     trims = list(trims) if trims is not None else [None] * len(patches)
     if len(trims) != len(patches) or len(orientation) != len(patches):
         raise BrepError(f"{len(patches)} faces need as many orientations and trims, got "
                         f"{len(orientation)} and {len(trims)}")
-    whole = [t is None for t in trims]
+    whole = [t is None or p in holed for p, t in enumerate(trims)]
+    pairs = {}
+    for i in trim_interfaces:
+        (a, la), (b, lb) = sorted([(i.a, i.loop_a), (i.b, i.loop_b)])
+        pairs[(b, lb)] = (a, la)
+    built: dict[tuple[int, int], dict[str, Any]] = {}
     pole_set = {(p, e) for p, e in poles if whole[p]}
     sides = _Union()
     corners = _Union()
@@ -194,11 +205,20 @@ def body_record(patches: Sequence[NurbsPatch], interfaces: Sequence[Interface],
         record.faces.append({"li": [li], "si": p, "rev": orientation[p] == -1})
         loop_trims: list[int] = []
         record.loops.append({"ti": loop_trims, "type": OUTER, "fi": p})
-        if not whole[p]:
-            from .cad_brep_trims import add_trim_loops
-
-            add_trim_loops(record, patch, trims[p], p)
-            continue
+        if trims[p] is not None:
+            joins = {lb: built[key] for (q, lb), key in pairs.items()
+                     if q == p and key in built}
+            single = add_trim_loops(record, patch, trims[p], p, whole[p], joins)
+            built.update({(p, k): v for k, v in single.items()})
+            unjoined = [f"face {q} loop {k}" for (q, k), key in pairs.items()
+                        if q == p and (key not in built
+                                       or len(record.edges[built[key]["ei"]]["ti"]) < 2)]
+            if unjoined:
+                warnings.warn(f"{', '.join(unjoined)} of the body's .3dm Brep are naked "
+                              "edges, not joined to the trim loop they meet: a loop of "
+                              "several trims", InputWarning, stacklevel=3)
+            if not whole[p]:
+                continue
         for side in LOOP_SIDES:
             start, end = (vertex(p, c) for c in CORNERS[side])
             against = AGAINST[side]
@@ -273,15 +293,23 @@ class BrepTopology:
     poles: tuple[Side, ...] = ()
     orientation: tuple[int, ...] | None = None
     name: str = "body"
+    #: trimmed faces whose outer loop is their rectangle (its sides joined as untrimmed)
+    holed: tuple[int, ...] = ()
+    trim_interfaces: tuple[TrimInterface, ...] = ()
 
     @classmethod
     def of(cls, body: Any, name: str = "body") -> BrepTopology:
-        """The topology of a :class:`~splinedeform.body.Body` (its interfaces and poles,
-        and the seam of every periodic direction of a patch)."""
+        """The topology of a :class:`~splinedeform.body.Body` (its interfaces, poles and
+        trim interfaces, the seam of every periodic direction of a patch, and which of
+        its trimmed faces are rectangles with holes)."""
+        from .trim.surface_trim import holed_rectangle
+
         periodic = [tuple(bool(getattr(b, "periodic", False)) for b in (s.basis_u, s.basis_v))
                     for s in body.patches]
+        holed = tuple(p for p, s in enumerate(body.patches) if holed_rectangle(s))
         return cls(tuple(body.interfaces) + tuple(seam_interfaces(periodic)),
-                   tuple(body.topology.poles), tuple(body.orientation), name)
+                   tuple(body.topology.poles), tuple(body.orientation), name, holed,
+                   tuple(getattr(body, "trim_interfaces", ())))
 
 
 def seam_interfaces(periodic: Sequence[tuple[bool, ...]]) -> list[Interface]:
@@ -299,7 +327,8 @@ def body_brep(patches: Sequence[NurbsPatch], body: BrepTopology, r3: Any,
     """The body as a rhino3dm ``Brep`` (:func:`body_record`, written in the archive form
     and decoded); a :class:`BrepError` naming what openNURBS found where it is not valid."""
     orientation = body.orientation or (1,) * len(patches)
-    record = body_record(patches, body.interfaces, body.poles, orientation, trims)
+    record = body_record(patches, body.interfaces, body.poles, orientation, trims,
+                         body.holed, body.trim_interfaces)
     brep = decode(brep_bytes(record), r3)
     if brep is None:
         raise BrepError("openNURBS could not read the Brep written for the body")

@@ -232,14 +232,22 @@ def _edge_gap(edge: Nurbs, pieces: Array, weights: Array, patch: NurbsPatch,
     return worst
 
 
-def add_trim_loops(record: BrepRecord, patch: NurbsPatch, domain: TrimDomain,
-                   face: int) -> None:
-    """Append the loops of ``domain`` (the outer one into the face's last loop, already
-    in ``record``; inner loops after it) with their trims, edges and vertices."""
+def add_trim_loops(record: BrepRecord, patch: NurbsPatch, domain: TrimDomain, face: int,
+                   holes_only: bool = False, joins: dict[int, dict[str, Any]] | None = None
+                   ) -> dict[int, dict[str, Any]]:
+    """Append the loops of ``domain`` (the outer one into the face's last loop, already in
+    ``record``, unless ``holes_only``: its rectangle's sides are that loop; inner loops
+    after it) with their trims, edges and vertices. A loop in ``joins`` (made of one trim)
+    runs along the edge given there (:func:`join_edge`) instead of an edge of its own.
+    Returns, per loop made of one trim, its edge and vertex (what a join needs)."""
     bu, bv = _bases(patch)
     box = np.array([*bu.domain, *bv.domain])
     outer = len(record.loops) - 1
+    joins = joins or {}
+    single: dict[int, dict[str, Any]] = {}
     for k, (pieces, weights) in enumerate(loop_pieces(domain)):
+        if holes_only and k == 0:
+            continue
         if k == 0:
             li = outer
         else:
@@ -249,9 +257,12 @@ def add_trim_loops(record: BrepRecord, patch: NurbsPatch, domain: TrimDomain,
         labels = domain.edges[k] if k < len(domain.edges) and domain.edges[k] else \
             (0,) * len(pieces)
         runs = [0] + [s for s in range(1, len(pieces)) if labels[s] != labels[s - 1]]
+        if k in joins and len(runs) == 1:
+            join_edge(record, patch, pieces, weights, li, box, joins[k])
+            continue
         ends = runs + [len(pieces)]
         first = start = _vertex(record, patch, pieces[0, 0])
-        for r, (a, b) in enumerate(zip(ends[:-1], ends[1:])):
+        for a, b in zip(ends[:-1], ends[1:]):
             end = first if b == len(pieces) else _vertex(record, patch, pieces[b, 0])
             edge, gap = trim_edge(pieces[a:b], weights[a:b], patch, float(a))
             ei, ti = len(record.edges), len(record.trims)
@@ -270,6 +281,89 @@ def add_trim_loops(record: BrepRecord, patch: NurbsPatch, domain: TrimDomain,
                                  "iso": iso_flag(curve.points, box)})
             record.loops[li]["ti"].append(ti)
             start = end
+        if len(runs) == 1:
+            single[k] = {"ei": len(record.edges) - 1, "vertex": first}
+    return single
+
+
+def _image(pieces: Array, weights: Array, patch: NurbsPatch, tau: Array) -> Array:
+    """``S(c_s(τ))`` of every piece at ``tau``, shape ``(K, len(tau), 3)``."""
+    B = bernstein(pieces.shape[1] - 1, tau)
+    out = []
+    for b, w in zip(pieces, weights):
+        Bw = B * w
+        uv = (Bw @ b) / Bw.sum(axis=1)[:, None]
+        out.append(np.array([patch.evaluate(np.array([u]), np.array([v]))[0, 0]
+                             for u, v in uv]))
+    return np.array(out)
+
+
+def split_piece(b: Array, w: Array, tau: float) -> tuple[tuple[Array, Array], ...]:
+    """The two halves ``[0, τ]``, ``[τ, 1]`` of a rational Bézier piece (de Casteljau on
+    ``(ω b, ω)``), each as points and weights."""
+    Q = np.concatenate([b * w[:, None], w[:, None]], axis=1)
+    left, right = [Q[0]], [Q[-1]]
+    while len(Q) > 1:
+        Q = (1 - tau) * Q[:-1] + tau * Q[1:]
+        left.append(Q[0])
+        right.append(Q[-1])
+    halves = (np.array(left), np.array(right[::-1]))
+    return tuple((h[:, :2] / h[:, 2:], h[:, 2]) for h in halves)
+
+
+def rotate_to(pieces: Array, weights: Array, patch: NurbsPatch, point: Array
+              ) -> tuple[Array, Array]:
+    """The same closed loop starting where its image ``S(c)`` is nearest ``point``: the
+    nearest of 65 samples per piece, refined by ternary search on ``τ`` (to round-off),
+    the piece there split in two."""
+    tau = np.linspace(0.0, 1.0, 65)
+    gap = np.linalg.norm(_image(pieces, weights, patch, tau) - point, axis=-1)
+    s, j = np.unravel_index(np.argmin(gap), gap.shape)
+    lo, hi = max(tau[j] - 1 / 64, 0.0), min(tau[j] + 1 / 64, 1.0)
+    far = lambda t: float(np.linalg.norm(  # noqa: E731
+        _image(pieces[s:s + 1], weights[s:s + 1], patch, np.array([t]))[0, 0] - point))
+    for _ in range(60):
+        m1, m2 = lo + (hi - lo) / 3, hi - (hi - lo) / 3
+        lo, hi = (lo, m2) if far(m1) < far(m2) else (m1, hi)
+    t = 0.5 * (lo + hi)
+    order = list(range(s, len(pieces))) + list(range(s))
+    if t <= 1e-12 or t >= 1 - 1e-12:
+        if t >= 1 - 1e-12:
+            order = order[1:] + order[:1]
+        return pieces[order], weights[order]
+    (pl, wl), (pr, wr) = split_piece(pieces[s], weights[s], t)
+    rest = order[1:]
+    return (np.concatenate([pr[None], pieces[rest], pl[None]]),
+            np.concatenate([wr[None], weights[rest], wl[None]]))
+
+
+def join_edge(record: BrepRecord, patch: NurbsPatch, pieces: Array, weights: Array,
+              li: int, box: Array, join: dict[str, Any]) -> None:
+    """One closed trim of loop ``li`` along the closed edge ``join["ei"]`` that another
+    face's loop made: the loop rotated to start at the edge's vertex, ``m_bRev3d`` where
+    it runs the other way round in space, the edge's tolerance raised to the largest
+    distance of this loop's image from the edge curve."""
+    from .cad_brep_3dm import DENSE, curve_domain, curve_points, polyline_distance
+
+    edge = record.edges[join["ei"]]
+    own = record.curves_3d[edge["c3i"]]
+    vertex = join["vertex"]
+    pieces, weights = rotate_to(pieces, weights, patch, record.vertices[vertex]["point"])
+    t0, t1 = curve_domain(own)
+    dense = curve_points(own, np.linspace(t0, t1, DENSE))
+    image = _image(pieces, weights, patch, np.linspace(0.0, 1.0, 9)).reshape(-1, 3)
+    edge["tolerance"] = max(edge["tolerance"], float(polyline_distance(image, dense).max()))
+    quarter = image[len(image) // 4]                # a quarter way round this loop
+    along = np.argmin(np.linalg.norm(dense - quarter, axis=1)) / (DENSE - 1)
+    curve = _joined(pieces, weights)
+    K = float(len(pieces))
+    ti = len(record.trims)
+    record.curves_2d.append(curve)
+    record.trims.append({"c2i": len(record.curves_2d) - 1, "ei": join["ei"],
+                         "domain": (0.0, K), "vi": (vertex, vertex), "rev3d": along > 0.5,
+                         "type": BOUNDARY, "li": li, "iso": iso_flag(curve.points, box)})
+    edge["ti"].append(ti)
+    record.loops[li]["ti"].append(ti)
 
 
 def _vertex(record: BrepRecord, patch: NurbsPatch, uv: Array) -> int:
