@@ -181,10 +181,9 @@ def test_an_open_body_has_as_many_naked_edges_as_its_boundary(tmp_path):
 
 def loop_points(pieces: np.ndarray, count: int = 9) -> np.ndarray:
     """Points of Bézier pieces ``(K, n + 1, 2)`` at ``count`` parameters each."""
-    from splinedeform.trim.bezier import bernstein
+    from splinedeform.trim.bezier import evaluate
 
-    B = bernstein(pieces.shape[1] - 1, np.linspace(0.0, 1.0, count))
-    return np.einsum("ta,kac->ktc", B, pieces).reshape(-1, 2)
+    return evaluate(pieces, np.linspace(0.0, 1.0, count)).reshape(-1, 2)
 
 
 def test_a_trimmed_face_keeps_its_loops(tmp_path):
@@ -222,6 +221,19 @@ def test_a_trimmed_face_keeps_its_loops(tmp_path):
                         - np.roll(outer[:, 0], -1) * outer[:, 1])
     # a polygon read back as straight pieces: its shoelace area exact to round-off 1e-12
     assert abs(area - domain.outer.signed_area) <= 1e-9
+
+
+def test_iso_trims_carry_the_flags_openNURBS_computes(tmp_path):
+    """openNURBS' validity check recomputes every trim's iso flag from its 2-D curve
+    (``ON_Surface::IsIsoparametric``): a polygon loop with sides on the domain's edges
+    (S, E), inside it (x, y) and slanted (none), each of its sides one trim, is valid."""
+    plane = sd.shapes.plane(size=(1.0, 1.0), cells=(3, 3), degree=2, knots="open")
+    polygon = PolygonLoop([[0.0, 0.0], [1.0, 0.0], [1.0, 0.6], [0.5, 0.6], [0.5, 0.9],
+                           [0.1, 0.8]])
+    domain = TrimDomain(polygon, edges=((0, 1, 2, 3, 4, 5),))
+    brep = body_brep([patch_from_surface(plane)], BrepTopology(()), r3, [domain])
+    assert_clean(brep)
+    assert len(list(brep.Faces[0].OuterLoop.Trims)) == 6 and len(brep.Vertices) == 6
 
 
 def test_two_trimmed_faces_meeting_along_a_circle_share_one_edge(tmp_path):

@@ -234,8 +234,10 @@ def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch],
     ``names`` label the objects (openNURBS object names), one per patch. ``units`` (a key
     of :data:`splinedeform.cad_units.UNITS`; default: the first patch's) is the file's
     ``ModelUnitSystem``; ``None`` when not known (openNURBS ``UnitSystem.None``).
-    ``trims`` (one per patch, None for an untrimmed one) are written beside their surface
-    as curves in its ``(u, v)`` (:func:`splinedeform.cad_trims_3dm.add_trim_curves`).
+    A patch with a trim (``trims``: one per patch, None for an untrimmed one) is a
+    one-face Brep with those loops (:mod:`splinedeform.cad_brep_trims`); where openNURBS
+    refuses it, its surface with the loops beside it as curves in its ``(u, v)``
+    (:func:`splinedeform.cad_trims_3dm.add_trim_curves`), and a warning.
 
     With ``body`` (the patches' topology) the patches are one Brep object instead, its
     edges joined where the faces meet (:func:`splinedeform.cad_brep_3dm.body_brep`),
@@ -269,11 +271,14 @@ def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch],
         attributes = r3.ObjectAttributes()
         if names is not None:
             attributes.Name = names[index]
+        trim = trims[index] if trims is not None else None
+        if trim is not None and _add_trimmed_face(model, r3, patch, trim, attributes):
+            continue
         model.Objects.AddSurface(srf, attributes)
-        if trims is not None and trims[index] is not None:
+        if trim is not None:
             from .cad_trims_3dm import add_trim_curves
 
-            add_trim_curves(model, r3, trims[index], len(model.Objects) - 1,
+            add_trim_curves(model, r3, trim, len(model.Objects) - 1,
                             names[index] if names is not None else f"surface {index}")
     with atomic_path(path) as tmp:
         if not model.Write(str(tmp), 7):
@@ -297,6 +302,23 @@ def add_body_brep(model: Any, r3: Any, patches: list[NurbsPatch], names: list[st
     attributes.Name = body.name
     for k, name in enumerate(names or []):
         attributes.SetUserString(f"{FACE_NAME}{k}", name)
+    model.Objects.AddBrep(brep, attributes)
+    return True
+
+
+def _add_trimmed_face(model: Any, r3: Any, patch: NurbsPatch, trim: TrimDomain,
+                      attributes: Any) -> bool:
+    """Add ``patch`` trimmed by ``trim`` to ``model`` as a one-face Brep; False, with a
+    one-line warning naming the reason, where openNURBS refuses it."""
+    from .cad_brep_3dm import BrepError, BrepTopology, body_brep
+
+    try:
+        brep = body_brep([patch], BrepTopology(()), r3, [trim])
+    except BrepError as exc:
+        warnings.warn(f"{attributes.Name or 'a trimmed surface'} is written with its trim "
+                      f"loops as curves beside it, not as a trimmed Brep face: {exc}",
+                      InputWarning, stacklevel=3)
+        return False
     model.Objects.AddBrep(brep, attributes)
     return True
 

@@ -155,10 +155,10 @@ def iso_flag(points: Array, box: Array) -> int:
         return (c - dt_ < x0 if strict else c - dt_ <= x0) and x1 <= c + dt_
 
     if ds * (t1 - t0) <= dt * (s1 - s0):
-        k, span, lo_k, hi_k, a, b, tol, strict = 0, dt, lo[0], hi[0], s0, s1, stol, False
+        span, lo_k, hi_k, a, b, tol, strict = dt, lo[0], hi[0], s0, s1, stol, False
         flags = (3, 5, 1)
     else:
-        k, span, lo_k, hi_k, a, b, tol, strict = 1, ds, lo[1], hi[1], t0, t1, ttol, True
+        span, lo_k, hi_k, a, b, tol, strict = ds, lo[1], hi[1], t0, t1, ttol, True
         flags = (4, 6, 2)
     iso = 0
     if hi_k <= a + tol and within(a, b, a, lo_k, hi_k, strict):
