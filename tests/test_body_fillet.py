@@ -126,6 +126,7 @@ def test_a_filleted_box_deforms_as_one_body_and_its_step_file_stays_closed(
     # its 48 edges each used by two faces, as many naked edges as the source (none), solid
     r3 = pytest.importorskip("rhino3dm", reason="the 'cad' extra (rhino3dm) is not installed")
     from splinedeform.export.body import write_body_3dm
+    from test_cad_brep_3dm import trims_per_edge
 
     oriented = sd.Body(patches, body.interfaces,           # the file's outward normals
                        orientation=[-1 if r else 1 for r in info["reversed"]])
@@ -134,12 +135,7 @@ def test_a_filleted_box_deforms_as_one_body_and_its_step_file_stays_closed(
     (obj,) = list(model.Objects)
     brep = obj.Geometry
     assert brep.IsValid and len(brep.Faces) == 26 and len(brep.Edges) == 48
-    uses = [0] * len(brep.Edges)
-    for face in brep.Faces:
-        for loop in face.Loops:
-            for trim in loop.Trims:
-                if trim.EdgeIndex >= 0:
-                    uses[trim.EdgeIndex] += 1
+    uses = trims_per_edge(brep)
     assert uses.count(1) == free_edges(filleted_box) and set(uses) == {2}
     assert brep.IsSolid
 

@@ -145,10 +145,17 @@ class _Union:
             self.parent[rb] = (ra, fa ^ fb ^ flip)
 
 
+def surface_points(patch: NurbsPatch, uv: Array) -> Array:
+    """``S(u_k, v_k)`` at the points ``uv`` ``(m, 2)``: ``(B_u H B_vᵀ)`` row by row."""
+    bu, bv = _bases(patch)
+    uv = np.asarray(uv, dtype=float).reshape(-1, 2)
+    h = np.einsum("mi,ijc,mj->mc", bu(uv[:, 0]), homogeneous(patch), bv(uv[:, 1]))
+    return h[:, :3] / h[:, 3:]
+
+
 def corner_point(patch: NurbsPatch, corner: tuple[int, int]) -> Array:
     bu, bv = _bases(patch)
-    u, v = bu.domain[corner[0]], bv.domain[corner[1]]
-    return patch.evaluate(np.array([u]), np.array([v]))[0, 0]
+    return surface_points(patch, np.array([[bu.domain[corner[0]], bv.domain[corner[1]]]]))[0]
 
 
 def body_record(patches: Sequence[NurbsPatch], interfaces: Sequence[Interface],

@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .cad import NurbsPatch
-from .cad_brep_3dm import BOUNDARY, INNER, BrepRecord, _bases, homogeneous
+from .cad_brep_3dm import BOUNDARY, INNER, BrepRecord, _bases, homogeneous, surface_points
 from .cad_on_archive import Nurbs
 from .trim.bezier import bernstein, bernstein_to_power, lobatto
 from .trim.loops import CircleLoop, TrimDomain
@@ -219,17 +219,13 @@ def trim_edge(pieces: Array, weights: Array, patch: NurbsPatch, t0: float
 
 def _edge_gap(edge: Nurbs, pieces: Array, weights: Array, patch: NurbsPatch,
               t0: float) -> float:
+    """The largest distance of ``edge`` from ``S(c(t))`` at 7 points inside each piece."""
     from .cad_brep_3dm import curve_points
 
     tau = (np.arange(7) + 0.5) / 7
-    worst = 0.0
-    for s, (b, w) in enumerate(zip(pieces, weights)):
-        Bm = bernstein(len(w) - 1, tau) * w
-        uv = (Bm @ b) / Bm.sum(axis=1)[:, None]
-        want = np.array([patch.evaluate(np.array([u]), np.array([v]))[0, 0] for u, v in uv])
-        worst = max(worst, float(np.linalg.norm(curve_points(edge, t0 + s + tau) - want,
-                                                axis=1).max()))
-    return worst
+    want = _image(pieces, weights, patch, tau).reshape(-1, 3)
+    t = (t0 + np.arange(len(pieces))[:, None] + tau[None]).ravel()
+    return float(np.linalg.norm(curve_points(edge, t) - want, axis=1).max())
 
 
 def add_trim_loops(record: BrepRecord, patch: NurbsPatch, domain: TrimDomain, face: int,
@@ -288,14 +284,9 @@ def add_trim_loops(record: BrepRecord, patch: NurbsPatch, domain: TrimDomain, fa
 
 def _image(pieces: Array, weights: Array, patch: NurbsPatch, tau: Array) -> Array:
     """``S(c_s(τ))`` of every piece at ``tau``, shape ``(K, len(tau), 3)``."""
-    B = bernstein(pieces.shape[1] - 1, tau)
-    out = []
-    for b, w in zip(pieces, weights):
-        Bw = B * w
-        uv = (Bw @ b) / Bw.sum(axis=1)[:, None]
-        out.append(np.array([patch.evaluate(np.array([u]), np.array([v]))[0, 0]
-                             for u, v in uv]))
-    return np.array(out)
+    Bw = bernstein(pieces.shape[1] - 1, tau)[None] * weights[:, None, :]   # (K, q, m + 1)
+    uv = np.einsum("kqa,kad->kqd", Bw, pieces) / Bw.sum(axis=2)[..., None]
+    return surface_points(patch, uv.reshape(-1, 2)).reshape(len(pieces), len(tau), 3)
 
 
 def split_piece(b: Array, w: Array, tau: float) -> tuple[tuple[Array, Array], ...]:
@@ -367,6 +358,6 @@ def join_edge(record: BrepRecord, patch: NurbsPatch, pieces: Array, weights: Arr
 
 
 def _vertex(record: BrepRecord, patch: NurbsPatch, uv: Array) -> int:
-    point = patch.evaluate(np.array([uv[0]]), np.array([uv[1]]))[0, 0]
+    point = surface_points(patch, uv)[0]
     record.vertices.append({"point": point, "ei": [], "tolerance": 0.0})
     return len(record.vertices) - 1

@@ -110,7 +110,7 @@ class Archive:
         self.byte(16 * major + minor)
 
     def object(self, kind: str, write: Any, *args: Any) -> None:
-        """``WriteObject``: the class chunk of ``CLASS_ID[kind]`` holding ``write(self, *args)``."""
+        """``WriteObject``: the class chunk of ``CLASS_ID[kind]``, ``write(self, *args)`` in it."""
         self.begin(TCODE_OPENNURBS_CLASS)
         self.begin(TCODE_OPENNURBS_CLASS_UUID)
         self.uuid(CLASS_ID[kind])
