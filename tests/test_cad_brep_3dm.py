@@ -279,3 +279,22 @@ def test_brep_faces_keep_a_reversed_orientation(tmp_path):
     assert brep.Faces[0].OrientationIsReversed
     assert not body_brep([patch_from_surface(plate)], BrepTopology(()), r3
                          ).Faces[0].OrientationIsReversed
+
+
+@pytest.mark.parametrize("shape, edges, vertices, naked, solid", [
+    ("cylinder", 3, 2, 2, False),      # the seam, two circles (naked)
+    ("torus", 2, 1, 0, True),          # two seams meeting at one vertex, closed
+    ("half_sphere", 2, 2, 1, False),   # the seam, the rim (naked); a pole, no edge
+])
+def test_periodic_built_in_shapes_are_joined_along_their_seams(shape, edges, vertices, naked,
+                                                               solid):
+    """A periodic direction (its net unwrapped in the .3dm) is a seam of its face: one
+    edge used twice by the face's loop."""
+    surface = getattr(sd.shapes, shape)()
+    body = sd.Body([surface])
+    brep = body_brep([patch_from_surface(surface)], BrepTopology.of(body), r3)
+    assert_clean(brep)
+    counts = trims_per_edge(brep)
+    assert (len(brep.Edges), len(brep.Vertices)) == (edges, vertices)
+    assert counts.count(1) == naked == body.summary()["boundary"]
+    assert brep.IsSolid == solid
