@@ -9,7 +9,8 @@ orientation. The Brep (:class:`splinedeform.cad_on_archive.BrepRecord`) has
 * one **outer loop** per face: the trims along ``v = v0``, ``u = u1``, ``v = v1``,
   ``u = u0`` in this order, counter-clockwise in ``(u, v)`` as openNURBS wants, each with
   its straight 2-D curve and its iso flag (``S``, ``E``, ``N``, ``W``); a trimmed face
-  has instead its trim loops (:mod:`splinedeform.cad_brep_trims`);
+  has instead its trim loops (:mod:`splinedeform.cad_brep_trims`), a rectangle with
+  holes its sides and inner loops, and two loops of a trim interface are one edge;
 * one **edge** per curve of the body: the sides of faces joined by interfaces are one
   edge (the union of the interfaces' pairs), its 3-D curve the iso curve of the first
   side, ``C(s) = S(u_0, s)`` (its control points ``Q_j = Σ_i N_i(u_0) H_ij`` in
@@ -30,8 +31,8 @@ seam of its face (``u0`` with ``u1``).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -244,14 +245,14 @@ def body_record(patches: Sequence[NurbsPatch], interfaces: Sequence[Interface],
                     first, last = (vertex(root[0], c) for c in CORNERS[root[1]])
                     record.edges.append({"c3i": len(record.curves_3d), "vi": (first, last),
                                          "ti": [], "domain": curve_domain(curve),
-                                         "tolerance": 0.0, "root": root})
+                                         "tolerance": 0.0})
                     record.curves_3d.append(curve)
                     record.vertices[first]["ei"].append(edge_of[root])
                     record.vertices[last]["ei"].append(edge_of[root])
                 ei = edge_of[root]
                 trim.update(ei=ei, rev3d=against ^ flip)
                 record.edges[ei]["ti"].append(ti)
-                _edge_tolerance(record, ei, side_curve(patch, side), flip)
+                _edge_tolerance(record, ei, side_curve(patch, side))
             record.trims.append(trim)
             loop_trims.append(ti)
     _trim_types(record)
@@ -270,7 +271,7 @@ def _side_line(patch: NurbsPatch, side: str) -> tuple[Nurbs, tuple[float, float]
     return Nurbs((1,), (np.array([a, a, b, b]),), np.array(ends, dtype=float)), (a, b)
 
 
-def _edge_tolerance(record: BrepRecord, ei: int, curve: Nurbs, flip: bool) -> None:
+def _edge_tolerance(record: BrepRecord, ei: int, curve: Nurbs) -> None:
     """Raise edge ``ei``'s tolerance to the distance of ``curve`` (one of its sides) from
     the edge curve (module docstring)."""
     edge = record.edges[ei]
