@@ -44,9 +44,9 @@ TCODE_OPENNURBS_CLASS_END = 0x80027FFF
 CLASS_ID = {"brep": "60B5DBC5-E660-11d3-BFE4-0010830122F0",
             "curve": "4ED7D4DD-E947-11d3-BFE5-0010830122F0",
             "surface": "4ED7D4DE-E947-11d3-BFE5-0010830122F0"}
-#: the archive version written (``Archive3dmVersion``) and the openNURBS version named
+#: the archive version written (``Archive3dmVersion``): the chunk versions chosen here
+#: (``ON_NurbsCurve`` 1.1, ``ON_BrepFaceArray`` 1.1) are those of a version 6 archive
 ARCHIVE_3DM = 60
-OPENNURBS_VERSION = -1869833980     # rhino3dm 8.35's own, as Encode() gives it
 #: the empty bounding box openNURBS writes where a box is "reserved": min (1, 0, 0), max (-1, 0, 0)
 EMPTY_BOX = (1.0, 0.0, 0.0, -1.0, 0.0, 0.0)
 
@@ -281,7 +281,10 @@ def brep_bytes(brep: BrepRecord) -> bytes:
 
 
 def decode(data: bytes, r3: Any) -> Any:
-    """The rhino3dm object of an archive form (``CommonObject.Decode``); None if it fails."""
-    return r3.CommonObject.Decode({"version": 10000, "archive3dm": ARCHIVE_3DM,
-                                   "opennurbs": OPENNURBS_VERSION,
+    """The rhino3dm object of an archive form (``CommonObject.Decode``, under the
+    installed rhino3dm's own ``version`` and ``opennurbs`` numbers, as its ``Encode()``
+    gives them, and :data:`ARCHIVE_3DM`); None if it fails."""
+    header = r3.Point(r3.Point3d(0.0, 0.0, 0.0)).Encode()
+    return r3.CommonObject.Decode({"version": header["version"], "archive3dm": ARCHIVE_3DM,
+                                   "opennurbs": header["opennurbs"],
                                    "data": base64.b64encode(data).decode("ascii")})
