@@ -298,3 +298,10 @@ def test_periodic_built_in_shapes_are_joined_along_their_seams(shape, edges, ver
     assert (len(brep.Edges), len(brep.Vertices)) == (edges, vertices)
     assert counts.count(1) == naked == body.summary()["boundary"]
     assert brep.IsSolid == solid
+
+
+def test_a_topology_of_other_faces_is_refused_with_a_warning(tmp_path):
+    plate = sd.shapes.plane(size=(1.0, 1.0), cells=(2, 2))
+    topology = BrepTopology((Interface(0, "u1", 3, "u0"),))
+    with pytest.warns(InputWarning, match="names a face outside the 1 written"):
+        write_3dm(tmp_path / "other.3dm", [patch_from_surface(plate)], body=topology)

@@ -173,6 +173,9 @@ def body_record(patches: Sequence[NurbsPatch], interfaces: Sequence[Interface],
     if len(trims) != len(patches) or len(orientation) != len(patches):
         raise BrepError(f"{len(patches)} faces need as many orientations and trims, got "
                         f"{len(orientation)} and {len(trims)}")
+    named = [(i.a, i.b) for i in (*interfaces, *trim_interfaces)] + [(p, p) for p, _ in poles]
+    if any(not 0 <= k < len(patches) for pair in named for k in pair):
+        raise BrepError(f"the topology names a face outside the {len(patches)} written")
     whole = [t is None or p in holed for p, t in enumerate(trims)]
     pairs = {}
     for i in trim_interfaces:
