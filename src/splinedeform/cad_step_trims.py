@@ -8,7 +8,10 @@ parameters, its pcurve, taken exactly as the model holds the loop:
 * a polygon: one ``Geom2d_Line`` segment per side, or where the loop names its trim edges
   (:attr:`TrimDomain.edges`, a CAD face's), one degree-1 ``Geom2d_BSplineCurve`` through
   the vertices of each trim edge;
-* a circle ``c + r (cos θ, sin θ)``: one closed ``Geom2d_Circle``;
+* a circle ``c + r (cos θ, sin θ)``: one closed edge, the ``Geom2d_Circle`` converted to
+  its exact rational quadratic B-spline (``Geom2dConvert``), run backwards for a
+  clockwise loop: kept as a circle, a clockwise one read back from STEP, and any from
+  IGES, bounded an area up to 5e-6 off;
 * a closed uniform B-spline ``Σ_k P_k b^n(t - k)``: one closed periodic
   ``Geom2d_BSplineCurve`` on the knots ``0, 1, …, K`` (its pole ``k`` is the B-spline
   supported on ``[k, k + n + 1]``, as in :class:`~splinedeform.trim.spline_loop.SplineLoop`);
@@ -129,7 +132,7 @@ def _curves(loop: Any, labels: tuple[int, ...] | None
             ) -> list[tuple[Any, float, float, bool]]:
     """``(Geom2d curve, first, last, backwards)`` of each edge of ``loop``, in its order;
     ``backwards``: the loop runs the curve from ``last`` to ``first`` (a clockwise circle is
-    the counter-clockwise one reversed, as STEP's placements are right-handed)."""
+    the counter-clockwise one's edge reversed)."""
     from OCP.Geom2d import Geom2d_Circle, Geom2d_TrimmedCurve
     from OCP.Geom2dConvert import Geom2dConvert
     from OCP.gp import gp_Ax2d, gp_Circ2d, gp_Dir2d, gp_Pnt2d
