@@ -15,8 +15,9 @@ from splinedeform.trim import CircleLoop, PiecewiseLoop, PolygonLoop, SplineLoop
 
 pytest.importorskip("OCP", reason="the 'cad-step' extra (cadquery-ocp) is not installed")
 
-from occt_shapes import (free_edges, inside_points, model_area, outward_normal,  # noqa: E402
-                         read_shape, solid_volume, sub_shapes, surface_points, valid)
+from occt_shapes import (area, free_edges, inside_points, model_area,  # noqa: E402
+                         outward_normal, read_shape, solid_volume, sub_shapes,
+                         surface_points, valid)
 from splinedeform.cad_step import write_frames_step  # noqa: E402
 from splinedeform.export.body import write_body_step  # noqa: E402
 
@@ -77,8 +78,7 @@ def test_trimmed_faces_keep_their_loops(tmp_path, name, suffix):
     uv = inside_points(trimmed)
     for face, net in zip(faces, [surface.control_points, *nets]):
         assert len(sub_shapes(face, "WIRE")) == len(domain.loops)
-        assert sub_shapes(face, "WIRE")                 # (the explorer finds wires at all)
-        assert model_area(trimmed, net) == pytest.approx(_area(face), rel=AREA_TOL)
+        assert model_area(trimmed, net) == pytest.approx(area(face), rel=AREA_TOL)
         # the position written is the deformed one: the face's surface at the region's
         # points is the model's surface with that net
         want = surface.with_control_points(net).evaluate(uv[:, 0], uv[:, 1])
@@ -86,15 +86,9 @@ def test_trimmed_faces_keep_their_loops(tmp_path, name, suffix):
     # the same faces written whole have the area of the whole rectangle, not the region
     whole = read_shape(write_frames_step(tmp_path / f"whole{suffix}", surface,
                                          np.array([0.0, 1.0]), nets))
-    assert _area(sub_shapes(whole, "FACE")[0]) == pytest.approx(
+    assert area(sub_shapes(whole, "FACE")[0]) == pytest.approx(
         model_area(surface, surface.control_points), rel=AREA_TOL)
-    assert _area(sub_shapes(whole, "FACE")[0]) > 1.2 * _area(faces[0])
-
-
-def _area(face):
-    from occt_shapes import area
-
-    return area(face)
+    assert area(sub_shapes(whole, "FACE")[0]) > 1.2 * area(faces[0])
 
 
 def test_a_loop_names_its_edges_as_the_edges_written(tmp_path):
@@ -185,9 +179,9 @@ def test_a_drilled_box_is_written_as_a_closed_shell_of_trimmed_faces(drilled_box
     # every face's area is its region's, matched by area (the sewn shell reorders them);
     # the rational wall of the hole to RATIONAL_AREA_TOL
     want = sorted((model_area(s, n), np.ptp(s.weights) > 0) for s, n in zip(patches, nets))
-    got = sorted(_area(f) for f in faces)
-    for (area, rational), read in zip(want, got):
-        assert read == pytest.approx(area, rel=RATIONAL_AREA_TOL if rational else AREA_TOL)
+    got = sorted(area(f) for f in faces)
+    for (region, rational), read in zip(want, got):
+        assert read == pytest.approx(region, rel=RATIONAL_AREA_TOL if rational else AREA_TOL)
     # the normals point out: the solid's volume is det(A) (box − cylinder), positive;
     # OpenCASCADE integrates it over the faces as read (asked for 1e-12; measured 1.5e-10
     # in STEP and IGES): 1e-8
