@@ -187,6 +187,14 @@ def test_a_drilled_box_is_written_as_a_closed_shell_of_trimmed_faces(drilled_box
     # in STEP and IGES): 1e-8
     volume = np.linalg.det(A) * (np.prod(BOX) - np.pi * HOLE_RADIUS ** 2 * BOX[2])
     assert solid_volume(written) == pytest.approx(volume, rel=AREA_TOL)
+    # and splinedeform reads the file as a body again (a sculpt bake does): the same
+    # orientations, the same trimmed regions (their pieces are polynomial, read back
+    # exactly; the parameter areas to the file's digits, 1e-10 and 1e-8)
+    again, signs_again, _ = _box_body(tmp_path / f"drilled{suffix}")
+    assert sorted(signs_again) == sorted(signs)
+    regions = [sorted(abs(s.trim.area()) for s in body if s.trim is not None)
+               for body in (patches, again)]
+    assert np.allclose(*regions, rtol={".step": 1e-10, ".igs": 1e-8}[suffix], atol=0)
 
 
 @pytest.fixture(scope="module")
