@@ -17,7 +17,7 @@ import splinedeform as sd
 from splinedeform.physics import coupling
 
 from coupling_systems import (CLAMPED_PLATE_CENTRE, PLATE, c0_basis, c1_basis, flat_patch,
-                              single)
+                              single, slope_jump)
 
 LOAD = sd.Uniform((0.0, 0.0, 1.0))
 
@@ -160,16 +160,6 @@ def test_a_creased_interface_keeps_its_rotation_penalty():
     # the same halves unfolded are tied
     flat = sd.BodyModel([left, flat_patch(0.5, 0.5, 4, 4)], PLATE, boundary="clamped")
     assert flat.constraints.ties.interfaces == {0}
-
-
-def slope_jump(surface: sd.Surface, net: np.ndarray) -> float:
-    """``max |∂_u d(1/2⁺) − ∂_u d(1/2⁻)|`` along u = 1/2 over the largest ``|∂_u d|``."""
-    v = np.linspace(0.0, 1.0, 41)
-    below = surface.derivative(0.5 - 1e-12, v, 1, 0, net)      # the left span's last point
-    above = surface.derivative(0.5, v, 1, 0, net)
-    x = np.linspace(0.0, 1.0, 81)
-    slopes = surface.derivative(x[:, None], x[None, :], 1, 0, net)
-    return float(np.abs(above - below).max() / np.abs(slopes).max())
 
 
 def test_a_plate_with_a_c0_line_has_no_slope_jump():

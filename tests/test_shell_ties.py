@@ -24,7 +24,7 @@ from splinedeform.physics.shell import ShellMaterial
 from splinedeform.physics.shell_model import AreaForce, ShellModel
 from splinedeform.refine import refine_surface
 
-from coupling_systems import CLAMPED_PLATE_CENTRE, c0_basis, c1_basis, flat_patch
+from coupling_systems import CLAMPED_PLATE_CENTRE, c0_basis, c1_basis, flat_patch, slope_jump
 
 SHELL = ShellMaterial(E=1.0, nu=0.3, thickness=0.01)
 D = SHELL.E * SHELL.thickness ** 3 / (12 * (1 - SHELL.nu ** 2))
@@ -45,16 +45,6 @@ def condition(model: ShellModel) -> float:
     """``λ_max / λ_min`` of ``K_r`` beside the free rigid motions (dense, small models)."""
     eigenvalues = np.linalg.eigvalsh(model.matrices()[2].toarray())
     return float(eigenvalues[-1] / eigenvalues[model.rigid.shape[1]])
-
-
-def slope_jump(surface: sd.Surface, net: np.ndarray) -> float:
-    """``max |∂_u d(1/2⁺) − ∂_u d(1/2⁻)|`` along u = 1/2 over the largest ``|∂_u d|``."""
-    v = np.linspace(0.0, 1.0, 41)
-    below = surface.derivative(0.5 - 1e-12, v, 1, 0, net)      # the left span's last point
-    above = surface.derivative(0.5, v, 1, 0, net)
-    x = np.linspace(0.0, 1.0, 81)
-    slopes = surface.derivative(x[:, None], x[None, :], 1, 0, net)
-    return float(np.abs(above - below).max() / np.abs(slopes).max())
 
 
 def test_a_shell_with_a_c0_line_is_tied_and_sags_like_the_smooth_shell(monkeypatch):

@@ -15,7 +15,8 @@ Leibniz' rule applied to ``A = W f`` (Piegl & Tiller, *The NURBS Book*, eq. 4.20
 Points are evaluated in homogeneous coordinates ``(w p, w)`` on the polynomial bases
 (every fast path of :class:`~splinedeform.surface.Surface` serves the numerator), the
 basis ``R_kl`` from its local functions (:func:`basis_derivatives`), which the plate
-(:mod:`splinedeform.physics.rational_plate`), the intrinsic physics and the evaluation
+(:mod:`splinedeform.physics.rational_plate`), the intrinsic physics, the Kirchhoff–Love
+shell (:mod:`splinedeform.physics.shell`, through the metric's grid) and the evaluation
 matrices share. Weights of the form ``a_k b_l`` keep per-direction
 :class:`~splinedeform.knots.RationalBasis` objects instead (:func:`product_factors`).
 """
@@ -235,11 +236,3 @@ def rational_operators(V: sp.spmatrix, derivatives: Iterable[sp.spmatrix], weigh
     R = (inverse @ V @ scale).tocsr()
     return R, [(inverse @ (D @ scale - sp.diags(D @ w) @ R)).tocsr() for D in derivatives]
 
-
-def refuse(surface: Surface, what: str) -> None:
-    """InputError where ``what`` cannot take a surface with general (non-product) weights."""
-    if getattr(surface, "net_weights", None) is not None:
-        raise InputError(f"{what} does not take NURBS weights that are not a product "
-                         f"w_kl = a_k b_l (surface {surface.name!r}); its basis evaluation "
-                         "is a tensor product of 1-D bases. Use physics 'parametric' or "
-                         "'intrinsic', whose rational basis is assembled element by element")
