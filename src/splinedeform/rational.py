@@ -163,19 +163,30 @@ def derivative(surface: Surface, u: ArrayLike, v: ArrayLike, du: int = 0, dv: in
                control_points: ArrayLike | None = None) -> Array:
     """``∂^{du+dv} x / ∂u^du ∂v^dv`` at points ``(u, v)`` (broadcast), ``S + (c,)``.
 
-    ``control_points`` is another net on the same rational basis (``Σ R_kl d_kl``).
+    ``control_points`` is another net on the same rational basis (``Σ R_kl d_kl``); its
+    trailing axes after ``(n_u, n_v)`` (several nets, ``(n_u, n_v, F, 3)``) are kept,
+    ``S + (F, 3)``, as for polynomial bases.
     """
     twin, hom = polynomial(surface), homogeneous(surface, control_points)
-    return _from_homogeneous(lambda i, j: twin.derivative(u, v, i, j, control_points=hom),
-                             du, dv)
+    out = _from_homogeneous(lambda i, j: twin.derivative(u, v, i, j, control_points=hom),
+                            du, dv)
+    return out.reshape(out.shape[:-1] + _trailing(surface, control_points))
+
+
+def _trailing(surface: Surface, control_points: ArrayLike | None) -> tuple[int, ...]:
+    """The axes of a net after its ``(n_u, n_v)`` (``(3,)`` for the surface's own)."""
+    if control_points is None:
+        return surface.control_points.shape[2:]
+    return np.shape(control_points)[2:]
 
 
 def evaluate_grid(surface: Surface, u: ArrayLike, v: ArrayLike, du: int = 0, dv: int = 0,
                   control_points: ArrayLike | None = None) -> Array:
     """Tensor grid evaluation of :func:`derivative`, ``(len(u), len(v), c)``."""
     twin, hom = polynomial(surface), homogeneous(surface, control_points)
-    return _from_homogeneous(lambda i, j: twin.evaluate_grid(u, v, i, j, control_points=hom),
-                             du, dv)
+    out = _from_homogeneous(lambda i, j: twin.evaluate_grid(u, v, i, j, control_points=hom),
+                            du, dv)
+    return out.reshape(out.shape[:-1] + _trailing(surface, control_points))
 
 
 def grid_nets(surface: Surface, u: ArrayLike, v: ArrayLike, nets: ArrayLike) -> Array:
