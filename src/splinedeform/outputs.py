@@ -150,7 +150,8 @@ def _write_files(result: RunResult, folder: Path, stages: Stages) -> None:
 
             with stages.stage(f"CAD surfaces {suffix}"):
                 result.outputs.append((f"NURBS surfaces {suffix}", write_frames_step(
-                    folder / f"{name}{suffix}", surface, times, nets, result.built.units)))
+                    folder / f"{name}{suffix}", surface, times, nets, result.built.units,
+                    trim=getattr(surface, "trim", None))))
     if "images" in formats:
         _write_images(result, folder, stages)
     for ext in ("gif", "mp4"):

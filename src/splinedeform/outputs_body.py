@@ -7,7 +7,8 @@
 * ``json`` / ``npz``: ``name_nets.json`` / ``.npz``, every face's nets in every frame keyed
   by its face number (:mod:`splinedeform.export.body_nets`);
 * ``3dm``, ``step``, ``iges``: the deformed body's faces in the file's unit (the ``.3dm``
-  one Brep with the body's topology, its faces named, STEP / IGES sewn into one shell);
+  one Brep with the body's topology, its faces named, STEP / IGES sewn into one shell,
+  trimmed faces bounded by their trim loops and reversed faces reversed);
 * ``images``: ``surfaces.png`` (every face at rest and at the frame of largest
   displacement, one welded mesh), ``probes.png`` for a dynamic solve (the probes), and
   for a shell ``stresses.png`` (every face at the frame where von Mises peaks);
@@ -118,7 +119,8 @@ def write_body_files(result: RunResult, folder: Path, stages: Stages) -> None:
         if ext in formats:
             with stages.stage(f"CAD surfaces {suffix}"):
                 result.outputs.append((f"NURBS surfaces {suffix}", body_files.write_body_step(
-                    folder / f"{name}{suffix}", patches, deformed_nets(result), units)))
+                    folder / f"{name}{suffix}", patches, deformed_nets(result), units,
+                    orientation=getattr(body, "orientation", None))))
     if "images" in formats:
         _write_images(result, folder, stages)
     for ext in ("gif", "mp4"):

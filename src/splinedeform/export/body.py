@@ -2,8 +2,9 @@
 
 * ``.3dm``: one Brep, a face per patch, its edges joined where the patches meet, in the
   body's unit (:func:`splinedeform.cad.write_3dm`, :mod:`splinedeform.cad_brep_3dm`);
-* STEP / IGES: one B-spline face per patch in one file, sewn into a shell where the
-  patches meet (:func:`splinedeform.cad_step.write_step`);
+* STEP / IGES: one B-spline face per patch in one file, bounded by its trim loops where
+  it is trimmed and reversed where the body's orientation says so, sewn into a shell
+  where the patches meet (:func:`splinedeform.cad_step.write_step`);
 * a welded mesh (``.vtu``, ``.vtk``, ``.obj``, ``.stl``, ``.ply``): each patch sampled on
   its ``r × r`` parameter grid, ``X_k = B_u P_k B_vᵀ`` (:func:`.frames.tessellate_frames`),
   the grids put side by side and their points merged where they coincide at rest and in
@@ -79,13 +80,16 @@ def write_body_3dm(path: str | os.PathLike, surfaces: Sequence[Surface],
 
 def write_body_step(path: str | os.PathLike, surfaces: Sequence[Surface],
                     nets: Sequence[ArrayLike], units: str | None = None,
-                    shell: bool = True) -> Path:
+                    shell: bool = True, orientation: Sequence[int] | None = None) -> Path:
     """Every patch with its net as a B-spline face of one STEP or IGES file (by the
-    suffix), in ``units``; with ``shell`` the faces are sewn where they meet into one
-    shell (:func:`splinedeform.cad_step.write_step`)."""
+    suffix), in ``units``: a trimmed surface (``surface.trim``) bounded by its trim loops,
+    a patch of ``orientation`` ``-1`` (:attr:`splinedeform.body.Body.orientation`)
+    reversed; with ``shell`` the faces are sewn where they meet into one shell
+    (:func:`splinedeform.cad_step.write_step`)."""
     from ..cad_step import write_step
 
-    return write_step(path, body_patches(surfaces, nets, units), units=units, shell=shell)
+    return write_step(path, body_patches(surfaces, nets, units), units=units, shell=shell,
+                      trims=[s.trim for s in surfaces], orientation=orientation)
 
 
 def welded_body(surfaces: Sequence[Surface], frames: Sequence[ArrayLike], resolution: int = 32

@@ -10,9 +10,9 @@ write_obj` (the surface sampled on the page's grid, vertex normals) and
 bytes returned; nothing is written beside the save.
 
 A body keeps every face: the ``.3dm`` holds one Brep of the body's faces, its edges joined,
-in the body's unit (:func:`splinedeform.export.body.write_body_3dm`), the OBJ one mesh welded across the
-shared edges (:func:`splinedeform.export.body.write_body_mesh`), the net file one net per
-face (``stem-face-k.json``, bundled as ``.zip``).
+in the body's unit (:func:`splinedeform.export.body.write_body_3dm`), the OBJ one mesh
+welded across the shared edges (:func:`splinedeform.export.body.write_body_mesh`), the net
+file one net per face (``stem-face-k.json``, bundled as ``.zip``).
 """
 
 from __future__ import annotations
