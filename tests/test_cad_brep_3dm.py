@@ -305,3 +305,28 @@ def test_a_topology_of_other_faces_is_refused_with_a_warning(tmp_path):
     topology = BrepTopology((Interface(0, "u1", 3, "u0"),))
     with pytest.warns(InputWarning, match="names a face outside the 1 written"):
         write_3dm(tmp_path / "other.3dm", [patch_from_surface(plate)], body=topology)
+
+
+def test_a_drilled_box_is_a_closed_brep_its_wall_sewn_to_the_holes(tmp_path_factory,
+                                                                   tmp_path):
+    """OpenCASCADE's box less a cylinder (tests/test_cad_step_trims.py): four planes, top
+    and bottom holed (rectangles less a circle), the hole's wall a closed face. The body
+    joins the planes along 12 edges and the wall along its seam; each hole's loop lies on
+    a circle of the wall (within the body's tolerance) and is sewn to it, as OpenCASCADE's
+    file has it: no naked edge, a solid."""
+    pytest.importorskip("OCP", reason="the 'cad-step' extra (cadquery-ocp) is not installed")
+    from occt_shapes import free_edges, read_shape
+    from test_cad_step_trims import _box_body, drilled_box
+
+    source = drilled_box.__wrapped__(tmp_path_factory)
+    patches, signs, units = _box_body(source)
+    body = sd.Body(patches, orientation=signs)
+    assert body.summary()["boundary"] == 2             # the wall's circles, on the holes
+    brep, _, _ = only_brep(write_body_3dm(tmp_path / "drilled.3dm", patches,
+                                          [s.control_points for s in patches], units=units,
+                                          body=body))
+    assert_clean(brep)
+    counts = trims_per_edge(brep)
+    assert (len(brep.Faces), len(brep.Edges)) == (7, 15)
+    assert counts.count(1) == free_edges(read_shape(source)) == 0
+    assert brep.IsSolid

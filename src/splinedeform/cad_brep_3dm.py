@@ -162,11 +162,13 @@ def corner_point(patch: NurbsPatch, corner: tuple[int, int]) -> Array:
 def body_record(patches: Sequence[NurbsPatch], interfaces: Sequence[Interface],
                 poles: Sequence[Side], orientation: Sequence[int],
                 trims: Sequence[Any] | None = None, holed: Sequence[int] = (),
-                trim_interfaces: Sequence[TrimInterface] = ()) -> BrepRecord:
+                trim_interfaces: Sequence[TrimInterface] = (), sew: float = 0.0
+                ) -> BrepRecord:
     """The Brep of a body (module docstring); ``trims`` (one per patch, None where
     untrimmed) are the faces' trim domains (:mod:`splinedeform.cad_brep_trims`), those of
     the faces ``holed`` their rectangle less holes (its sides the outer loop, joined by
-    the interfaces); two loops of a trim interface, each one trim, are one closed edge."""
+    the interfaces); two loops of a trim interface, each one trim, are one closed edge,
+    and so is a loop of one trim with a naked closed edge it lies on within ``sew``."""
     from .cad_brep_trims import add_trim_loops
 
     trims = list(trims) if trims is not None else [None] * len(patches)
@@ -211,35 +213,21 @@ def body_record(patches: Sequence[NurbsPatch], interfaces: Sequence[Interface],
         return k
 
     edge_of: dict[Any, int] = {}
-    for p, patch in enumerate(patches):
-        li = len(record.loops)
-        record.faces.append({"li": [li], "si": p, "rev": orientation[p] == -1})
-        loop_trims: list[int] = []
-        record.loops.append({"ti": loop_trims, "type": OUTER, "fi": p})
-        if trims[p] is not None:
-            joins = {lb: built[key] for (q, lb), key in pairs.items()
-                     if q == p and key in built}
-            single = add_trim_loops(record, patch, trims[p], p, whole[p], joins)
-            built.update({(p, k): v for k, v in single.items()})
-            unjoined = [f"face {q} loop {k}" for (q, k), key in pairs.items()
-                        if q == p and (key not in built
-                                       or len(record.edges[built[key]["ei"]]["ti"]) < 2)]
-            if unjoined:
-                warnings.warn(f"{', '.join(unjoined)} of the body's .3dm Brep are naked "
-                              "edges, not joined to the trim loop they meet: a loop of "
-                              "several trims", InputWarning, stacklevel=3)
-            if not whole[p]:
-                continue
+    for p, patch in enumerate(patches):        # the faces, and the sides of the whole ones
+        record.faces.append({"li": [len(record.loops)], "si": p, "rev": orientation[p] == -1})
+        record.loops.append({"ti": [], "type": OUTER, "fi": p})
+        if not whole[p]:
+            continue
+        li = record.faces[p]["li"][0]
         for side in LOOP_SIDES:
             start, end = (vertex(p, c) for c in CORNERS[side])
             against = AGAINST[side]
             ti = len(record.trims)
+            line, domain = _side_line(patch, side)
             trim = {"c2i": len(record.curves_2d), "ei": -1, "iso": ISO[side], "li": li,
                     "vi": (end, start) if against else (start, end), "rev3d": False,
-                    "type": SINGULAR}
-            line, domain = _side_line(patch, side)
+                    "type": SINGULAR, "domain": domain}
             record.curves_2d.append(line)
-            trim["domain"] = domain
             if (p, side) not in pole_set:
                 root, flip = sides.find((p, side))
                 if root not in edge_of:
@@ -257,7 +245,21 @@ def body_record(patches: Sequence[NurbsPatch], interfaces: Sequence[Interface],
                 record.edges[ei]["ti"].append(ti)
                 _edge_tolerance(record, ei, side_curve(patch, side))
             record.trims.append(trim)
-            loop_trims.append(ti)
+            record.loops[li]["ti"].append(ti)
+    for p, patch in enumerate(patches):        # the trim loops, joined where they meet
+        if trims[p] is None:
+            continue
+        joins = {lb: built[key] for (q, lb), key in pairs.items() if q == p and key in built}
+        single = add_trim_loops(record, patch, trims[p], p, record.faces[p]["li"][0],
+                                whole[p], joins, sew)
+        built.update({(p, k): v for k, v in single.items()})
+        unjoined = [f"face {q} loop {k}" for (q, k), key in pairs.items()
+                    if q == p and (key not in built
+                                   or len(record.edges[built[key]["ei"]]["ti"]) < 2)]
+        if unjoined:
+            warnings.warn(f"{', '.join(unjoined)} of the body's .3dm Brep are naked edges, "
+                          "not joined to the trim loop they meet: a loop of several trims",
+                          InputWarning, stacklevel=3)
     _trim_types(record)
     for k, points in members.items():
         record.vertices[k]["tolerance"] = float(np.max(np.linalg.norm(
@@ -307,6 +309,8 @@ class BrepTopology:
     #: trimmed faces whose outer loop is their rectangle (its sides joined as untrimmed)
     holed: tuple[int, ...] = ()
     trim_interfaces: tuple[TrimInterface, ...] = ()
+    #: distance within which a trim loop lying on a naked closed edge is sewn to it
+    sew: float = 0.0
 
     @classmethod
     def of(cls, body: Any, name: str = "body") -> BrepTopology:
@@ -320,7 +324,7 @@ class BrepTopology:
         holed = tuple(p for p, s in enumerate(body.patches) if holed_rectangle(s))
         return cls(tuple(body.interfaces) + tuple(seam_interfaces(periodic)),
                    tuple(body.topology.poles), tuple(body.orientation), name, holed,
-                   tuple(getattr(body, "trim_interfaces", ())))
+                   tuple(getattr(body, "trim_interfaces", ())), float(body.topology.tol))
 
 
 def seam_interfaces(periodic: Sequence[tuple[bool, ...]]) -> list[Interface]:
@@ -339,7 +343,7 @@ def body_brep(patches: Sequence[NurbsPatch], body: BrepTopology, r3: Any,
     and decoded); a :class:`BrepError` naming what openNURBS found where it is not valid."""
     orientation = body.orientation or (1,) * len(patches)
     record = body_record(patches, body.interfaces, body.poles, orientation, trims,
-                         body.holed, body.trim_interfaces)
+                         body.holed, body.trim_interfaces, body.sew)
     brep = decode(brep_bytes(record), r3)
     if brep is None:
         raise BrepError("openNURBS could not read the Brep written for the body")

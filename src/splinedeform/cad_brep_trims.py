@@ -229,17 +229,18 @@ def _edge_gap(edge: Nurbs, pieces: Array, weights: Array, patch: NurbsPatch,
 
 
 def add_trim_loops(record: BrepRecord, patch: NurbsPatch, domain: TrimDomain, face: int,
-                   holes_only: bool = False, joins: dict[int, dict[str, Any]] | None = None
+                   outer: int, holes_only: bool = False,
+                   joins: dict[int, dict[str, Any]] | None = None, sew: float = 0.0
                    ) -> dict[int, dict[str, Any]]:
-    """Append the loops of ``domain`` (the outer one into the face's last loop, already in
-    ``record``, unless ``holes_only``: its rectangle's sides are that loop; inner loops
-    after it) with their trims, edges and vertices. A loop in ``joins`` (made of one trim)
-    runs along the edge given there (:func:`join_edge`) instead of an edge of its own.
-    Returns, per loop made of one trim, its edge and vertex (what a join needs)."""
+    """Append the loops of ``domain`` (the outer one into the face's loop ``outer``, unless
+    ``holes_only``: its rectangle's sides are that loop; inner loops after it) with their
+    trims, edges and vertices. A loop in ``joins`` (made of one trim) runs along the edge
+    given there (:func:`join_edge`) instead of an edge of its own, and so does a loop of
+    one trim on a naked closed edge within ``sew`` (:func:`naked_edge_on`). Returns, per
+    loop made of one trim with an edge of its own, that edge and its vertex."""
     bu, bv = _bases(patch)
     box = np.array([*bu.domain, *bv.domain])
-    outer = len(record.loops) - 1
-    joins = joins or {}
+    joins = dict(joins or {})
     single: dict[int, dict[str, Any]] = {}
     for k, (pieces, weights) in enumerate(loop_pieces(domain)):
         if holes_only and k == 0:
@@ -253,6 +254,10 @@ def add_trim_loops(record: BrepRecord, patch: NurbsPatch, domain: TrimDomain, fa
         labels = domain.edges[k] if k < len(domain.edges) and domain.edges[k] else \
             (0,) * len(pieces)
         runs = [0] + [s for s in range(1, len(pieces)) if labels[s] != labels[s - 1]]
+        if k not in joins and len(runs) == 1 and sew > 0:
+            found = naked_edge_on(record, _image(pieces, weights, patch, TAU_SEW), sew)
+            if found is not None:
+                joins[k] = found
         if k in joins and len(runs) == 1:
             join_edge(record, patch, pieces, weights, li, box, joins[k])
             continue
@@ -287,6 +292,35 @@ def _image(pieces: Array, weights: Array, patch: NurbsPatch, tau: Array) -> Arra
     Bw = bernstein(pieces.shape[1] - 1, tau)[None] * weights[:, None, :]   # (K, q, m + 1)
     uv = np.einsum("kqa,kad->kqd", Bw, pieces) / Bw.sum(axis=2)[..., None]
     return surface_points(patch, uv.reshape(-1, 2)).reshape(len(pieces), len(tau), 3)
+
+
+#: parameters per piece at which a loop is compared with a naked edge it may lie on
+TAU_SEW = np.linspace(0.0, 1.0, 129)
+
+
+def naked_edge_on(record: BrepRecord, image: Array, sew: float) -> dict[str, Any] | None:
+    """A closed edge with one trim (its vertex at both ends) that the closed curve
+    ``image`` (its points at :data:`TAU_SEW` on each piece, ``(K, q, 3)``) lies on and
+    that lies on it: each's points within ``sew`` of the other's polyline beyond the
+    polyline's own chord error (its segments' midpoints from the curve's points at the
+    mid parameters); None if there is none."""
+    from .cad_brep_3dm import DENSE, curve_domain, curve_points, polyline_distance
+
+    line = np.concatenate([image[:, :-1:2].reshape(-1, 3), image[-1:, -1]])
+    mids = image[:, 1::2].reshape(-1, 3)
+    own = float(np.linalg.norm(mids - 0.5 * (line[:-1] + line[1:]), axis=1).max())
+    for ei, edge in enumerate(record.edges):
+        if len(edge["ti"]) != 1 or edge["vi"][0] != edge["vi"][1]:
+            continue
+        curve = record.curves_3d[edge["c3i"]]
+        t = np.linspace(*curve_domain(curve), DENSE)
+        dense = curve_points(curve, t)
+        chord = float(np.linalg.norm(curve_points(curve, 0.5 * (t[1:] + t[:-1]))
+                                     - 0.5 * (dense[1:] + dense[:-1]), axis=1).max())
+        if (polyline_distance(line[::8], dense).max() <= sew + chord
+                and polyline_distance(dense[::16], line).max() <= sew + own):
+            return {"ei": ei, "vertex": edge["vi"][0]}
+    return None
 
 
 def split_piece(b: Array, w: Array, tau: float) -> tuple[tuple[Array, Array], ...]:
