@@ -12,7 +12,7 @@ import splinedeform as sd
 r3 = pytest.importorskip("rhino3dm", reason="the 'cad' extra (rhino3dm) is not installed")
 
 from splinedeform.body import Interface  # noqa: E402
-from splinedeform.cad import FACE_NAME, patch_from_surface, write_3dm  # noqa: E402
+from splinedeform.cad import FACE_NAME, NurbsPatch, patch_from_surface, write_3dm  # noqa: E402
 from splinedeform.cad_body import read_body  # noqa: E402
 from splinedeform.cad_brep_3dm import BrepTopology, body_brep  # noqa: E402
 from splinedeform.cad_on_archive import BrepRecord, Nurbs, brep_bytes  # noqa: E402
@@ -330,3 +330,21 @@ def test_a_drilled_box_is_a_closed_brep_its_wall_sewn_to_the_holes(tmp_path_fact
     assert (len(brep.Faces), len(brep.Edges)) == (7, 15)
     assert counts.count(1) == free_edges(read_shape(source)) == 0
     assert brep.IsSolid
+
+
+def test_a_trim_edge_is_the_trim_curve_on_the_surface_to_round_off():
+    """The 3-D edge of a loop on a rational, non-uniform surface is S(c(t)): exact between
+    the knot lines it crosses, a rational polynomial of degree m (p + q) (a circle, m = 2,
+    on degree (2, 2): 8), off S(c(t)) between its interpolation points by round-off."""
+    from splinedeform.cad_brep_trims import loop_pieces, trim_edge
+
+    knots = np.array([0, 0, 0, 0.3, 0.7, 1, 1, 1.0])
+    x = np.linspace(0.0, 1.0, 5)
+    P = np.stack([*np.meshgrid(x, x, indexing="ij"), np.zeros((5, 5))], axis=-1)
+    P[..., 2] = 0.2 * np.sin(3 * P[..., 0]) * P[..., 1]
+    w = 1.0 + 0.3 * np.outer(np.sin(np.arange(5.0)) ** 2, np.cos(np.arange(5.0)) ** 2)
+    patch = NurbsPatch((2, 2), knots, knots, P, w)
+    (pieces, weights), = loop_pieces(TrimDomain(CircleLoop((0.5, 0.45), 0.3)))
+    edge, gap = trim_edge(pieces, weights, patch, 0.0)
+    assert edge.degrees == (8,)
+    assert gap <= 1e-13                        # round-off of the surface's size (1)

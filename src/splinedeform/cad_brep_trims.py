@@ -118,22 +118,15 @@ def _surface_homogeneous(bases: Any, H: Array, uv: Array, inside: Array) -> Arra
 
 def _span_basis(t: Array, n: int, span: int, x: Array) -> Array:
     """All B-splines at ``x`` as the polynomials of knot span ``[t_span, t_span+1)``
-    (Cox–de Boor on that span for every ``x``, also outside it), shape ``(len(x), N)``."""
-    N = np.zeros((len(x), n + 1))
-    N[:, 0] = 1.0
-    left = np.zeros((len(x), n + 1))
-    right = np.zeros((len(x), n + 1))
-    for j in range(1, n + 1):
-        left[:, j] = x - t[span + 1 - j]
-        right[:, j] = t[span + j] - x
-        saved = np.zeros(len(x))
-        for r in range(j):
-            temp = N[:, r] / (right[:, r + 1] + left[:, j - r])
-            N[:, r] = saved + right[:, r + 1] * temp
-            saved = left[:, j - r] * temp
-        N[:, j] = saved
+    (the Cox–de Boor triangle of :func:`splinedeform.deboor.triangle` on that span for
+    every ``x``, also outside it), shape ``(len(x), N)``."""
+    from .deboor import triangle
+
+    k = np.arange(1, n + 1)[:, None]
+    left = x[None] - t[span + 1 - k]
+    right = t[span + k] - x[None]
     out = np.zeros((len(x), len(t) - n - 1))
-    out[:, span - n:span + 1] = N
+    out[:, span - n:span + 1] = triangle(left, right, n, 0)[0].T
     return out
 
 
