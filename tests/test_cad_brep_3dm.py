@@ -11,6 +11,7 @@ import splinedeform as sd
 
 r3 = pytest.importorskip("rhino3dm", reason="the 'cad' extra (rhino3dm) is not installed")
 
+from body_patches import rhino3dm_box  # noqa: E402
 from splinedeform.body import Interface  # noqa: E402
 from splinedeform.cad import FACE_NAME, NurbsPatch, patch_from_surface, write_3dm  # noqa: E402
 from splinedeform.cad_body import read_body  # noqa: E402
@@ -99,12 +100,7 @@ def test_a_brep_rhino3dm_made_is_written_back_byte_for_byte():
 def box(tmp_path_factory):
     """The 1 × 2 × 3 box of docs/cad.md (rhino3dm, metres) and a deformed net per face
     (a smooth field applied to every control point, so shared edges move alike)."""
-    path = tmp_path_factory.mktemp("brep") / "box.3dm"
-    model = r3.File3dm()
-    model.Settings.ModelUnitSystem = r3.UnitSystem.Meters
-    model.Objects.AddBrep(r3.Brep.CreateFromBox(r3.Box(r3.BoundingBox(0, 0, 0, 1, 2, 3))))
-    assert model.Write(str(path), 7)
-    surfaces, topology, info = read_body(path)
+    surfaces, topology, info = read_body(rhino3dm_box(tmp_path_factory.mktemp("brep"), "Meters"))
     body = sd.Body(surfaces, topology.interfaces,
                    orientation=[-1 if r else 1 for r in info["reversed"]])
     nets = [P + 0.01 * np.stack([np.sin(P[..., 1]), np.cos(P[..., 2]), P[..., 0] * P[..., 1]],
