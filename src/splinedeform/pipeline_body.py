@@ -90,7 +90,8 @@ def body_mode_displacements(patches: Any, shapes: list[Any],
 def body_net_normals(patches: Any, orientation: Any = ()) -> list[Any]:
     """Per patch ``(n_u, n_v, 3)``: ``n̄`` of :func:`body_mode_displacements`, the sum of
     the outward net normals ``σ_p n_p`` over the control points that coincide at rest (to
-    1e-9 of the body's size, or 1e-9 below a size of 1), normalised; a point whose sum vanishes keeps its own."""
+    1e-9 of the body's size, or 1e-9 below a size of 1), normalised; a point whose sum
+    vanishes keeps its own."""
     from .pipeline import _net_normals
     from .viz.plots import _mean_per_point
 

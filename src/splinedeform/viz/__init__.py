@@ -21,6 +21,7 @@ from .viewer import content_security_policy, script_json, vertex_checksum, viewe
 __all__ = ["ANIMATION_PIXELS", "COLORBAR_INCHES", "COLORMAP", "DPI", "LIGHT", "MODE_COLORMAP",
            "PANEL_INCHES", "RENDERER_VERSION", "animation_frames", "colormap_table",
            "content_security_policy", "displacement_colors",
-           "mode_geometry", "mp4_available", "plot_body_modes", "plot_modes", "plot_probes", "render_body_surfaces", "render_surfaces",
+           "mode_geometry", "mp4_available", "plot_body_modes", "plot_modes", "plot_probes",
+           "render_body_surfaces", "render_surfaces",
            "script_json", "shade", "vertex_checksum", "viewer_data", "viewer_html",
            "write_animation", "write_body_animation", "write_viewer"]
