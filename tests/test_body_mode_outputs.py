@@ -234,3 +234,51 @@ def test_the_sphere_is_one_welded_grid_in_every_mode(sphere):
     # 2 (r - 1) meridians of r - 2 inner points each, and the two poles
     for name in ("sphere_modes.vtu", "sphere_mode3_0001.vtu"):
         assert len(meshio.read(out / name).points) == 2 * (r - 1) * (r - 2) + 2
+
+
+@pytest.fixture(scope="module")
+def shell_box(box, tmp_path_factory):
+    """The box of :func:`box` as a Kirchhoff–Love shell, 7 modes (the six rigid motions
+    and the lowest vibration), the seventh animated."""
+    folder = tmp_path_factory.mktemp("shellmodes")
+    shutil.copy(box[1].parent / "box.3dm", folder / "box.3dm")
+    (folder / "shell.toml").write_text(
+        '[surface]\nshape = "cad"\npath = "box.3dm"\nelevate = 1\nrefine = 1\n\n'
+        '[material]\nphysics = "shell"\nE = 2.0e11\nnu = 0.3\nthickness = 0.01\n\n'
+        f'[solve]\nkind = "modes"\nmodes = 7\nframes = {FRAMES}\n\n'
+        f'[output]\nformats = ["vtu", "report"]\nresolution = {RESOLUTION - 1}\n'
+        'animate_modes = [7]\n')
+    return run(load_scenario(folder / "shell.toml"), folder / "out"), folder / "out"
+
+
+def test_a_shell_body_s_mode_series_and_report_hold_every_face_s_stresses(shell_box):
+    from splinedeform.outputs_body_shell import face_shells
+
+    result, out = shell_box
+    r, k = RESOLUTION - 1, 7
+    report = json.loads((out / "report.json").read_text())
+    top = report["modes"]["max von Mises top (mass-normalised shape)"]
+    assert len(top) == len(report["modes"]["omega"]) == 7
+    seen = meshio.read(out / "shell_mode7_0001.vtu")          # the quarter period
+    assert len(seen.points) == 6 * r ** 2 - 12 * r + 8
+    # mode 7 as written is c times its mass-normalised shape
+    c = max(np.abs(D[k - 1]).max() for D in result.mode_nets) / \
+        max(np.abs(S[k - 1]).max() for S in result.shell_modes)
+    # each face's own von Mises (top) of D_7 on its grid, computed here face by face
+    rest, stress, owner = [], [], []
+    for p, (face, D) in enumerate(zip(face_shells(result.built.model), result.mode_nets)):
+        u, v = face.surface.sample_parameters(r)
+        U, V = np.meshgrid(u, v, indexing="ij")
+        rest.append(face.surface.evaluate(U, V).reshape(-1, 3))
+        stress.append(face.stresses(D[k - 1], U, V, at_poles="nan").von_mises["top"].ravel())
+        owner.append(np.full(U.size, p))
+    rest, stress, owner = map(np.concatenate, (rest, stress, owner))
+    # the report's maximum is over every face (mass-normalised: divided by c); the
+    # series' point takes the stress of the face it was first sampled on (`patch`);
+    # both to round-off, 1e-9 of the largest stress
+    peak = float(np.nanmax(stress))
+    assert c * top[k - 1] == pytest.approx(peak, rel=1e-9)
+    tree = cKDTree(rest)
+    for at, p, s in zip(seen.points, seen.point_data["patch"], seen.point_data["von_mises_top"]):
+        mine = [i for i in tree.query_ball_point(at, 1e-9) if abs(owner[i] - p) < 0.5]
+        assert len(mine) == 1 and abs(stress[mine[0]] - s) <= 1e-9 * peak
