@@ -120,8 +120,10 @@ def _mode_fields(result: RunResult, path: Path) -> Path:
 
     body, res = result.built.surface, result.scenario.output.resolution
     if is_body(body):
+        from .outputs_body import orientation
+
         return export.write_body_mode_fields(path, list(body.patches), result.mode_nets, res,
-                                             getattr(body, "orientation", ()))
+                                             orientation(result))
     return export.write_mode_fields(path, body, result.mode_nets, resolution=res)
 
 
@@ -132,11 +134,11 @@ def _mode_nets(result: RunResult, folder: Path, stem: str, k: int, formats: list
     body = result.built.surface
     if is_body(body):
         from .export.body_nets import write_body_control_nets
-        from .outputs_body import face_numbers
+        from .outputs_body import face_numbers, orientation
 
         return write_body_control_nets(folder, stem, list(body.patches), face_numbers(result),
                                        result.times, mode_frames(result, k), formats=formats,
-                                       orientation=getattr(body, "orientation", ()))
+                                       orientation=orientation(result))
     return export.write_control_nets(folder, stem, body, result.times, mode_frames(result, k),
                                      formats=formats)
 
@@ -150,11 +152,12 @@ def _mode_series(result: RunResult, folder: Path, stem: str, nets: Any) -> Path:
     res, rest = result.scenario.output.resolution, result.rest_net
     if is_body(body):
         from .export.body import write_body_series
+        from .outputs_body import orientation
         from .outputs_body_shell import body_stress_fields
 
         fields = body_stress_fields(model, rest, nets, res) if is_shell(model) else None
         return write_body_series(folder, stem, list(body.patches), rest, result.times, nets,
-                                 res, fields, getattr(body, "orientation", ()))
+                                 res, fields, orientation(result))
     fields = stress_fields(model, rest, nets, res) if is_shell(model) else None
     return export.write_time_series(folder, stem, body, rest, result.times, nets,
                                     resolution=res, fields=fields)
