@@ -141,6 +141,18 @@ def test_each_written_mode_is_an_eigenvector_of_the_body(box, k):
     assert (q @ (K @ q)) / (q @ (M @ q)) == pytest.approx(result.omegas[k - 1] ** 2, rel=1e-8)
 
 
+def sampled_mode(result, k: int, r: int) -> tuple[np.ndarray, np.ndarray]:
+    """Every face's ``r × r`` grid points at rest and mode ``k``'s net displacement ``D_k``
+    evaluated there (``Surface.evaluate``), face after face: ``(points, displacement)``."""
+    points, moved = [], []
+    for surface, D in zip(result.built.surface.patches, result.mode_nets):
+        u, v = surface.sample_parameters(r)
+        U, V = np.meshgrid(u, v, indexing="ij")
+        points.append(surface.evaluate(U, V).reshape(-1, 3))
+        moved.append(surface.with_control_points(D[k - 1]).evaluate(U, V).reshape(-1, 3))
+    return np.concatenate(points), np.concatenate(moved)
+
+
 PARAVIEW = textwrap.dedent("""
     import json, sys
     from paraview import servermanager
@@ -176,13 +188,7 @@ def test_paraview_reads_mode_3_of_every_face(box, tmp_path):
     assert seen["cells"] == 12 * (r - 1) ** 2
     # at the quarter period the displacement is D_3 evaluated on each face's grid (every
     # face's sample at the point; the points are the rest geometry): 1e-12 of the size
-    points, moved = [], []
-    for surface, D in zip(result.built.surface.patches, result.mode_nets):
-        u, v = surface.sample_parameters(r)
-        U, V = np.meshgrid(u, v, indexing="ij")
-        points.append(surface.evaluate(U, V).reshape(-1, 3))
-        moved.append(surface.with_control_points(D[2]).evaluate(U, V).reshape(-1, 3))
-    points, moved = np.concatenate(points), np.concatenate(moved)
+    points, moved = sampled_mode(result, 3, r)
     tree = cKDTree(points)
     for at, d in zip(np.asarray(seen["points"]), np.asarray(seen["displacement"])):
         near = tree.query_ball_point(at, 1e-9)

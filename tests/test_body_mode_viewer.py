@@ -23,6 +23,8 @@ import chromium  # noqa: E402,F401
 
 r3 = pytest.importorskip("rhino3dm", reason="the 'cad' extra (rhino3dm) is not installed")
 
+from test_body_mode_outputs import sampled_mode  # noqa: E402
+
 from splinedeform import viz  # noqa: E402
 from splinedeform.pipeline import run  # noqa: E402
 from splinedeform.scenario import load_scenario  # noqa: E402
@@ -73,13 +75,7 @@ def test_choosing_mode_3_moves_every_face(browser, box_run, tmp_path):
     fields = decoded(data["modes"]["fields"], "<f4", (K, N, 3))
     # the file's mode 3 at every point is D_3 evaluated on every face sampled there (the
     # points of an edge or a corner are shared): float32, 1e-6 of the size 2
-    points, moved = [], []
-    for surface, D in zip(result.built.surface.patches, result.mode_nets):
-        u, v = surface.sample_parameters(R)
-        U, V = np.meshgrid(u, v, indexing="ij")
-        points.append(surface.evaluate(U, V).reshape(-1, 3))
-        moved.append(surface.with_control_points(D[2]).evaluate(U, V).reshape(-1, 3))
-    points, moved = np.concatenate(points), np.concatenate(moved)
+    points, moved = sampled_mode(result, 3, R)
     for near, d in zip(cKDTree(points).query_ball_point(rest, 2e-6), fields[2]):
         assert near and np.abs(moved[near] - d).max() <= 2e-6
 
