@@ -116,6 +116,15 @@ def test_a_3dm_face_marked_reversed_pushes_outwards_alone(tmp_path):
 
     assert [read_cad(path, k).reversed for k in range(6)] == flags
     check_faces(tmp_path, path.name, flags)
+    # read as a body, the surfaces carry the same signs, and a body made of them without
+    # naming its orientation takes theirs
+    from splinedeform.cad_body import read_body
+
+    surfaces, topology, info = read_body(path)
+    signs = tuple(-1 if r else 1 for r in info["reversed"])
+    assert signs == tuple(-1 if r else 1 for r in flags)
+    assert tuple(s.orientation for s in surfaces) == signs
+    assert sd.Body(surfaces, topology.interfaces).orientation == signs
 
 
 def test_an_opencascade_face_marked_reversed_pushes_outwards_alone(tmp_path):
@@ -136,3 +145,10 @@ def test_an_opencascade_face_marked_reversed_pushes_outwards_alone(tmp_path):
     assert len(flags) == 6
     assert [read_cad(path, k).reversed for k in range(6)] == flags
     check_faces(tmp_path, path.name, flags)
+
+
+@pytest.mark.parametrize("bad", [0, 2, True, "-1"])
+def test_an_orientation_is_one_sign(bad):
+    plane = sd.shapes.plane(cells=2)
+    with pytest.raises(sd.InputError, match="orientation must be"):
+        sd.Surface(plane.control_points, plane.basis_u, plane.basis_v, orientation=bad)
