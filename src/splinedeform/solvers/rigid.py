@@ -271,8 +271,14 @@ def null_space(K: sp.spmatrix, M: sp.spmatrix, what: str, known: Array | None = 
         lam, phi = sla.eigh(K.toarray(), M.toarray(), check_finite=False)
         count, Z = _rigid_count(lam, float(np.abs(lam).max(initial=0.0)), K, M, known, what)
         return phi[:, :count] if Z is None else Z
-    top = float(spla.eigsh(K, k=1, M=sp.csc_matrix(M), which="LA", tol=1e-2,
-                           return_eigenvectors=False)[0])
+    try:
+        top = float(spla.eigsh(K, k=1, M=sp.csc_matrix(M), which="LA", tol=1e-2,
+                               return_eigenvectors=False)[0])
+    except spla.ArpackNoConvergence as exc:
+        if not len(exc.eigenvalues):
+            raise UnresolvedSpectrum(f"{what}: ARPACK found no estimate of the largest "
+                                     "eigenvalue") from None
+        top = float(np.max(exc.eigenvalues))
     sigma = SHIFT * top
     shifted = (K + sigma * M).tocsc()
     block = 8
