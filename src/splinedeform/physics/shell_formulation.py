@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from ..body.body import Body
+from ..body.loads import surface_field
 from ..errors import InputError, SingularSystemError
 from ..solvers.system import Reduction
 from ..surface import Surface
@@ -56,7 +57,7 @@ class ShellReduction(Reduction):
 
     def field(self, term: Any, t: float = 0.0) -> Array:
         if isinstance(self.surface, Surface):
-            return np.asarray(term.field_vector(self.surface, t)).reshape(-1, 1)
+            return np.asarray(surface_field(term, self.surface, t)).reshape(-1, 1)
         return body_field(self.surface, term, t, self.signs)[:, None]
 
 
