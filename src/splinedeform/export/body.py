@@ -22,14 +22,15 @@
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import InputError
+from ..errors import InputError, InputWarning
 from ..surface import Surface
 from .atomic import _check_stem, write_text
 from .frames import check_frames, check_net, tessellate_frames
@@ -75,8 +76,14 @@ def write_body_3dm(path: str | os.PathLike, surfaces: Sequence[Surface],
 
     names = [s.name for s in surfaces] if names is None else list(names)
     patches = body_patches(surfaces, nets, units)
-    topology = BrepTopology.of(Body(surfaces) if body is None else body, name)
     trims = [getattr(s, "trim", None) for s in surfaces]
+    topology = None
+    try:
+        topology = BrepTopology.of(Body(surfaces) if body is None else body, name)
+    except InputError as exc:
+        warnings.warn(f"the body is written as {len(patches)} separate surfaces, not one "
+                      f"Brep: its topology could not be found: {exc}", InputWarning,
+                      stacklevel=2)
     return write_3dm(path, patches, names=names, units=units, body=topology,
                      trims=trims if any(t is not None for t in trims) else None)
 
