@@ -43,6 +43,7 @@ from .body import Body
 from .constraints import boundary_presets, build_body_constraints
 from .interface import EDGES
 from .loads import OnPatch, along_normal
+from .trim_edges import edge_penalty
 from .trimmed import edge_boundary, face_boundary, loop_presets, with_trimmed_faces
 
 Array = NDArray[np.float64]
@@ -117,7 +118,8 @@ class BodyModel(Model):
     the patches' own. A trimmed face (``physics = "parametric"`` only) brings the matrices
     and the extension map of :func:`~splinedeform.trim.model_matrices.trimmed_system`,
     and the faces sharing a trim curve are coupled along it by the same penalties
-    (:func:`~splinedeform.physics.coupling_curves.curve_penalty`).
+    (:func:`~splinedeform.physics.coupling_curves.curve_penalty`), those sharing a
+    stretch of a trim edge along it (:func:`~.trim_edges.edge_penalty`).
 
     Examples
     --------
@@ -154,7 +156,7 @@ class BodyModel(Model):
             raise InputError(f"a body with trimmed faces ({sorted(faces)}) takes physics "
                              f"'parametric' (each face's energy over its trimmed region); "
                              f"{physics!r} is not trimmed yet")
-        loops = loop_presets(self.patches, trims, boundary)
+        loops = loop_presets(self.patches, trims, boundary, body.edge_interfaces)
         presets = boundary_presets(edge_boundary(boundary, loops), topology)
         self.constraints = build_body_constraints(
             self.patches, topology, {k: "free" if k[0] in faces else v
@@ -183,6 +185,8 @@ class BodyModel(Model):
         couplings = [interface_coupling(self.patches, topology.interfaces, material,
                                         self.constraints.edges, offsets[:-1], ties.interfaces)]
         couplings += [curve_penalty(self.patches, i, material, offsets[:-1]) for i in trims]
+        couplings += [edge_penalty(self.patches, i, material, offsets[:-1])
+                      for i in body.edge_interfaces]
         couplings += [c0_coupling(s, material, {e: self.constraints.edges.get((p, e), "free")
                                                 for e in EDGES}, int(offsets[p]), size,
                                   {(d, k) for q, d, k in ties.lines if q == p})
@@ -242,7 +246,7 @@ class BodyModel(Model):
             return None
         n = len(self.patches)
         links = [(i.a, i.b) for i in self.body.topology.interfaces + self.body.trim_interfaces
-                 ] or [(0, 0)]
+                 + self.body.edge_interfaces] or [(0, 0)]
         graph = sp.coo_matrix((np.ones(len(links)), np.array(links).T), shape=(n, n))
         parts, label = connected_components(graph, directed=False)
         held = np.zeros(parts, dtype=bool)
