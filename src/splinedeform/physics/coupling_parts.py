@@ -27,6 +27,8 @@ from .coupling import c0_lines
 Array = NDArray[np.float64]
 MERGE = 0.25
 """An equal-span break closer to a kink than this fraction of a span is moved onto it."""
+SEAM = 1e-9
+"""Ends of an edge closer than this (relative to its face's size) are one point, a seam."""
 
 
 def crossings(loop: Any, lines: tuple[Sequence[float], Sequence[float]]) -> Array:
@@ -102,7 +104,9 @@ def running_space(side: Any, t: Array) -> sp.csr_matrix:
     ``u`` basis along ``v0`` / ``v1`` (where the rectangle's polygon runs along ``u``),
     its ``v`` basis along ``u0`` / ``u1``, the functions that vanish on the stretch
     dropped (the other side's trace is measured in this one's own space, as on a
-    non-conforming iso-edge)."""
+    non-conforming iso-edge). A whole edge that closes on itself (a cylinder's circle,
+    whose two ends are merged at the seam) has its first and last functions summed: the
+    merged net's trace space, so that the projected jump can vanish there too."""
     from .coupling_curves import curve_points
 
     p, d = curve_points(side.loop, t)
@@ -111,4 +115,12 @@ def running_space(side: Any, t: Array) -> sp.csr_matrix:
     x = np.clip(p[:, 0 if along_u else 1], 0.0, basis.length)
     matrix = basis.matrix(x).tocsc()
     used = np.flatnonzero(np.abs(matrix).sum(axis=0).A1 > 0)
-    return matrix[:, used].tocsr()
+    space = matrix[:, used].tocsc()
+    lo, hi = side.bounds()
+    ends = side.position(np.array([lo, hi]))[0]
+    size = float(np.ptp(side.surface.control_points.reshape(-1, 3), axis=0).max())
+    whole = abs(hi - lo - 1.0) < 1e-9 and used[0] == 0 and used[-1] == basis.size - 1
+    if whole and np.linalg.norm(ends[1] - ends[0]) <= SEAM * size and space.shape[1] > 2:
+        glued = space[:, :1] + space[:, -1:]
+        space = sp.hstack([glued, space[:, 1:-1]], format="csc")
+    return space.tocsr()
