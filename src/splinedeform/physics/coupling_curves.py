@@ -278,7 +278,8 @@ def curve_line(side_a: CurveSide, side_b: CurveSide, where: str,
             Xk = side_b.position(kinks(side_b))[0]
             corners.append(side_a.closest(Xk, None if start is None else
                                           np.interp(kinks(side_b), *_inverse(start, lo, hi))))
-        space = stretch_space(t, (lo, hi), spans, degree, np.concatenate(corners))
+        own = breaks_a if fine is side_a else np.sort(mapped)
+        space = stretch_space(t, (lo, hi), own, degree, np.concatenate(corners))
     return Line((trace_a, trace_b), weights, space.tocsr(), False), length / spans
 
 

@@ -3,13 +3,16 @@
 Along a stretch ``[t_0, t_1]`` of ``a``'s curve (:mod:`.coupling_curves`, sides with a
 part) the displacement jump ``d_a − d_b`` is penalised after its ``L²`` projection onto
 B-splines of degree ``n`` (the finer side's) on ``[t_0, t_1]``, open at both ends, with
-as many equal spans as the finer side has pieces there. A side's trace is only ``C^0``
+a simple knot at each of the finer side's knot-line crossings: that side's trace space,
+exactly where its curve is straight in its parameters (the mortar method's choice of the
+finer side's space, :func:`stretch_space`). A side's trace is only ``C^0``
 where its curve crosses a ``C^0`` knot line of its face (a knot repeated as often as the
 degree: the joints of a CAD circle's rational quadratic arcs, :func:`~.coupling.c0_lines`);
 a smooth trace space cannot follow the jump's kink there, and what it misses is left
 unpenalised, whatever the penalty factor. So each such crossing (of either side, ``b``'s
 mapped onto ``a``'s curve) is a knot of multiplicity ``n`` of the trace space, replacing
-the equal-span break nearest it when that lies within :data:`MERGE` of a span.
+the crossings within :data:`MERGE` of a mean span of it. Where one side is an iso-edge,
+its own running basis is the space (:func:`running_space`).
 """
 
 from __future__ import annotations
@@ -26,7 +29,7 @@ from .coupling import c0_lines
 
 Array = NDArray[np.float64]
 MERGE = 0.25
-"""An equal-span break closer to a kink than this fraction of a span is moved onto it."""
+"""A crossing closer to a kink than this fraction of a mean span is replaced by it."""
 SEAM = 1e-9
 """Ends of an edge closer than this (relative to its face's size) are one point, a seam."""
 
@@ -81,17 +84,20 @@ def kinks(side: Any) -> Array:
     return np.sort(every[(every > lo + 1e-9 * span) & (every < hi - 1e-9 * span)])
 
 
-def stretch_space(t: Array, part: tuple[float, float], spans: int, degree: int,
+def stretch_space(t: Array, part: tuple[float, float], breaks: Array, degree: int,
                   corners: Array) -> sp.csr_matrix:
     """The trace space at ``t`` (module docstring): open B-splines of ``degree`` on
-    ``part`` with ``spans`` equal spans and a knot of multiplicity ``degree`` at each of
-    ``corners`` (kinks in ``a``'s parameter)."""
+    ``part`` with a simple knot at each of the finer side's ``breaks`` inside it (its
+    knot-line crossings, in ``a``'s parameter) and a knot of multiplicity ``degree`` at
+    each of ``corners`` (kinks in ``a``'s parameter)."""
     lo, hi = part
-    width = (hi - lo) / spans
-    inner = lo + width * np.arange(1, spans)
-    corners = np.unique(np.round(np.asarray(corners, dtype=float) / (1e-9 * (hi - lo)))
-                        ) * (1e-9 * (hi - lo)) if len(corners) else np.zeros(0)
+    tol = 1e-9 * (hi - lo)
+    inner = np.unique(np.asarray(breaks, dtype=float))
+    inner = inner[(inner > lo + tol) & (inner < hi - tol)]
+    width = (hi - lo) / (inner.size + 1)
+    corners = np.asarray(corners, dtype=float)
     if corners.size:
+        corners = np.unique(np.round(corners / tol) * tol)
         near = np.abs(inner[:, None] - corners[None]).min(axis=1) < MERGE * width
         inner = inner[~near]
     knots = np.sort(np.concatenate([np.full(degree + 1, lo), inner,
