@@ -146,13 +146,15 @@ class Body:
 
     def conforming(self) -> Body:
         """The same body with every interface of equal degrees made conforming by exact knot
-        insertion (module docstring); interfaces of different degrees stay as they are."""
+        insertion (module docstring); interfaces of different degrees stay as they are,
+        and so do those of trimmed faces (coupled by penalties, never merged)."""
         patches = list(self.patches)
+        trims = {p for p, s in enumerate(patches) if s.trim is not None}
         for _ in range(MAX_PASSES):
             topology = find_topology(patches, self.topology.tol)
             if not insert_missing_knots(patches, [
                     i for i, aligned in zip(topology.interfaces, topology.aligned)
-                    if aligned and not i.conforming]):
+                    if aligned and not i.conforming and not {i.a, i.b} & trims]):
                 return Body(patches, None, self.topology.tol, orientation=self.orientation)
         raise InputError(f"knot insertion did not make the interfaces conform in {MAX_PASSES} "
                          "rounds; refine the patches to common knots")
