@@ -233,6 +233,8 @@ def body_report(result: RunResult) -> dict[str, Any]:
                 "faces": faces, "patches": len(body),
                 "topology": getattr(body, "counts", None) or body.summary(),
                 "interfaces": len(body.interfaces),
+                **({"trim edges": body.trim_summary()} if any(p.trim is not None for p in body)
+                   else {}),
                 "reversed": [sign < 0 for sign in orientation(result)],
                 "nets": [f"{p.shape[0]} x {p.shape[1]}" for p in body],
                 "degrees": [[p.basis_u.degree, p.basis_v.degree] for p in body],
