@@ -308,7 +308,7 @@ def test_a_drilled_box_is_a_closed_brep_its_wall_sewn_to_the_holes(tmp_path_fact
     """OpenCASCADE's box less a cylinder (tests/test_cad_step_trims.py): four planes, top
     and bottom holed (rectangles less a circle), the hole's wall a closed face. The body
     joins the planes along 12 edges and the wall along its seam; each hole's loop lies on
-    a circle of the wall (within the body's tolerance) and is sewn to it, as OpenCASCADE's
+    a circle of the wall (a trim edge the body shares with it) and is sewn to it, as OpenCASCADE's
     file has it: no naked edge, a solid."""
     pytest.importorskip("OCP", reason="the 'cad-step' extra (cadquery-ocp) is not installed")
     from occt_shapes import free_edges, read_shape
@@ -317,7 +317,9 @@ def test_a_drilled_box_is_a_closed_brep_its_wall_sewn_to_the_holes(tmp_path_fact
     source = drilled_box.__wrapped__(tmp_path_factory)
     patches, signs, units = _box_body(source)
     body = sd.Body(patches, orientation=signs)
-    assert body.summary()["boundary"] == 2             # the wall's circles, on the holes
+    # the wall's circles are the holes' trim edges, shared (coupled), not boundary edges
+    assert body.summary()["boundary"] == 0
+    assert body.trim_summary()["shared"] == 2
     brep, _, _ = only_brep(write_body_3dm(tmp_path / "drilled.3dm", patches,
                                           [s.control_points for s in patches], units=units,
                                           body=body))
