@@ -55,11 +55,12 @@ def _face_number(spec: Any) -> int:
     return int(chosen[0])
 
 
-def why_untrimmable(scenario: Any, surface: Any) -> str | None:
-    """Why the trimmed model cannot hold ``surface`` in this scenario; None when it can."""
-    if scenario.material.physics != "parametric":
-        return (f"physics {scenario.material.physics!r} is not trimmed yet (a trimmed "
-                "surface takes \"parametric\")")
+def why_untrimmable(scenario: Any, surface: Any, body: bool = False) -> str | None:
+    """Why the trimmed model cannot hold ``surface`` in this scenario; None when it can
+    (one face takes every physics; a face of a body, ``parametric`` only)."""
+    if body and scenario.material.physics != "parametric":
+        return (f"physics {scenario.material.physics!r} is not trimmed in a body of faces "
+                "yet (a trimmed face of a body takes \"parametric\")")
     return None
 
 
@@ -168,7 +169,7 @@ def with_body_trims(scenario: Any, body: Any, caught: list[warnings.WarningMessa
         else:
             if domain is None or (not domain.holes and whole_rectangle(surface, domain.outer)):
                 continue
-            reason = why_untrimmable(scenario, surface)
+            reason = why_untrimmable(scenario, surface, body=True)
         if reason is None:
             try:
                 patches[p] = equal_cell_form(surface).with_trim(domain)
