@@ -70,12 +70,13 @@ def test_refusals_name_the_problem():
         sd.Model(surface, membrane, boundary={"hole7": "clamped"})
     with pytest.raises(InputError, match="every control point is fixed"):
         sd.Model(surface, membrane, boundary="pinned", fixed=np.ones(surface.shape, bool))
-    with pytest.raises(InputError, match="parametric"):
-        sd.Model(surface, membrane, boundary="pinned", physics="intrinsic")
+    with pytest.raises(InputError, match="ShellModel"):
+        sd.Model(surface, membrane, boundary="pinned", physics="shell")
     with pytest.raises(InputError, match="rest = 'none'"):
         sd.Model(surface, membrane, boundary="pinned", rest="none")
-    with pytest.raises(InputError, match="shell is not trimmed"):
-        sd.ShellModel(surface, sd.ShellMaterial(1.0, 0.3, 0.01, 1.0))
+    with pytest.raises(InputError, match="fixed components"):
+        sd.ShellModel(surface, sd.ShellMaterial(1.0, 0.3, 0.01, 1.0),
+                      fixed=np.ones(surface.shape, bool))
     with pytest.raises(InputError, match="outside the trimmed region"):
         sd.Model(surface, membrane, boundary="pinned").static(
             sd.Point(0.05, 0.05, [0.0, 0.0, 1.0]))

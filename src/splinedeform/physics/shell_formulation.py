@@ -34,7 +34,7 @@ from .coupling_model import c0_coupling
 from .shell import ShellMaterial, matrices
 from .shell_body import body_field, body_system
 from .shell_edges import check_edges, constraint_matrix
-from .shell_rigid import RigidMotions, describe, free_rigid_motions
+from .shell_rigid import describe, free_rigid_motions
 from .shell_solution import ShellBodyReadout, ShellReadout
 from .shell_solve import dissection_ranks, static_displacement, unknown_order
 
@@ -87,7 +87,7 @@ class ShellFormulation:
         if not isinstance(material, ShellMaterial):
             raise InputError("a shell needs a ShellMaterial(E, nu, thickness, density)")
         self.material = material
-        held = False
+        motions = None
         if isinstance(surface, (Body, list, tuple)):
             if fixed is not None:
                 raise InputError("a shell body is held by its boundary edges; fixed "
@@ -106,7 +106,7 @@ class ShellFormulation:
             self.surface, self.patches, points = surface, None, surface.control_points
             self.K_full, self.M_full, self.T, self.edges = (trim.stiffness, trim.mass, trim.T,
                                                             trim.edges)
-            held = trim.holds
+            motions = trim.motions
         else:
             if isinstance(boundary, str):
                 raise InputError("a single surface's shell boundary is a mapping edge -> "
@@ -119,9 +119,8 @@ class ShellFormulation:
                 self.K_full = (self.K_full + kinks).tocsr()
             self.T = constraint_matrix(surface, self.edges, fixed)
             points = surface.control_points
-        # Nitsche's penalty on a held trim loop takes every rigid motion
-        motions = (RigidMotions(np.zeros((self.T.shape[1], 0)), np.zeros((6, 0)))
-                   if held else free_rigid_motions(self.T, points))
+        if motions is None:
+            motions = free_rigid_motions(self.T, points)
         self.rigid_basis: Array = motions.reduced
         #: words for a basis of the free rigid motions (rotation axes, translations)
         self.rigid_motions = describe(motions.twists,

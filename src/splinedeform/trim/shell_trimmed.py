@@ -42,6 +42,7 @@ import scipy.sparse as sp
 
 from ..errors import InputError
 from ..physics.shell import ShellMaterial, constitutive, strain_vectors
+from ..physics.shell_rigid import RigidMotions, free_rigid_motions
 from ..rational import refuse
 from .energy_forms import Array, Form, Geometry, energy_matrix, scalar_mass
 from .holed import with_edges
@@ -74,13 +75,24 @@ def shell_form(material: ShellMaterial) -> Form:
 @dataclass(frozen=True)
 class TrimmedShell:
     """``K``, ``M`` over the interleaved ``3N`` displacements, ``T = E ⊗ I₃``, the presets
-    of edges and loops, and whether a held loop takes the rigid motions."""
+    of edges and loops, and the free rigid motions (:func:`rigid_motions`)."""
 
     stiffness: sp.csr_matrix
     mass: sp.csr_matrix
     T: sp.csr_matrix
     edges: dict[str, str]
-    holds: bool
+    motions: RigidMotions
+
+
+def rigid_motions(T: sp.csr_matrix, points: Array, holds: bool) -> RigidMotions:
+    """The free rigid motions: none where a held loop's penalty takes them, else those in
+    ``range T`` on the control points the region moves (``T``'s nonzero rows; the others
+    stay at rest)."""
+    if holds:
+        return RigidMotions(np.zeros((T.shape[1], 0)), np.zeros((6, 0)))
+    moving = np.flatnonzero(np.diff(T.indptr)[::3] > 0)
+    rows = (3 * moving[:, None] + np.arange(3)).ravel()
+    return free_rigid_motions(T[rows], points.reshape(-1, 3)[moving])
 
 
 def trimmed_shell(surface: Any, material: ShellMaterial,
@@ -119,4 +131,4 @@ def trimmed_shell(surface: Any, material: ShellMaterial,
                       weights=net_weights_of(surface)).extension
     T = sp.kron(sp.csr_matrix(E), sp.identity(3), format="csr")
     return TrimmedShell(((K + K.T) * 0.5).tocsr(), M.tocsr(), T, {**edges, **loops},
-                        bool(held))
+                        rigid_motions(T, surface.control_points, bool(held)))
