@@ -98,7 +98,7 @@ def curved(cells, degree):
 def test_a_curved_face_holds_its_manufactured_solution():
     # quartic B-splines hold d = w², Nitsche's terms (with the metric's derivatives along
     # the loop) are consistent, so the error is that of the quadrature of the rational
-    # metric: measured 1.8e-10 on 6 × 6 cells and 3e-12 on 10 × 10 (dropping the
+    # metric: measured 1.8e-10 on 6 × 6 cells and 3.8e-12 on 10 × 10 (dropping the
     # coefficients' derivatives from the boundary terms leaves 7e-5); 1e-8 and 1e-10
     assert curved(6, 4) < 1e-8
     assert curved(10, 4) < 1e-10
