@@ -82,9 +82,19 @@ def test_refusals_name_the_problem():
             sd.Point(0.05, 0.05, [0.0, 0.0, 1.0]))
     with pytest.raises(InputError, match="reaches outside the parameter domain"):
         surface.with_trim(TrimDomain(CircleLoop((0.5, 0.5), 0.6)))
-    with pytest.raises(InputError, match="uniform or open knots"):
+    with pytest.raises(InputError, match="uniform or open knots.*closed .periodic. "
+                       "direction.*knots='open'"):
         sd.shapes.cylinder(cells=(8, 4)).with_trim(
             TrimDomain(PolygonLoop([[1, 0.5], [3, 0.5], [3, 1.5], [1, 1.5]])))
+    from splinedeform.knots import KnotVectorBasis
+
+    kinked = KnotVectorBasis(3, [0, 0, 0, 0, 0.5, 0.5, 1, 1, 1, 1])
+    bv = sd.shapes.plane(cells=(4, 4)).basis_v
+    net = np.zeros((kinked.size, bv.size, 3))
+    with pytest.raises(InputError, match=r"'kinked'.*in u .*interior knot\(s\) \[0.5\].*"
+                       "split the surface"):
+        sd.Surface(net, kinked, bv, name="kinked").with_trim(TrimDomain(CircleLoop(
+            (0.5, 0.5), 0.3)))
 
 
 def test_a_holed_rectangle_keeps_its_edges_in_the_mesh():
