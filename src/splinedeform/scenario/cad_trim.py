@@ -4,8 +4,9 @@ Face ``face`` of a ``.3dm``, STEP or IGES file is read as its whole underlying s
 its loops (:func:`splinedeform.cad_trims.read_trims`) are attached after ``elevate`` and
 ``refine`` (the loops live in parameter space, refinement does not move them), so the
 model and every output use the trimmed region only. ``surface.trimmed`` switches this:
-by default the trim is taken where the trimmed model can hold the surface (physics
-``parametric``, clamped knots with simple interior knots, not periodic;
+by default the trim is taken where the trimmed model can hold the surface (any physics
+for one face, ``parametric`` for a face of a body; clamped knots with simple interior
+knots, not periodic;
 :func:`~splinedeform.trim.surface_trim.trim_grid`) and the whole face
 is used otherwise, with one warning line naming the face and the reason; ``trimmed =
 true`` refuses such a face, ``trimmed = false`` takes the whole face without a word.

@@ -1,8 +1,8 @@
 """The Kirchhoff–Love shell (:mod:`splinedeform.physics.shell`) on a trimmed region.
 
-The shell's strains ``ε_αβ``, ``κ_αβ`` (Kiendl's, :func:`~splinedeform.physics.shell.strain_vectors`)
-and constitutive matrix ``H`` are the strain rows of an :mod:`.energy_forms` energy with
-three components, ``C = √g diag(E t/(1−ν²) H, E t³/(12(1−ν²)) H)``; membrane and bending
+The shell's strains ``ε_αβ``, ``κ_αβ`` (Kiendl's,
+:func:`~splinedeform.physics.shell.strain_vectors`) and constitutive matrix ``H`` are the
+strain rows of an :mod:`.energy_forms` energy with three components, ``C = √g diag(E t/(1−ν²) H, E t³/(12(1−ν²)) H)``; membrane and bending
 stiffness, the mass ``ρ t ∫_Ω N_k N_l dA ⊗ I₃`` and the loads (:mod:`splinedeform.loads`)
 are integrated over the trimmed cells with the parametric plate's trimmed quadrature.
 The unknowns are the interleaved displacements of the inner B-splines, ``T = E ⊗ I₃``
