@@ -26,9 +26,11 @@ the penalty holds ``d`` and ``a_3·∂_n d`` only. A pinned loop holds ``d`` (``
 the moment ``g·n``, which is natural). The penalties scale with the membrane and bending
 coefficients at each point (:func:`~.energy_forms.penalty_scales`).
 
-The rectangle's edges of a holed rectangle stay free here (the shell's edge kinds of
-:mod:`splinedeform.physics.shell_edges` are not combined with the extension yet), and
-fixed components are refused.
+The rectangle's edges ``u0 … v1`` of a holed rectangle (the outer loop is the parameter
+rectangle) take ``free``, ``pinned`` or ``clamped`` through the same Nitsche terms on the
+points of that loop (:func:`edge_nitsche`; the shell's other edge kinds of
+:mod:`splinedeform.physics.shell_edges` are not combined with the extension yet). Fixed
+components are refused.
 """
 
 from __future__ import annotations
@@ -44,11 +46,17 @@ from ..errors import InputError
 from ..physics.shell import ShellMaterial, constitutive, strain_vectors
 from ..physics.shell_rigid import RigidMotions, free_rigid_motions
 from ..rational import refuse
-from .energy_forms import Array, Form, Geometry, energy_matrix, scalar_mass
+from .energy_forms import Array, Form, Geometry, energy_matrix, nitsche_matrix, scalar_mass
 from .holed import with_edges
-from .model_matrices import _points, form_nitsche, loop_conditions, quadrature_of
-from .surface_trim import extension_knots, holed_rectangle, net_weights_of, surface_degrees
+from .model_matrices import (_cell_size, _points, form_nitsche, loop_conditions,
+                             loop_quadrature, nitsche_penalty, quadrature_of)
+from .surface_trim import (extension_knots, holed_rectangle, net_weights_of, surface_degrees,
+                           trim_grid)
 from .web import web_basis
+
+#: a point of the rectangle's loop within this fraction of its longer side from a side
+#: lies on it
+SIDE = 1e-9
 
 
 def shell_form(material: ShellMaterial) -> Form:
@@ -110,11 +118,7 @@ def trimmed_shell(surface: Any, material: ShellMaterial,
     edges, loops, held = loop_conditions(surface, "free" if boundary is None else boundary)
     rectangle = holed_rectangle(surface)
     kept = {e: k for e, k in edges.items() if k != "free"}
-    if rectangle and kept:
-        raise InputError(f"boundary {kept}: the trimmed shell holds its trim loops by "
-                         "Nitsche's method; the rectangle's edges of a holed rectangle are "
-                         "free in the shell (hold a loop, or use physics 'parametric')")
-    if held and min(degrees) < 3:
+    if (held or kept) and min(degrees) < 3:
         raise InputError("a pinned or clamped trim loop of the shell needs degree >= 3 (third "
                          f"derivatives in Nitsche's terms), got {degrees}")
     form = shell_form(material)
@@ -123,12 +127,33 @@ def trimmed_shell(surface: Any, material: ShellMaterial,
     K = energy_matrix(surface, form, points, quad.weights)
     if held:
         K = K + form_nitsche(surface, form, held)
+    if kept:
+        K = K + edge_nitsche(surface, form, edges)
     M = sp.kron(scalar_mass(surface, points, quad.weights, form.density), sp.identity(3))
-    if rectangle:
-        E, _ = with_edges(surface, edges, quad.classes, None)
+    if rectangle:                         # its edges held by Nitsche's terms, not here
+        E, _ = with_edges(surface, {e: "free" for e in edges}, quad.classes, None)
     else:
         E = web_basis(quad.classes, degrees, knots=extension_knots(surface),
                       weights=net_weights_of(surface)).extension
     T = sp.kron(sp.csr_matrix(E), sp.identity(3), format="csr")
     return TrimmedShell(((K + K.T) * 0.5).tocsr(), M.tocsr(), T, {**edges, **loops},
-                        rigid_motions(T, surface.control_points, bool(held)))
+                        rigid_motions(T, surface.control_points, bool(held or kept)))
+
+
+def edge_nitsche(surface: Any, form: Form, edges: Mapping[str, str]) -> sp.csr_matrix:
+    """Nitsche's terms of the held edges ``u0 … v1`` of a holed rectangle: the points of
+    its outer loop (the rectangle, :func:`~.model_matrices.loop_quadrature`), each with
+    the preset of the side it lies on."""
+    grid = trim_grid(surface)
+    p, ds, n, s, _, _ = loop_quadrature(surface.trim, grid, max(surface_degrees(surface)) + 2,
+                                        surface.trim.loops[:1])
+    (_, lu), (_, lv) = surface.domain
+    p = np.clip(p, 0.0, [lu, lv])
+    tol = SIDE * max(lu, lv)
+    preset = np.full(len(p), "free", dtype=object)
+    for name, on_side in (("u0", p[:, 0] < tol), ("u1", p[:, 0] > lu - tol),
+                          ("v0", p[:, 1] < tol), ("v1", p[:, 1] > lv - tol)):   # the sides
+        preset[on_side] = edges[name]
+    on = preset != "free"
+    return nitsche_matrix(surface, form, p[on], ds[on], n[on], s[on], preset[on] == "clamped",
+                          _cell_size(grid, p[on]), nitsche_penalty(max(surface_degrees(surface))))
