@@ -114,7 +114,7 @@ class BodyModel(Model):
     edge's splines (a penalised mortar condition); with bending weights, every interface
     and C0 knot line also by a penalty on the slope jump across it. The factors come from
     the material and the mesh (:mod:`splinedeform.physics.coupling_model`); the mass is
-    the patches' own. A trimmed face (``physics = "parametric"`` only) brings the matrices
+    the patches' own. A trimmed face (``parametric`` or ``intrinsic``) brings the matrices
     and the extension map of :func:`~splinedeform.trim.model_matrices.trimmed_system`,
     and the faces sharing a trim curve are coupled along it by the same penalties
     (:func:`~splinedeform.physics.coupling_curves.curve_penalty`).
@@ -150,10 +150,6 @@ class BodyModel(Model):
             check_bending(surface, material)
         trims = body.trim_interfaces
         faces = {p for p, s in enumerate(self.patches) if s.trim is not None}
-        if faces and physics != "parametric":
-            raise InputError(f"a body with trimmed faces ({sorted(faces)}) takes physics "
-                             f"'parametric' (each face's energy over its trimmed region); "
-                             f"{physics!r} is not trimmed yet")
         loops = loop_presets(self.patches, trims, boundary)
         presets = boundary_presets(edge_boundary(boundary, loops), topology)
         self.constraints = build_body_constraints(

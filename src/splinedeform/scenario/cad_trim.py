@@ -5,7 +5,7 @@ its loops (:func:`splinedeform.cad_trims.read_trims`) are attached after ``eleva
 ``refine`` (the loops live in parameter space, refinement does not move them), so the
 model and every output use the trimmed region only. ``surface.trimmed`` switches this:
 by default the trim is taken where the trimmed model can hold the surface (any physics
-for one face, ``parametric`` for a face of a body; clamped knots with simple interior
+for one face, the plate's for a face of a body; clamped knots with simple interior
 knots, not periodic;
 :func:`~splinedeform.trim.surface_trim.trim_grid`) and the whole face
 is used otherwise, with one warning line naming the face and the reason; ``trimmed =
@@ -58,10 +58,11 @@ def _face_number(spec: Any) -> int:
 
 def why_untrimmable(scenario: Any, surface: Any, body: bool = False) -> str | None:
     """Why the trimmed model cannot hold ``surface`` in this scenario; None when it can
-    (one face takes every physics; a face of a body, ``parametric`` only)."""
-    if body and scenario.material.physics != "parametric":
-        return (f"physics {scenario.material.physics!r} is not trimmed in a body of faces "
-                "yet (a trimmed face of a body takes \"parametric\")")
+    (one face takes every physics; a face of a body, the plate's ``parametric`` and
+    ``intrinsic``)."""
+    if body and scenario.material.physics == "shell":
+        return ("the shell is not trimmed in a body of faces yet (a trimmed face of a body "
+                "takes physics \"parametric\" or \"intrinsic\")")
     return None
 
 

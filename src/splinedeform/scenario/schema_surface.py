@@ -200,7 +200,7 @@ class FromCad(_Refined):
             "`hole1`, …; an outer loop that is the parameter rectangle keeps the `[boundary]` "
             "edges; `[boundary.loops]` holds the loops): `true` refuses a face the trimmed "
             "model cannot take (periodic, repeated interior knots; a face of a body under "
-            "physics other than `parametric`), `false` takes the whole underlying surface"),
+            "physics `shell`), `false` takes the whole underlying surface"),
         json_schema_extra={"doc_default": "the trim where the model can take it, else the "
                                           "whole surface with one warning"})
     faces: Optional[Union[Literal["all"], Annotated[list[FaceNumber], Field(min_length=1)],
