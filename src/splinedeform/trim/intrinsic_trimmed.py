@@ -23,8 +23,8 @@ import scipy.sparse as sp
 
 from ..material import Material
 from ..physics.intrinsic import coefficients
-from .energy_forms import Array, Form, Geometry, energy_matrix, gradient_rotation, scalar_mass
-from .model_matrices import _points, form_nitsche, quadrature_of
+from .energy_forms import Array, Form, Geometry, gradient_rotation
+from .model_matrices import form_matrices
 
 
 def intrinsic_form(material: Material) -> Form:
@@ -51,10 +51,4 @@ def intrinsic_matrices(surface: Any, material: Material,
                        held: Mapping[int, str | tuple[str, ...]]
                        ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
     """``K`` (with Nitsche's terms of the ``held`` loops) and ``M`` over the region."""
-    form = intrinsic_form(material)
-    quad = quadrature_of(surface)
-    points = _points(surface, quad)
-    K = energy_matrix(surface, form, points, quad.weights)
-    if held:
-        K = K + form_nitsche(surface, form, held)
-    return K.tocsr(), scalar_mass(surface, points, quad.weights, material.mass)
+    return form_matrices(surface, intrinsic_form(material), held)

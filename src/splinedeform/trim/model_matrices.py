@@ -46,7 +46,7 @@ from ..errors import InputError
 from ..material import Material
 from ..solvers import rigid
 from .cells import Grid, loop_pieces
-from .energy_forms import Form, nitsche_matrix
+from .energy_forms import Form, energy_matrix, nitsche_matrix, scalar_mass
 from .loops import TrimDomain
 from .quadrature import TrimQuadrature, trim_quadrature
 from .holed import holed_quadrature, with_edges
@@ -211,6 +211,19 @@ def form_nitsche(surface: Any, form: Form, held: Mapping[int, str | tuple[str, .
     on = preset != "free"
     return nitsche_matrix(surface, form, p[on], ds[on], n[on], s[on], preset[on] == "clamped",
                           _cell_size(grid, p[on]), nitsche_penalty(max(surface_degrees(surface))))
+
+
+def form_matrices(surface: Any, form: Form, held: Mapping[int, str | tuple[str, ...]]
+                  ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """``K`` of an energy :class:`~.energy_forms.Form` over the trimmed region (with
+    :func:`form_nitsche` of the ``held`` loops) and the scalar mass
+    ``ρ ∫_Ω b_k b_l √g du dv`` of its density."""
+    quad = quadrature_of(surface)
+    points = _points(surface, quad)
+    K = energy_matrix(surface, form, points, quad.weights)
+    if held:
+        K = K + form_nitsche(surface, form, held)
+    return K.tocsr(), scalar_mass(surface, points, quad.weights, form.density)
 
 
 def _rigid_count(surface: Any, material: Material, holds: bool, physics: str = "parametric"

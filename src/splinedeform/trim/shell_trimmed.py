@@ -46,10 +46,10 @@ from ..errors import InputError
 from ..physics.shell import ShellMaterial, constitutive, strain_vectors
 from ..physics.shell_rigid import RigidMotions, free_rigid_motions
 from ..rational import refuse
-from .energy_forms import Array, Form, Geometry, energy_matrix, nitsche_matrix, scalar_mass
+from .energy_forms import Array, Form, Geometry, nitsche_matrix
 from .holed import with_edges
-from .model_matrices import (_cell_size, _points, form_nitsche, loop_conditions,
-                             loop_quadrature, nitsche_penalty, quadrature_of)
+from .model_matrices import (_cell_size, form_matrices, loop_conditions, loop_quadrature,
+                             nitsche_penalty, quadrature_of)
 from .surface_trim import (extension_knots, holed_rectangle, net_weights_of, surface_degrees,
                            trim_grid)
 from .web import web_basis
@@ -122,18 +122,15 @@ def trimmed_shell(surface: Any, material: ShellMaterial,
         raise InputError("a pinned or clamped trim loop of the shell needs degree >= 3 (third "
                          f"derivatives in Nitsche's terms), got {degrees}")
     form = shell_form(material)
-    quad = quadrature_of(surface)
-    points = _points(surface, quad)
-    K = energy_matrix(surface, form, points, quad.weights)
-    if held:
-        K = K + form_nitsche(surface, form, held)
+    K, mass = form_matrices(surface, form, held)
     if kept:
         K = K + edge_nitsche(surface, form, edges)
-    M = sp.kron(scalar_mass(surface, points, quad.weights, form.density), sp.identity(3))
+    M = sp.kron(mass, sp.identity(3))
+    classes = quadrature_of(surface).classes
     if rectangle:                         # its edges held by Nitsche's terms, not here
-        E, _ = with_edges(surface, {e: "free" for e in edges}, quad.classes, None)
+        E, _ = with_edges(surface, {e: "free" for e in edges}, classes, None)
     else:
-        E = web_basis(quad.classes, degrees, knots=extension_knots(surface),
+        E = web_basis(classes, degrees, knots=extension_knots(surface),
                       weights=net_weights_of(surface)).extension
     T = sp.kron(sp.csr_matrix(E), sp.identity(3), format="csr")
     return TrimmedShell(((K + K.T) * 0.5).tocsr(), M.tocsr(), T, {**edges, **loops},
