@@ -122,8 +122,9 @@ def test_a_disc_face_as_a_shell_against_the_closed_form(folder, edge, closed_for
 def test_a_disc_face_runs_end_to_end_as_shell_and_intrinsic_plate(folder, tail, rigidity):
     # `splinedeform run` of the face clamped on its loop (12 × 12 cubic cells): the
     # report's largest displacement is the centre deflection q a⁴/(64 D) (the shell
-    # 7.5e-5 from it, the plate about as close); 1e-3. The written mesh keeps to the disc
-    # (every vertex within the radius, to the bisection's round-off of 1e-12 here)
+    # 7.5e-5 from it, the intrinsic plate 2.9e-5); 1e-3. The written mesh keeps to the
+    # disc: every vertex within the radius, to the round-off of the clipping's bisection
+    # on the file's Bézier circle (1e-12)
     import json
 
     scenario = folder / "run.toml"
