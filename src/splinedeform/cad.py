@@ -53,6 +53,8 @@ class NurbsPatch:
     weights: NDArray[np.float64]
     #: length unit of ``points`` (a key of :data:`splinedeform.cad_units.UNITS`), None: unknown
     units: str | None = None
+    #: whether its Brep marks the face reversed (outward normal ``-(S_u × S_v)``)
+    reversed: bool = False
 
     def __post_init__(self) -> None:
         check_units(self.units, "NURBS patch units")
@@ -111,7 +113,7 @@ def refine(patch: NurbsPatch, splits: int) -> NurbsPatch:
     hom = np.concatenate([patch.points * w[..., None], w[..., None]], axis=-1)
     hom = np.einsum("ai,ijc,bj->abc", Su, hom, Sv)
     return NurbsPatch(patch.degrees, fu.knots, fv.knots, hom[..., :3] / hom[..., 3:],
-                      hom[..., 3], patch.units)
+                      hom[..., 3], patch.units, patch.reversed)
 
 
 def surface_from_patch(patch: NurbsPatch, name: str = "cad surface",
@@ -140,11 +142,12 @@ def surface_from_patch(patch: NurbsPatch, name: str = "cad surface",
                                  "knots repeated degree + 1 times); general weights need "
                                  "clamped knots: re-export the surface with clamped knots")
         return Surface(np.asarray(patch.points, dtype=float), bu, bv, name=name,
-                       net_weights=w)
+                       net_weights=w, orientation=-1 if patch.reversed else 1)
     a, b = factors
     basis_u: Basis = bu if np.ptp(a) <= WEIGHT_TOL * a.max() else RationalBasis(bu, a)
     basis_v: Basis = bv if np.ptp(b) <= WEIGHT_TOL * b.max() else RationalBasis(bv, b)
-    return Surface(np.asarray(patch.points, dtype=float), basis_u, basis_v, name=name)
+    return Surface(np.asarray(patch.points, dtype=float), basis_u, basis_v, name=name,
+                   orientation=-1 if patch.reversed else 1)
 
 
 def warn_open_seams(patch: NurbsPatch, source: str = "NURBS patch") -> None:
@@ -316,4 +319,5 @@ def read_3dm(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
         raise InputError(f"{path}: face {face!r} out of range; faces are numbered from 0")
     data = read_in_child(read_3dm_arrays, path, face, library="openNURBS (rhino3dm)")
     return NurbsPatch(tuple(data["degrees"]), data["knots_u"], data["knots_v"],
-                      data["points"], data["weights"], units=data["units"])
+                      data["points"], data["weights"], units=data["units"],
+                      reversed=bool(data.get("reversed", False)))

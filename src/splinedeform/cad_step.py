@@ -2,7 +2,9 @@
 
 A :class:`~splinedeform.cad.NurbsPatch` becomes an OpenCASCADE ``Geom_BSplineSurface``
 (poles ``P_ij``, weights ``w_ij``, distinct knots with multiplicities, degrees) bounded
-by its natural edges as one face; faces are written as a compound with
+by its natural edges as one face, or, given its trim region, by wires whose edges have
+the trim loops as pcurves (:mod:`splinedeform.cad_step_trims`); a face marked reversed
+in its body is written ``TopAbs_REVERSED``. Faces are written as a compound with
 ``STEPControl_Writer`` / ``IGESControl_Writer``, in the patches' length unit (STEP
 ``LENGTH_UNIT``, IGES unit flag; millimetres when not known). Reading
 (:func:`read_step`) runs :func:`splinedeform.cad_step_read.read_arrays` in a child
@@ -15,6 +17,7 @@ from __future__ import annotations
 
 import importlib.util
 import os
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +26,7 @@ import numpy as np
 from .cad import NurbsPatch, frame_patches
 from .cad_child import check_cad_file, read_in_child
 from .cad_step_read import IGES_SUFFIXES, MISSING, STEP_SUFFIXES, ocp, read_arrays
+from .cad_step_trims import checked_signs, checked_trims, oriented, trimmed_face
 from .cad_units import millimetres, occt_name
 from .errors import InputError
 from .export.atomic import atomic_path
@@ -81,12 +85,19 @@ def bspline_surface(patch: NurbsPatch, scale: float = 1.0) -> Any:
 
 
 def write_step(path: str | os.PathLike, patches: list[NurbsPatch],
-               units: str | None = None, shell: bool = False) -> Path:
-    """Write ``patches`` as untrimmed B-spline faces of one compound to a STEP or IGES
-    file, chosen by the suffix (atomically); return its path.
+               units: str | None = None, shell: bool = False,
+               trims: Sequence[Any] | None = None,
+               orientation: Sequence[int] | None = None) -> Path:
+    """Write ``patches`` as B-spline faces of one compound to a STEP or IGES file, chosen
+    by the suffix (atomically); return its path.
 
     ``units`` (a key of :data:`splinedeform.cad_units.UNITS`; default: the first patch's,
     millimetres if that is not known) is the unit of the patches' coordinates and of the file.
+    ``trims`` gives per patch its :class:`~splinedeform.trim.loops.TrimDomain` in the
+    patch's parameters, or None: that face is bounded by its trim loops
+    (:func:`splinedeform.cad_step_trims.trimmed_face`), the others by their natural edges.
+    ``orientation`` gives per patch ``+1`` or ``-1`` (a face whose outward normal is
+    ``-(S_u × S_v)``, written ``TopAbs_REVERSED``); default ``+1``.
     With ``shell``, the faces are sewn where their edges meet (OpenCASCADE's
     ``BRepBuilderAPI_Sewing``, within :data:`SEW_TOLERANCE` of the patches' size): one
     shell whose faces share their common edges, as the body they came from.
@@ -105,14 +116,26 @@ def write_step(path: str | os.PathLike, patches: list[NurbsPatch],
     if units is None and patches:
         units = patches[0].units
     scale, name = millimetres(units), occt_name(units)
+    domains = checked_trims(trims, len(patches))
+    signs = checked_signs(orientation, len(patches))
     compound, builder = TopoDS_Compound(), BRep_Builder()
     builder.MakeCompound(compound)
-    faces = [BRepBuilderAPI_MakeFace(bspline_surface(patch, scale),
-                                     EDGE_TOLERANCE * scale).Face() for patch in patches]
+    size = _size(patches) * scale
+    faces = []
+    for k, (patch, domain, sign) in enumerate(zip(patches, domains, signs)):
+        surface = bspline_surface(patch, scale)
+        if domain is None:
+            face = BRepBuilderAPI_MakeFace(surface, EDGE_TOLERANCE * scale).Face()
+        else:
+            try:
+                face = trimmed_face(surface, domain, size)
+            except InputError as exc:
+                raise InputError(f"{path}: face {k}: {exc}") from None
+        faces.append(oriented(face, sign))
     for face in faces:
         builder.Add(compound, face)
     if shell and patches:
-        compound = _sewn(faces, patches, scale)
+        compound = _sewn(faces, size)
     with atomic_path(path) as tmp:
         if suffix in STEP_SUFFIXES:
             from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
@@ -137,12 +160,18 @@ def write_step(path: str | os.PathLike, patches: list[NurbsPatch],
     return path
 
 
-def _sewn(faces: list[Any], patches: list[NurbsPatch], scale: float) -> Any:
-    """The faces sewn into a shell (see :func:`write_step`)."""
+def _size(patches: list[NurbsPatch]) -> float:
+    """The diagonal of the patches' control points' bounding box (0 for no patch)."""
+    if not patches:
+        return 0.0
+    points = np.concatenate([np.asarray(p.points, float).reshape(-1, 3) for p in patches])
+    return float(np.linalg.norm(np.ptp(points, axis=0)))
+
+
+def _sewn(faces: list[Any], size: float) -> Any:
+    """The faces sewn into a shell (see :func:`write_step`), ``size`` in millimetres."""
     from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
 
-    points = np.concatenate([np.asarray(p.points, float).reshape(-1, 3) for p in patches])
-    size = float(np.linalg.norm(np.ptp(points, axis=0))) * scale
     sewing = BRepBuilderAPI_Sewing(SEW_TOLERANCE * max(size, 1e-300))
     for face in faces:
         sewing.Add(face)
@@ -151,11 +180,13 @@ def _sewn(faces: list[Any], patches: list[NurbsPatch], scale: float) -> Any:
 
 
 def write_frames_step(path: str | os.PathLike, surface: Any, times: Any, nets: Any,
-                      units: str | None = None) -> Path:
+                      units: str | None = None, trim: Any = None) -> Path:
     """The initial surface (face 0) and every frame ``k`` (face ``k + 1``) in one STEP or
     IGES file, same degrees, knots and weights (see :func:`splinedeform.cad.frame_patches`),
-    in ``units`` (see :func:`write_step`)."""
-    return write_step(path, frame_patches(surface, times, nets)[0], units)
+    in ``units``, each face bounded by the loops of ``trim`` (a
+    :class:`~splinedeform.trim.loops.TrimDomain`) when given (see :func:`write_step`)."""
+    patches = frame_patches(surface, times, nets)[0]
+    return write_step(path, patches, units, trims=[trim] * len(patches))
 
 
 def read_step(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
@@ -175,4 +206,5 @@ def read_step(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
         raise InputError(f"{path}: face {face!r} out of range; faces are numbered from 0")
     data = read_in_child(read_arrays, path, face, library="OpenCASCADE")
     return NurbsPatch(tuple(data["degrees"]), data["knots_u"], data["knots_v"],
-                      data["points"], data["weights"], units=data["units"])
+                      data["points"], data["weights"], units=data["units"],
+                      reversed=bool(data.get("reversed", False)))

@@ -47,8 +47,9 @@ class Body:
         (:func:`~.trimmed.find_trim_interfaces`) if not given.
     orientation : sequence of {+1, -1}, optional
         Per patch the sign ``s`` that makes ``s x_u × x_v`` the body's normal (a CAD face
-        marked reversed in its Brep has ``-1``); a pressure pushes along it. Default
-        ``+1`` for every patch. The parametrisations are left as they are.
+        marked reversed in its Brep has ``-1``); a pressure pushes along it. Default: each
+        patch's own :attr:`~splinedeform.Surface.orientation` (``+1`` unless it was read
+        reversed). The parametrisations are left as they are.
 
     Trimmed faces (``surface.trim``) meet along their trim curves: pairs of loops tracing
     one curve are found geometrically (:mod:`.trimmed`), :attr:`trim_interfaces`.
@@ -68,7 +69,9 @@ class Body:
                  trim_interfaces: Sequence[TrimInterface] | None = None,
                  orientation: Sequence[int] | None = None):
         self.patches: tuple[Surface, ...] = tuple(patches)
-        self.orientation: tuple[int, ...] = _orientation(orientation, len(self.patches))
+        self.orientation: tuple[int, ...] = _orientation(
+            [getattr(s, "orientation", 1) for s in self.patches] if orientation is None
+            else orientation, len(self.patches))
         found = without_trimmed_edges(self.patches, find_topology(self.patches, tol))
         if interfaces is None:
             self.topology = found

@@ -72,8 +72,9 @@ class ShellModel(Model):
     ----------
     surface : Surface, or Body (or list of Surface)
         One patch, or a body of patches deformed as one shell (:mod:`.shell_body`:
-        conforming interfaces merged, non-conforming ones and every interface's rotation
-        coupled by penalties).
+        conforming interfaces merged, their slopes tied where the rest shape is smooth
+        across them, the others and every crease coupled by penalties); general NURBS
+        weights (``net_weights``) included.
     material : ShellMaterial
     boundary : mapping edge -> kind, optional
         See the module docstring; missing edges are free. For a body one kind for every

@@ -195,9 +195,6 @@ def check_body_scenario(scenario: Scenario, body: FileBody) -> None:
         if ext not in BODY_FORMATS:
             raise s.error("output.formats", f"{ext} is not written for a body of "
                           f"{len(body)} faces yet; a body writes {', '.join(BODY_FORMATS)}")
-    if s.output.animate_modes not in (None, (1,)):
-        raise s.error("output.animate_modes", "a body animates its lowest mode (as the "
-                      "gif / mp4 of a modes solve); its other modes are not animated yet")
     for i, spec in enumerate(s.loads, start=1):
         if spec.face is None:
             if spec.kind == "point":

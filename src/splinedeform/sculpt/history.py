@@ -113,7 +113,8 @@ def _baked_body(scenario: Scenario, basis: SculptBasis, nets: list[NDArray[np.fl
     from ..export.body import write_body_step
 
     faces = list(getattr(basis.model.body, "faces", range(len(basis.patches))))
-    write_body_step(path, basis.patches, nets, basis.units, shell=True)
+    write_body_step(path, basis.patches, nets, basis.units, shell=True,
+                    orientation=getattr(basis.model.body, "orientation", None))
     number = {face: patch for patch, face in enumerate(faces)}
     overrides: dict[str, Any] = {"surface": {"shape": "cad", "path": path.name, "faces": "all"}}
     named = scenario.raw.get("boundary", {}).get("faces")

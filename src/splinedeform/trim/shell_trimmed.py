@@ -107,7 +107,7 @@ def trimmed_shell(surface: Any, material: ShellMaterial,
                   boundary: str | Mapping[str, str] | None, fixed: Any = None) -> TrimmedShell:
     """The shell of a trimmed surface (module docstring); ``boundary`` names its loops
     (``{"outer": "clamped", "hole1": "free"}``, or one preset for every loop)."""
-    refuse(surface, "the trimmed Kirchhoff–Love shell")
+    refuse(surface, "the trimmed Kirchhoff–Love shell")      # general weights: not yet
     degrees = surface_degrees(surface)
     if min(degrees) < 2:
         raise InputError("the Kirchhoff–Love shell needs degree >= 2 in u and v (curvatures)")
