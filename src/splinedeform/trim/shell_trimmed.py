@@ -45,7 +45,6 @@ import scipy.sparse as sp
 from ..errors import InputError
 from ..physics.shell import ShellMaterial, constitutive, strain_vectors
 from ..physics.shell_rigid import RigidMotions, free_rigid_motions
-from ..rational import refuse
 from .energy_forms import Array, Form, Geometry, nitsche_matrix
 from .holed import with_edges
 from .model_matrices import (_cell_size, form_matrices, loop_conditions, loop_quadrature,
@@ -107,7 +106,10 @@ def trimmed_shell(surface: Any, material: ShellMaterial,
                   boundary: str | Mapping[str, str] | None, fixed: Any = None) -> TrimmedShell:
     """The shell of a trimmed surface (module docstring); ``boundary`` names its loops
     (``{"outer": "clamped", "hole1": "free"}``, or one preset for every loop)."""
-    refuse(surface, "the trimmed Kirchhoff–Love shell")      # general weights: not yet
+    if surface.net_weights is not None:
+        raise InputError(f"the trimmed Kirchhoff–Love shell does not take NURBS weights that "
+                         f"are not a product w_kl = a_k b_l yet (surface {surface.name!r}); "
+                         "the untrimmed shell and the trimmed plate do")
     degrees = surface_degrees(surface)
     if min(degrees) < 2:
         raise InputError("the Kirchhoff–Love shell needs degree >= 2 in u and v (curvatures)")
