@@ -107,7 +107,8 @@ def test_refusals_name_the_problem():
         ShellModel(disc, MATERIAL, {"hole7": "clamped"})
     from dataclasses import replace
 
-    weighted = replace(plane, net_weights=1 + 0.1 * plane.control_points[..., 0])
+    opened = sd.shapes.plane(cells=(6, 6), degree=3, knots="open")
+    weighted = replace(opened, net_weights=1 + 0.1 * opened.control_points[..., 0])
     with pytest.raises(sd.InputError, match="not a product"):
         ShellModel(weighted.with_trim(TrimDomain(CircleLoop((0.5, 0.5), A))), MATERIAL,
                    {"outer": "clamped"})
