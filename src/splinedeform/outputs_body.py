@@ -8,8 +8,8 @@
 * ``json`` / ``npz``: ``name_nets.json`` / ``.npz``, every face's nets in every frame keyed
   by its face number, each marked ``reversed`` or not (:mod:`splinedeform.export.body_nets`);
 * ``3dm``, ``step``, ``iges``: the deformed body's faces in the file's unit (the ``.3dm``
-  one named surface per face, STEP / IGES sewn into one shell, trimmed faces bounded by
-  their trim loops and reversed faces reversed);
+  one Brep with the body's topology, its faces named, STEP / IGES sewn into one shell,
+  trimmed faces bounded by their trim loops and reversed faces reversed);
 * ``images``: ``surfaces.png`` (every face at rest and at the frame of largest
   displacement, one welded mesh), ``probes.png`` for a dynamic solve (the probes),
   ``modes.png`` for modes (every mode of the whole body, :func:`splinedeform.viz.
@@ -130,8 +130,9 @@ def write_body_files(result: RunResult, folder: Path, stages: Stages) -> None:
                 result.outputs.append((f"control nets {path.suffix}", path))
     if "3dm" in formats:
         with stages.stage("CAD surfaces"):
-            result.outputs.append(("NURBS surfaces .3dm", body_files.write_body_3dm(
-                folder / f"{name}.3dm", patches, deformed_nets(result), names, units)))
+            result.outputs.append(("NURBS Brep .3dm", body_files.write_body_3dm(
+                folder / f"{name}.3dm", patches, deformed_nets(result), names, units,
+                body=body, name=name)))
     for ext, suffix in _suffixes().items():
         if ext in formats:
             with stages.stage(f"CAD surfaces {suffix}"):
@@ -232,6 +233,8 @@ def body_report(result: RunResult) -> dict[str, Any]:
                 "faces": faces, "patches": len(body),
                 "topology": getattr(body, "counts", None) or body.summary(),
                 "interfaces": len(body.interfaces),
+                **({"trim edges": body.trim_summary()} if any(p.trim is not None for p in body)
+                   else {}),
                 "reversed": [sign < 0 for sign in orientation(result)],
                 "nets": [f"{p.shape[0]} x {p.shape[1]}" for p in body],
                 "degrees": [[p.basis_u.degree, p.basis_v.degree] for p in body],

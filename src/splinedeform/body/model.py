@@ -69,7 +69,8 @@ class BodyModel(Model):
     the patches' own. A trimmed face (``parametric`` or ``intrinsic``) brings the matrices
     and the extension map of :func:`~splinedeform.trim.model_matrices.trimmed_system`,
     and the faces sharing a trim curve are coupled along it by the same penalties
-    (:func:`~splinedeform.physics.coupling_curves.curve_penalty`).
+    (:func:`~splinedeform.physics.coupling_curves.curve_penalty`), those sharing a
+    stretch of a trim edge along it (:func:`~.trim_edges.edge_penalty`).
 
     Examples
     --------

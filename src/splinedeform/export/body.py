@@ -1,7 +1,7 @@
 """Outputs of a body: every patch's deformed net in one file.
 
-* ``.3dm``: one NURBS surface per patch, named, in the body's unit
-  (:func:`splinedeform.cad.write_3dm`);
+* ``.3dm``: one Brep, a face per patch, its edges joined where the patches meet, in the
+  body's unit (:func:`splinedeform.cad.write_3dm`, :mod:`splinedeform.cad_brep_3dm`);
 * STEP / IGES: one B-spline face per patch in one file, bounded by its trim loops where
   it is trimmed and reversed where the body's orientation says so, sewn into a shell
   where the patches meet (:func:`splinedeform.cad_step.write_step`);
@@ -22,13 +22,15 @@
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import InputError
+from ..errors import InputError, InputWarning
 from ..surface import Surface
 from .atomic import _check_stem, write_text
 from .frames import check_frames, check_net, tessellate_frames
@@ -60,13 +62,30 @@ def body_patches(surfaces: Sequence[Surface], nets: Sequence[ArrayLike],
 
 def write_body_3dm(path: str | os.PathLike, surfaces: Sequence[Surface],
                    nets: Sequence[ArrayLike], names: Sequence[str] | None = None,
-                   units: str | None = None) -> Path:
-    """Every patch with its net as a named NURBS surface of one ``.3dm`` file, in
-    ``units`` (the file's ``ModelUnitSystem``); names default to the surfaces' names."""
+                   units: str | None = None, body: Any = None, name: str = "body") -> Path:
+    """Every patch with its net as a face of one Brep named ``name`` in a ``.3dm`` file,
+    its edges joined where the patches meet, in ``units`` (the file's
+    ``ModelUnitSystem``); the faces' names (default: the surfaces') are the Brep's user
+    strings ``splinedeform.face k``. The topology is ``body``'s (a
+    :class:`~splinedeform.body.Body` of ``surfaces``), found from the surfaces when not
+    given; where no Brep can be formed, one named NURBS surface per patch, with a warning
+    (:func:`splinedeform.cad.write_3dm`)."""
+    from ..body import Body
     from ..cad import write_3dm
+    from ..cad_brep_3dm import BrepTopology
 
     names = [s.name for s in surfaces] if names is None else list(names)
-    return write_3dm(path, body_patches(surfaces, nets, units), names=names, units=units)
+    patches = body_patches(surfaces, nets, units)
+    trims = [getattr(s, "trim", None) for s in surfaces]
+    topology = None
+    try:
+        topology = BrepTopology.of(Body(surfaces) if body is None else body, name)
+    except InputError as exc:
+        warnings.warn(f"the body is written as {len(patches)} separate surfaces, not one "
+                      f"Brep: its topology could not be found: {exc}", InputWarning,
+                      stacklevel=2)
+    return write_3dm(path, patches, names=names, units=units, body=topology,
+                     trims=trims if any(t is not None for t in trims) else None)
 
 
 def write_body_step(path: str | os.PathLike, surfaces: Sequence[Surface],

@@ -9,7 +9,8 @@ face's :func:`~splinedeform.trim.model_matrices.trimmed_system`), so that
 
 where ``K_coupling`` is the penalty coupling each non-conforming interface and, with
 bending, the rotation across every interface and C0 line (:mod:`.coupling_model`), and
-the penalty along each trim curve two faces share (:mod:`.coupling_curves`). The
+the penalty along each trim curve two faces share (:mod:`.coupling_curves`) and along
+each stretch of trim edges they share (:mod:`splinedeform.body.trim_edges`). The
 constraint map ``d = T d_free`` of :mod:`splinedeform.body.constraints` merges the control
 points of conforming interfaces and poles, ties the slopes across smooth ones and applies
 the edge conditions of boundary edges: ``K_r = Tᵀ K T``, ``M_r = Tᵀ M T``, ``F_r = Tᵀ F``
@@ -38,6 +39,7 @@ from ..body.body import Body
 from ..body.constraints import BodyConstraints, boundary_presets, build_body_constraints
 from ..body.interface import EDGES
 from ..body.loads import OnPatch, along_normal
+from ..body.trim_edges import edge_penalty
 from ..body.trimmed import edge_boundary, face_boundary, loop_presets, with_trimmed_faces
 from ..errors import InputError
 from ..loads import Point
@@ -109,7 +111,7 @@ def body_system(body: Body, material: Material,
         check_bending(surface, material)
     trims = body.trim_interfaces
     faces = {p for p, s in enumerate(patches) if s.trim is not None}
-    loops = loop_presets(patches, trims, boundary)
+    loops = loop_presets(patches, trims, boundary, body.edge_interfaces)
     presets = boundary_presets(edge_boundary(boundary, loops), topology)
     constraints = build_body_constraints(
         patches, topology, {k: "free" if k[0] in faces else v for k, v in presets.items()},
@@ -132,7 +134,8 @@ def body_system(body: Body, material: Material,
               for p, s in enumerate(patches)]
     K = sp.block_diag([k for k, _ in blocks], format="csr")
     M = sp.block_diag([m for _, m in blocks], format="csr")
-    for penalty in couplings(patches, topology, trims, material, constraints):
+    for penalty in couplings(patches, topology, trims, material, constraints,
+                             body.edge_interfaces):
         K = (K + penalty).tocsr()
     formulation = PlateFormulation(physics, material, patches=patches,
                                    reduction_type=partial(BodyReduction,
@@ -144,16 +147,19 @@ def body_system(body: Body, material: Material,
 
 
 def couplings(patches: Sequence[Surface], topology: Any, trims: Sequence[Any],
-              material: Material, constraints: BodyConstraints) -> list[sp.spmatrix]:
+              material: Material, constraints: BodyConstraints,
+              stretches: Sequence[Any] = ()) -> list[sp.spmatrix]:
     """The penalties of ``K_coupling`` (module docstring): across the interfaces, along the
-    shared trim curves and across each patch's C0 lines, leaving out the slopes that the
-    constraint map ties exactly (``constraints.ties``)."""
+    shared trim curves and the shared stretches of trim edges (``stretches``,
+    :func:`~splinedeform.body.trim_edges.edge_penalty`) and across each patch's C0 lines,
+    leaving out the slopes that the constraint map ties exactly (``constraints.ties``)."""
     offsets = constraints.offsets
     size = int(offsets[-1])
     ties = constraints.ties
     terms = [interface_coupling(patches, topology.interfaces, material, constraints.edges,
                                 offsets[:-1], ties.interfaces)]
     terms += [curve_penalty(patches, i, material, offsets[:-1]) for i in trims]
+    terms += [edge_penalty(patches, i, material, offsets[:-1]) for i in stretches]
     terms += [c0_coupling(s, material, {e: constraints.edges.get((p, e), "free")
                                         for e in EDGES}, int(offsets[p]), size,
                           {(d, k) for q, d, k in ties.lines if q == p})
@@ -182,7 +188,8 @@ def rigid_count(body: Body, material: Material, constraints: BodyConstraints) ->
     else:
         return None
     n = len(body.patches)
-    links = [(i.a, i.b) for i in body.topology.interfaces + body.trim_interfaces] or [(0, 0)]
+    links = [(i.a, i.b) for i in body.topology.interfaces + body.trim_interfaces
+             + body.edge_interfaces] or [(0, 0)]
     graph = sp.coo_matrix((np.ones(len(links)), np.array(links).T), shape=(n, n))
     parts, label = connected_components(graph, directed=False)
     held = np.zeros(parts, dtype=bool)

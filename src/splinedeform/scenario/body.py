@@ -314,6 +314,9 @@ def describe_body(built: Any) -> list[tuple[str, str]]:
     rows = [("faces", f"{len(body)} ({', '.join(str(f) for f in body.faces)})"),
             ("control nets", f"{points} points in {len(body)} nets"),
             ("edges", ", ".join(f"{v} {k.replace('_', '-')}" for k, v in counts.items())),
+            *([("trim edges", "{shared} shared, {free} free, {stretches} stretches coupled"
+                .format(**body.trim_summary()))] if any(s.trim is not None for s in body)
+              else []),
             (getattr(built.model, "unknowns_label", "free control points"),
              str(built.model.n_free))]
     return rows + ([("length unit", built.units)] if built.units is not None else [])
