@@ -1,5 +1,7 @@
 """The parametric energy of a trimmed surface: matrices over the trimmed region, the WEB
-map as constraint map, and Nitsche's terms for the held trim loops.
+map as constraint map, and Nitsche's terms for the held trim loops; the loops' conditions,
+quadrature and penalty that the intrinsic plate and the shell share with it
+(:func:`loop_conditions`, :func:`form_matrices`, :mod:`.energy_forms`).
 
 With the surface's B-splines ``b_k`` (tensor, row-major ``k = i n_v + j``) and the
 trimmed quadrature ``(x_q, ω_q)`` of :func:`~splinedeform.trim.quadrature.trim_quadrature`
