@@ -237,16 +237,22 @@ def test_a_loop_along_the_far_side_of_the_box(trimmed_plane):
     assert quadrature_of(built.surface).weights.sum() == pytest.approx(4.0, rel=1e-12)
 
 
-def test_a_face_the_trimmed_model_cannot_take(trimmed_plane):
-    shell = 'physics = "intrinsic"'
-    built, said = _built(trimmed_plane, physics=shell)
-    whole = [s for s in said if "whole underlying surface" in s]
-    assert len(whole) == 1 and "face 0" in whole[0] and "intrinsic" in whole[0]
-    assert built.surface.trim is None
+def test_a_face_the_trimmed_model_cannot_take(trimmed_plane, monkeypatch):
+    # every physics takes a trimmed face now; a face the model cannot hold (here one
+    # made so) is taken whole with one warning line, or refused under trimmed = true
+    built, said = _built(trimmed_plane, physics='physics = "intrinsic"')
+    assert built.surface.trim is not None
+    assert not [s for s in said if "whole underlying surface" in s]
     from splinedeform.errors import ScenarioError
+    from splinedeform.scenario import cad_trim
 
+    monkeypatch.setattr(cad_trim, "why_untrimmable", lambda *a, **k: "a reason")
+    built, said = _built(trimmed_plane)
+    whole = [s for s in said if "whole underlying surface" in s]
+    assert len(whole) == 1 and "face 0" in whole[0] and "a reason" in whole[0]
+    assert built.surface.trim is None
     with pytest.raises(ScenarioError, match="surface.trimmed"):
-        _built(trimmed_plane, switch="trimmed = true", physics=shell)
+        _built(trimmed_plane, switch="trimmed = true")
     built, said = _built(trimmed_plane, switch="trimmed = false")
     assert built.surface.trim is None
     assert not [s for s in said if "whole underlying surface" in s]

@@ -72,8 +72,9 @@ class Model:
         ``parametric``: the paper's energy per unit parameter area (Kronecker matrices);
         ``intrinsic``: the same plate under tension measured on the initial surface
         (:mod:`splinedeform.physics.intrinsic`), independent of the parametrisation.
-        A trimmed surface (``surface.trim``) takes ``parametric`` over its trimmed region
-        (:mod:`splinedeform.trim.model_matrices`), with ``boundary`` naming its loops
+        A trimmed surface (``surface.trim``) takes either over its trimmed region
+        (:mod:`splinedeform.trim.model_matrices`, :mod:`splinedeform.trim.intrinsic_trimmed`;
+        the shell's is :mod:`splinedeform.trim.shell_trimmed`), with ``boundary`` naming its loops
         (``{"outer": "clamped", "hole1": "free"}``). With bending weights, the tangent
         continuity across each C0 knot line where the rest shape is smooth is imposed
         exactly by the constraint map (:mod:`splinedeform.physics.coupling_ties`), the

@@ -66,7 +66,7 @@ class BodyModel(Model):
     edge's splines (a penalised mortar condition); with bending weights, every interface
     and C0 knot line also by a penalty on the slope jump across it. The factors come from
     the material and the mesh (:mod:`splinedeform.physics.coupling_model`); the mass is
-    the patches' own. A trimmed face (``physics = "parametric"`` only) brings the matrices
+    the patches' own. A trimmed face (``parametric`` or ``intrinsic``) brings the matrices
     and the extension map of :func:`~splinedeform.trim.model_matrices.trimmed_system`,
     and the faces sharing a trim curve are coupled along it by the same penalties
     (:func:`~splinedeform.physics.coupling_curves.curve_penalty`), those sharing a

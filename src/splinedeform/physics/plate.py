@@ -160,8 +160,8 @@ def surface_system(surface: Surface, material: Material, boundary: str | Mapping
                                    unconstrained=constraints.unconstrained)
     general = surface.net_weights is not None         # weights that do not factor
     gram_u, gram_v = (None, None) if general else gram_matrices(surface)
-    full = (intrinsic.matrices(surface, material, lumped) if physics == "intrinsic"
-            else (trimmed.stiffness, trimmed.mass) if trimmed
+    full = ((trimmed.stiffness, trimmed.mass) if trimmed
+            else intrinsic.matrices(surface, material, lumped) if physics == "intrinsic"
             else patch_matrices(surface, material, physics, lumped)[2:] if general else None)
     tied: set[tuple[str, float]] = set()
     if not trimmed and bends(material):    # smooth C0 lines: C1 in the constraint map

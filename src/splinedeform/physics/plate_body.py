@@ -101,9 +101,8 @@ def body_system(body: Body, material: Material,
     Raises
     ------
     InputError
-        A non-manifold edge or an interface not parametrised alike (:func:`refuse`),
-        trimmed faces under a physics other than ``parametric``, or a boundary that fixes
-        every control point.
+        A non-manifold edge or an interface not parametrised alike (:func:`refuse`), or a
+        boundary that fixes every control point.
     """
     topology = body.topology
     refuse(topology)
@@ -112,10 +111,6 @@ def body_system(body: Body, material: Material,
         check_bending(surface, material)
     trims = body.trim_interfaces
     faces = {p for p, s in enumerate(patches) if s.trim is not None}
-    if faces and physics != "parametric":
-        raise InputError(f"a body with trimmed faces ({sorted(faces)}) takes physics "
-                         f"'parametric' (each face's energy over its trimmed region); "
-                         f"{physics!r} is not trimmed yet")
     loops = loop_presets(patches, trims, boundary, body.edge_interfaces)
     presets = boundary_presets(edge_boundary(boundary, loops), topology)
     constraints = build_body_constraints(

@@ -94,6 +94,7 @@ class ShellFormulation:
         if not isinstance(material, ShellMaterial):
             raise InputError("a shell needs a ShellMaterial(E, nu, thickness, density)")
         self.material = material
+        motions = None
         if isinstance(surface, (Body, list, tuple)):
             if fixed is not None:
                 raise InputError("a shell body is held by its boundary edges; fixed "
@@ -106,10 +107,17 @@ class ShellFormulation:
                                                             system.edges)
             self.ties = system.ties
             points = np.concatenate([s.control_points.reshape(-1, 3) for s in self.patches])
+        elif getattr(surface, "trim", None) is not None:     # loops held by Nitsche
+            from ..trim.shell_trimmed import trimmed_shell
+
+            trim = trimmed_shell(surface, material, boundary, fixed)
+            self.surface, self.patches, points = surface, None, surface.control_points
+            self.K_full, self.M_full, self.T, self.edges = (trim.stiffness, trim.mass, trim.T,
+                                                            trim.edges)
+            motions = trim.motions
+            self.ties = smooth_ties([surface], (), np.array([0, surface.shape[0]
+                                                             * surface.shape[1]]))
         else:
-            if getattr(surface, "trim", None) is not None:
-                raise InputError("the shell is not trimmed yet: a trimmed surface takes the "
-                                 "parametric Model (docs/trim.md)")
             if isinstance(boundary, str):
                 raise InputError("a single surface's shell boundary is a mapping edge -> "
                                  f"kind, got {boundary!r}")
@@ -125,7 +133,8 @@ class ShellFormulation:
             # the slopes tied exactly across each smooth C0 line
             self.T = tie_components(constraint_matrix(surface, self.edges, fixed), self.ties.C)
             points = surface.control_points
-        motions = free_rigid_motions(self.T, points)
+        if motions is None:
+            motions = free_rigid_motions(self.T, points)
         self.rigid_basis: Array = motions.reduced
         #: words for a basis of the free rigid motions (rotation axes, translations)
         self.rigid_motions = describe(motions.twists,

@@ -45,6 +45,12 @@ class AreaForce(Load):
         object.__setattr__(self, "profile", _profile(self.profile))
 
     def field_vector(self, surface: Surface, t: float = 0.0) -> Array:
+        if surface.trim is not None:             # over the trimmed region, dA = √g du dv
+            from ..loads import project
+
+            return project(surface, lambda U, V: np.linalg.norm(np.cross(
+                surface.derivative(U, V, 1, 0), surface.derivative(U, V, 0, 1)),
+                axis=-1)[..., None] * np.asarray(self.force, dtype=float))
         G = metric.grid(surface, extra_points=1)
         N = metric.shape_derivatives(G)[0, 0]
         index = metric.global_index(G, surface.basis_v.size)
