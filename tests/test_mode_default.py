@@ -233,3 +233,27 @@ def test_a_time_just_after_a_jump_is_met_by_the_transient_correction(monkeypatch
     largest = np.abs(full.control_points(np.linspace(0.0, 4.0, 201)) - rest).max()
     # the default: largest coordinate error <= 1e-8 of the largest displacement
     assert np.abs(net - reference).max() / largest <= modal_solve.DEFAULT_TOLERANCE
+
+
+def test_frames_near_a_jump_are_met_with_fewer_modes_than_the_over_damped_range():
+    """The cost study's frames (200 on [0, t_end], the first t_end/398 after the
+    switch-off) on the 24² plate: one basis serves them all (chosen also half a spacing
+    after each jump), its count below the first over-damped mode (the transient
+    correction of under-damped omitted modes), and every frame within DEFAULT_TOLERANCE
+    of all modes (dense eigh, exact to round-off) relative to the largest displacement."""
+    from splinedeform.solvers.transient_correction import over_damped_from
+
+    material, load, options, cells = CASES["plate, point force on and off"]
+    surf = sd.shapes.plane(cells=(cells, cells))
+    sol = sd.Model(surf, material, **options).dynamic(load, 4.0)
+    frames = np.linspace(0.0, 4.0, 200)
+    net = sol.control_points(frames)
+    assert sol.finer is None                           # no second basis for the frames
+    assert sol.truncation["correction_degree"] > 0
+    # the first omitted mode is under-damped (λ_{m+1} < λ_o, here by a factor of 4 or more)
+    assert sol.truncation["omega_first_omitted"] ** 2 < 0.25 * over_damped_from(0.8, 5e-4)
+    full = sd.Model(surf, material, **options).dynamic(load, 4.0, modes="all")
+    reference = full.control_points(frames)
+    rest = surf.control_points
+    error = np.abs(net - reference).max() / np.abs(reference - rest).max()
+    assert error <= modal_solve.DEFAULT_TOLERANCE
