@@ -39,6 +39,7 @@ the bound is the static one.
 
 from __future__ import annotations
 
+import functools
 from typing import Callable
 
 import numpy as np
@@ -111,6 +112,21 @@ def over_damped_from(gamma: float, beta: float) -> float:
     return 0.0 if disc < 0 or b < 0 else (b + np.sqrt(disc)) / (2.0 * beta * beta)
 
 
+@functools.lru_cache(maxsize=8)
+def _fit_tables(degree: int) -> tuple[Array, Array, Array, Array]:
+    """``(nodes, pinv, check, at_check)``: the :data:`FIT` Chebyshev points of ``x``, the
+    least-squares map from values there to coefficients, the :data:`CHECK` points and
+    ``T_k(2x − 1)`` at them (the same for every cut-off and time; read-only)."""
+    nodes = 0.5 * (1.0 - np.cos(np.pi * (np.arange(FIT) + 0.5) / FIT))
+    check = np.unique(np.concatenate([np.linspace(0.0, 1.0, CHECK // 2),
+                                      np.geomspace(1e-14, 1.0, CHECK // 2)]))
+    tables = (nodes, np.linalg.pinv(_chebyshev(nodes, degree)), check,
+              _chebyshev(check, degree))
+    for table in tables:
+        table.flags.writeable = False
+    return tables
+
+
 def fitted(lam_next: float, gamma: float, beta: float, tau: Array, degree: int = DEGREE
            ) -> tuple[Array, Array]:
     """``(c, E)``: the coefficients ``c[k, u]`` of ``p_τ`` at ``tau[u]`` and the bound
@@ -135,11 +151,8 @@ def fitted(lam_next: float, gamma: float, beta: float, tau: Array, degree: int =
     c = np.zeros((degree + 1, tau.size))
     if not beta > 0 or not np.isfinite(lam_next):
         return c, static_error
-    nodes = 0.5 * (1.0 - np.cos(np.pi * (np.arange(FIT) + 0.5) / FIT))
-    check = np.unique(np.concatenate([np.linspace(0.0, 1.0, CHECK // 2),
-                                      np.geomspace(1e-14, 1.0, CHECK // 2)]))
+    nodes, pinv, check, at_check = _fit_tables(degree)
     safe = np.where(check > 0, check, 1.0)  # x = 0 is set below
-    pinv = np.linalg.pinv(_chebyshev(nodes, degree))
 
     def response(lam: Array) -> Array:
         return free_response(lam, gamma, beta, tau[None, :])
@@ -147,7 +160,7 @@ def fitted(lam_next: float, gamma: float, beta: float, tau: Array, degree: int =
     fit = pinv @ response(lam_next / nodes[:, None])
     exact = response(lam_next / safe[:, None])
     exact[check == 0] = np.exp(-tau / beta)  # λ → ∞: P_11 → e^{−τ/β}
-    fit_error = MARGIN * np.abs(_chebyshev(check, degree) @ fit - exact).max(axis=0) + ROUNDING
+    fit_error = MARGIN * np.abs(at_check @ fit - exact).max(axis=0) + ROUNDING
     better = fit_error < static_error
     c[:, better] = fit[:, better]
     return c, np.where(better, fit_error, static_error)
