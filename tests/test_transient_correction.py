@@ -130,6 +130,7 @@ def test_the_sampled_fit_error_bounds_its_supremum(gamma, beta):
             for u, tau in enumerate(taus):
                 if not np.any(coef[:, u]):
                     continue                           # the static bound: not a fit
-                exact = np.where(x > 0, free_response(lam, gamma, beta, tau), np.exp(-tau / beta))
+                exact = np.where(x > 0, free_response(lam, gamma, beta, tau),
+                                 np.exp(-tau / beta))
                 sup = np.abs(_chebyshev(x, degree) @ coef[:, u] - exact).max()
                 assert sup <= E[u], (lam_next, degree, tau)

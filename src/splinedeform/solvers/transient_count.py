@@ -24,7 +24,8 @@ Array = NDArray[np.float64]
 def transient_bound(norms: Array, jump_times: Array, lam_next: float, gamma: float,
                     beta: float, times: Array, degree: int = DEGREE) -> Array:
     """``Σ_j ‖R_j‖_M E_d(λ_{m+1}, t − t_j) H(t − t_j)`` for rows of ``norms`` (``(r, J)``)
-    at ``times`` → ``(r, T)``: the bound of :class:`.transient_correction.TransientCorrection`."""
+    at ``times`` → ``(r, T)``: the bound of
+    :class:`.transient_correction.TransientCorrection`."""
     tau = times[None, :] - np.asarray(jump_times, dtype=float)[:, None]       # (J, T)
     out = np.zeros((norms.shape[0], times.size))
     on = tau > 0
@@ -67,8 +68,8 @@ def over_damped_count(k: int, lam: Array, gamma: float, beta: float) -> int:
 
 
 def transient_count(upto: int, lam: Array, norms: Array, jump_times: Array, gamma: float,
-                     beta: float, times: Array, weight: float, tolerance: float,
-                     static: Array) -> tuple[int, float] | None:
+                    beta: float, times: Array, weight: float, tolerance: float,
+                    static: Array) -> tuple[int, float] | None:
     """Fewer modes than ``upto + 1`` whose bound with the transient correction
     (:func:`transient_bound`) meets ``tolerance`` at ``times``: ``(m, bound)``, or ``None``.
 
@@ -118,16 +119,16 @@ def transient_count(upto: int, lam: Array, norms: Array, jump_times: Array, gamm
 
 
 def transient_grown(k: int, lam: Array, norms: Array, jump_times: Array, gamma: float,
-                     beta: float, times: Array, weight: float, tolerance: float,
-                     static: Array) -> float:
+                    beta: float, times: Array, weight: float, tolerance: float,
+                    static: Array) -> float:
     """The estimate of the modes the transient correction needs, from ``k + 1`` computed
     (``inf`` when no cut-off up to ``max(λ_o, 100 λ_{k+1})`` meets ``tolerance``).
 
-    As in :func:`_grown`, ``‖R_j‖`` is continued past ``λ_{k+1}`` as the fitted power of
-    ``λ`` (never growing) and the count below a cut-off ``λ_c`` as that of
-    :func:`count_power`, plus 10 % and 4 modes; ``λ_c`` is found by bisection in
-    ``log λ_c`` (to 2 %) on the bound at the times where the static one misses
-    (``static``, the static bound at ``k`` per time).
+    As in the static estimate (:mod:`.mode_select`), ``‖R_j‖`` is continued past
+    ``λ_{k+1}`` as the fitted power of ``λ`` (:func:`norm_power`, never growing) and the
+    count below a cut-off ``λ_c`` as that of :func:`count_power`, plus 10 % and 4 modes;
+    ``λ_c`` is found by bisection in ``log λ_c`` (to 2 %) on the bound at the times where
+    the static one misses (``static``, the static bound at ``k`` per time).
     """
     missed = np.flatnonzero(static > tolerance)
     if not beta > 0 or not missed.size:
@@ -140,8 +141,9 @@ def transient_grown(k: int, lam: Array, norms: Array, jump_times: Array, gamma: 
     def meets(cut: float) -> bool:
         at = norms[:, k] * min((cut / lam[k]) ** slope, 1.0)
         for chunk in (order[:1], order[1:]):
-            if chunk.size and weight * transient_bound(at[None, :], jump_times, cut, gamma,
-                                                       beta, times[chunk])[0].max() > tolerance:
+            if chunk.size and weight * transient_bound(
+                    at[None, :], jump_times, cut, gamma, beta,
+                    times[chunk])[0].max() > tolerance:
                 return False
         return True
 
