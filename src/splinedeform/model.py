@@ -356,9 +356,10 @@ class Model:
             of the largest static displacement ``max_t ‖K⁻¹F(t)‖_∞``, in the largest
             control-point coordinate (``c_∞ ≥ max_p √((M⁻¹)_pp)``,
             :mod:`splinedeform.solvers.mode_select`) at ``times`` (default 201 on
-            ``[0, t_end]``; one time for one state). It holds at **any** time asked later:
-            ``E`` never grows between jumps, and a time where the basis' bound misses
-            (just after a jump) is computed with modes chosen for it
+            ``[0, t_end]`` and half their spacing after each jump; one time for one
+            state). It holds at **any** time asked later: the bound is evaluated there,
+            and a time where the basis' bound misses (just after a jump) is computed with
+            modes chosen for it
             (``solution.accuracy``); the bound reached is ``solution.truncation["bound"]``.
             ``modes`` (keep the lowest k modes) or ``omega_max`` (keep ``ω <= omega_max``),
             both with the exact static part of the omitted modes (mode acceleration) and a
