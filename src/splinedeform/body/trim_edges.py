@@ -247,11 +247,12 @@ def trim_edge_summary(patches: Sequence[Surface], whole: Sequence[Any],
 
 
 def edge_penalty(patches: Sequence[Surface], interface: TrimEdgeInterface, material: Material,
-                 offsets: Sequence[int]) -> sp.csr_matrix:
+                 offsets: Sequence[int], penalties: Any = None) -> sp.csr_matrix:
     """The penalties of one shared stretch (:func:`~splinedeform.physics.coupling_curves.
     line_penalties` on the line of :func:`~splinedeform.physics.coupling_curves.curve_line`,
     ``b``'s parameter guessed by the linear map of the stretch's ends); the trace space is
-    the iso-edge's running basis where one side is an iso-edge."""
+    the iso-edge's running basis where one side is an iso-edge. ``penalties`` as for
+    :func:`~splinedeform.physics.coupling_curves.curve_penalty`."""
     from ..physics.coupling_curves import curve_line, line_penalties
 
     a = side(patches, edge_curve(patches, interface.a, interface.edge_a), interface.part_a)
@@ -260,4 +261,5 @@ def edge_penalty(patches: Sequence[Surface], interface: TrimEdgeInterface, mater
     start = lambda t: s0 + (np.asarray(t) - c0) * ((s1 - s0) / (c1 - c0))  # noqa: E731
     iso = [name in EDGES for name in (interface.edge_a, interface.edge_b)]
     line, h = curve_line(a, b, str(interface), start, 1 if iso[1] else 0 if iso[0] else None)
-    return line_penalties(line, h, material, interface.a, interface.b, patches, offsets)
+    return (penalties or line_penalties)(line, h, material, interface.a, interface.b, patches,
+                                         offsets)

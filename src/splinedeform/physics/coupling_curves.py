@@ -301,13 +301,15 @@ def loop_of(surface: Surface, index: int) -> Any:
 
 
 def curve_penalty(patches: Sequence[Surface], interface: TrimInterface, material: Material,
-                  offsets: Sequence[int]) -> sp.csr_matrix:
+                  offsets: Sequence[int], penalties: Any = None) -> sp.csr_matrix:
     """The coupling of two faces along a trim curve, every factor from the material and the
     mesh: ``½ α ∫_Γ |Π (d_a − d_b)|² ds`` and, where the energy bends,
     ``½ β ∫_Γ (Π (∂_{n_a} d_a + ∂_{n_b} d_b))² ds``, ``(α, β)`` of
     :func:`~.coupling.penalty_factors` at the element size of :func:`curve_line`;
     the same matrices as an iso-edge's (:func:`~.coupling.line_penalty`), on the faces'
-    concatenated control points (``offsets`` their first rows)."""
+    concatenated control points (``offsets`` their first rows). ``penalties`` (the
+    signature of :func:`line_penalties`, its default) makes the matrices of the line: the
+    shell's are :func:`~.shell_body_trimmed.shell_line_penalties`."""
     for index in (interface.a, interface.b):
         if not 0 <= index < len(patches):
             raise InputError(f"{interface} names face {index}, but the body has "
@@ -315,7 +317,8 @@ def curve_penalty(patches: Sequence[Surface], interface: TrimInterface, material
     sides = [CurveSide.of_loop(patches[p], loop_of(patches[p], k))
              for p, k in ((interface.a, interface.loop_a), (interface.b, interface.loop_b))]
     line, h = curve_line(sides[0], sides[1], str(interface))
-    return line_penalties(line, h, material, interface.a, interface.b, patches, offsets)
+    return (penalties or line_penalties)(line, h, material, interface.a, interface.b, patches,
+                                         offsets)
 
 
 def line_penalties(line: Line, h: float, material: Material, a: int, b: int,

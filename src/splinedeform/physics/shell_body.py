@@ -28,7 +28,7 @@ penalty there: the rotation is continuous exactly.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Mapping, Sequence
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 import scipy.sparse as sp
@@ -65,6 +65,9 @@ class ShellBodySystem:
         First control point of each patch (``len(patches) + 1`` values).
     ties : :class:`~.coupling_ties.Ties`
         The interfaces and C0 lines whose slopes ``T`` ties exactly.
+    motions : :class:`~.shell_rigid.RigidMotions` or None
+        The free rigid motions where the system knows them (a body with trimmed faces,
+        :mod:`.shell_body_trimmed`); None: those in ``range T``.
     """
 
     K: sp.csr_matrix
@@ -73,10 +76,13 @@ class ShellBodySystem:
     edges: dict[tuple[int, str], str]
     offsets: NDArray[np.int64]
     ties: Ties
+    motions: Any = None
 
 
 def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
-                boundary: str | Mapping[tuple[int, str], str] = "free") -> ShellBodySystem:
+                boundary: str | Mapping[tuple[int, str], str] = "free",
+                given: Mapping[int, tuple[sp.spmatrix, sp.spmatrix]] | None = None
+                ) -> ShellBodySystem:
     """Assemble the shell body of the module docstring.
 
     Parameters
@@ -86,6 +92,9 @@ def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
     boundary : str or mapping
         One kind of :data:`BODY_KINDS` for every boundary edge, or ``{(patch, edge): kind}``
         (missing boundary edges are free).
+    given : mapping, optional
+        ``{patch: (K_p, M_p)}``: the matrices of those patches, taken instead of
+        :func:`.shell.matrices` (a trimmed face's, :mod:`.shell_body_trimmed`).
     """
     if not isinstance(body, Body):
         body = Body(body)
@@ -98,7 +107,9 @@ def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
     own = [check_edges(s, {e: presets.get((p, e), "free") for e in EDGES})
            for p, s in enumerate(patches)]
     Tb = sp.block_diag([constraint_matrix(s, e) for s, e in zip(patches, own)], format="csr")
-    blocks = [matrices(s, material) for s in patches]
+    given = given or {}
+    blocks = [given[p] if p in given else matrices(s, material)
+              for p, s in enumerate(patches)]
     K = sp.block_diag([k for k, _ in blocks], format="csr")
     M = sp.block_diag([m for _, m in blocks], format="csr")
     size = int(offsets[-1])
