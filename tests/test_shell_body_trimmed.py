@@ -252,3 +252,24 @@ def test_a_trimmed_shell_s_stress_fields_follow_its_clipped_mesh(tmp_path):
     # of the largest
     assert len(d) > 40 and np.abs(d[:, 2]).max() > 0
     assert np.abs(np.abs(normal) - np.abs(d[:, 2])).max() < 1e-9 * np.abs(d).max()
+
+
+def test_a_shell_body_s_face_with_general_weights_is_taken_whole():
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from splinedeform.scenario.cad_trim import why_untrimmable
+
+    plane = sd.shapes.plane(cells=(4, 4), degree=3, knots="open")
+    u = np.arange(plane.shape[0])[:, None]
+    v = np.arange(plane.shape[1])[None, :]
+    weighted = replace(plane, net_weights=1.0 + 0.1 * np.sin(u + 2.0 * v) ** 2)  # no product
+    shell = SimpleNamespace(material=SimpleNamespace(physics="shell"))
+    plate = SimpleNamespace(material=SimpleNamespace(physics="parametric"))
+    assert "not a product" in why_untrimmable(shell, weighted, body=True)
+    assert why_untrimmable(shell, plane, body=True) is None
+    assert why_untrimmable(plate, weighted, body=True) is None
+    # one face keeps the trimmed shell's own refusal, which names the weights
+    assert why_untrimmable(shell, weighted) is None
+    with pytest.raises(sd.errors.InputError, match="not a product"):
+        ShellModel(weighted.with_trim(TrimDomain(CIRCLE)), SHELL, {"outer": "clamped"})
