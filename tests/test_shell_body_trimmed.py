@@ -131,39 +131,21 @@ def test_the_gap_along_the_circle_and_the_penalty():
     assert abs(centres[1] / centres[0] - 1) < 1e-6
 
 
-SCENARIO = """
-[surface]
-shape = "cad"
-path = "drilled.step"
-elevate = [2, 2]
-refine = [3, 3]
-
-[material]
-physics = "shell"
-E = 1.0e4
-nu = 0.3
-thickness = 0.02
-
-[[load]]
-kind = "pressure"
-q = 1.0
-
-[solve]
-kind = "static"
-
-[output]
-formats = ["report", "vtu"]
-resolution = 9
-"""
+#: the membrane's drilled box scenario (tests/test_body_trim_edges_cad.py) as a thin shell
+SHELL_MATERIAL = 'physics = "shell"\nE = 1.0e4\nnu = 0.3\nthickness = 0.02'
 
 
 @pytest.fixture(scope="module")
 def drilled_box(tmp_path_factory):
     pytest.importorskip("OCP", reason="the 'cad-step' extra (cadquery-ocp) is not installed")
+    from test_body_trim_edges_cad import SCENARIO
     from test_body_trim_edges_cad import drilled_box as made
 
     folder = made.__wrapped__(tmp_path_factory).parent
-    (folder / "shell.toml").write_text(SCENARIO)
+    membrane = 'w10 = 1.0\nw01 = 1.0\nphysics = "parametric"'
+    assert membrane in SCENARIO
+    (folder / "shell.toml").write_text(SCENARIO.format(path="drilled.step", refine=3)
+                                       .replace(membrane, SHELL_MATERIAL))
     return folder
 
 
