@@ -255,3 +255,15 @@ def test_a_shell_body_s_face_with_general_weights_is_taken_whole():
     assert why_untrimmable(shell, weighted) is None
     with pytest.raises(sd.errors.InputError, match="not a product"):
         ShellModel(weighted.with_trim(TrimDomain(CIRCLE)), SHELL, {"outer": "clamped"})
+
+
+def test_a_trimmed_shell_body_s_boundary_by_edge_and_loop():
+    body = split_square(8, 8)
+    one = ShellModel(body, SHELL, "clamped").static(sd.Pressure(1.0))
+    each = ShellModel(body, SHELL, {(1, e): "clamped" for e in EDGES}).static(sd.Pressure(1.0))
+    # the same edges held, named one by one: the same system, to round-off (1e-12)
+    a, b = one.displacement(0.5, 0.5, patch=0), each.displacement(0.5, 0.5, patch=0)
+    assert np.abs(a - b).max() < 1e-12 * np.abs(a).max()
+    # the circle is shared by the two faces: it takes no condition
+    with pytest.raises(sd.errors.InputError, match="shared with another face"):
+        ShellModel(body, SHELL, {(0, "outer"): "clamped"})
