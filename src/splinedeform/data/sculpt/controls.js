@@ -44,7 +44,7 @@
     hudBox.textContent = "t = " + t.toFixed(2) + (paused ? " (paused)" : "") +
       "   " + (mean > 0 ? (1000 / mean).toFixed(0) : "-") + " fps, " + work.toFixed(1) + " ms per frame" +
       "\n" + K + (data.complete ? " modes (all)" : " of " + data.n_free + " modes" +
-      (online || data.offline ? " + static correction" : "")) + ", " + (data.body ? faceList.length + " faces of " + faceRows : ru) + "×" + rv + " samples, max |d| = " + (dmax > 0 ? dmax.toPrecision(3) : "0") +
+      (online || data.offline ? " + static correction" : "")) + ", " + (data.body ? faceList.length + " faces of " + faceRows : ru) + "×" + rv + " samples" + (trimTriangles ? " clipped to the trims" : "") + ", max |d| = " + (dmax > 0 ? dmax.toPrecision(3) : "0") +
       (grab || extra.length ? "\n" + grabWords() : "");
   }
 
@@ -316,6 +316,8 @@
     face(n) { return sampleAt(n).number; },
     get faceCount() { return faceList.length; },
     triangleCount() { return geometry.index.count / 3; },
+    get sampleCount() { return N; },
+    inside(n) { return !inside || Boolean(inside[n]); },
     nearestNet(n) { return nearestNetPoint(data.u[Math.floor(n / rv)], data.v[n % rv]); },
     get grabView() { return grabEnds && { point: grabEnds.point.slice(), pointer: grabEnds.pointer && grabEnds.pointer.slice(),
                                           marker: grabMarker.visible, spring: springLine.visible }; },

@@ -1,0 +1,103 @@
+"""Sculpting a trimmed face: the page gets the clipped mesh the exports draw, pushes move
+the trimmed (WEB-spline) model, and a grab outside the trims is refused, through the
+session and the server API."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import splinedeform as sd
+from splinedeform.errors import InputError
+from splinedeform.scenario import load_scenario
+from splinedeform.sculpt import Push
+from splinedeform.sculpt.export import decode
+from splinedeform.sculpt.messages import PushMessage, SaveMessage
+from splinedeform.sculpt.state import modal_history
+from trim_scenario import HEAD, RIM
+
+R = 17          # samples per direction: 0.5 is sample 8, the disc's centre
+CENTRE = 8 * R + 8
+#: a membrane disc of radius 0.4 cut from the unit square, clamped on its rim
+DISC = HEAD + RIM + """[material]
+w10 = 1.0
+w01 = 1.0
+damping = 1.0
+[solve]
+kind = "modes"
+"""
+
+
+@pytest.fixture()
+def served(tmp_path):
+    from sculpt_client import serve_sheet
+
+    return serve_sheet(tmp_path, DISC, resolution=R)
+
+
+def test_the_page_gets_the_exports_clipped_mesh(served):
+    from splinedeform.export.frames import tessellate_frames
+
+    client, session = served
+    data = client.get("/api/basis").json()
+    basis = session.basis
+    surface = basis.model.surface
+    tri = decode(data["trim"]["triangles"], "<i4").reshape(-1, 3)
+    rest = decode(data["rest"]).reshape(-1, 3)
+    assert rest.shape[0] == basis.sample_count == R * R + len(data["trim"]["crossings"]["u"])
+    inside = decode(data["trim"]["inside"], "u1")
+    assert inside[tri].all()                                # only samples inside are drawn
+    # the same triangles as the exports' mesh (an independent evaluation of the surface):
+    # corner positions sorted, float32 transport of positions of size 1: 1e-6
+    vertices, faces = tessellate_frames(surface, surface.control_points, R)
+    ours = np.sort(np.sort(rest[tri].reshape(len(tri), -1), axis=1), axis=0)
+    theirs = np.sort(np.sort(vertices[faces].reshape(len(faces), -1), axis=1), axis=0)
+    assert ours.shape == theirs.shape and np.abs(ours - theirs).max() <= 1e-6
+    # every crossing on the rim |p - c| = 0.4 (bisection to 2^-60 of a grid edge: 1e-12)
+    c = data["trim"]["crossings"]
+    radius = np.hypot(np.array(c["u"]) - 0.5, np.array(c["v"]) - 0.5)
+    assert radius.size > 0 and np.abs(radius - 0.4).max() <= 1e-12
+    # the grid points inside are those within the circle (none within 1e-9 of it at R = 17)
+    g = np.linspace(0, 1, R)
+    uu, vv = np.meshgrid(g, g, indexing="ij")
+    within = np.hypot(uu - 0.5, vv - 0.5).ravel() < 0.4
+    assert np.array_equal(inside[:R * R].astype(bool), within)      # booleans: exact
+
+
+def test_a_push_at_the_centre_moves_the_trimmed_model(served):
+    """The page's closed form on its samples is the trimmed model's dynamics (every mode
+    kept): the clamped rim stays put and the centre moves as ``Model.dynamic`` says."""
+    _, session = served
+    basis = session.basis
+    pushes = [Push(0.5, 0.5, (0.0, 0.0, -1.0), t_on=0.0, t_off=0.4)]
+    q = modal_history(basis, pushes, [0.3, 0.9])
+    model = basis.model
+    sol = model.dynamic([sd.Point(0.5, 0.5, (0.0, 0.0, -1.0), sd.Step(0.0, 0.4))], 1.0)
+    for k, t in enumerate([0.3, 0.9]):
+        d = basis.phi_samples @ q[k]
+        ref = sol.displacement(t, np.array([0.5]), np.array([0.5]))[0]
+        # two evaluations of the same modal sum: 1e-10 of the displacement
+        assert np.abs(d[CENTRE] - ref).max() <= 1e-10 * np.abs(ref).max()
+        assert abs(d[CENTRE, 2]) > 1e-3
+        # the rim is held (weakly, by Nitsche's terms): the crossings, on the rim, move by
+        # the discretisation error only (3e-4 of the centre at 10 cells; 1e-3 allowed), where
+        # a disc not held there would move its rim by a fair part of its centre
+        assert np.abs(d[R * R:]).max() <= 1e-3 * abs(d[CENTRE, 2])
+
+
+def test_a_grab_outside_the_trims_is_refused(served):
+    client, session = served
+    basis = session.basis
+    with pytest.raises(InputError, match="outside the trims"):
+        basis.participation(0.02, 0.02)
+    # sample 0 is the corner (0, 0): cut away
+    reply = client.post("/api/correction", json={"version": session.version, "index": 0})
+    assert reply.status_code == 400 and "outside the trims" in reply.json()["error"]
+    corner = PushMessage(index=0, force=(0.0, 0.0, -1.0), t_on=0.0, t_off=0.5)
+    with pytest.raises(InputError, match=r"pushes\[1\].index = 0: the point u = 0, v = 0"):
+        session.save(SaveMessage(version=session.version, t_end=1.0, pushes=[corner]))
+    centre = PushMessage(index=CENTRE, force=(0.0, 0.0, -1.0), t_on=0.0, t_off=0.5)
+    path, _ = session.save(SaveMessage(version=session.version, t_end=1.0, pushes=[centre]))
+    saved = load_scenario(path)
+    # the sample grid point (8/16, 8/16) written with %.17g: 1e-15
+    assert saved.surface.trim is not None and np.allclose(saved.loads[0].at, 0.5, atol=1e-15)
