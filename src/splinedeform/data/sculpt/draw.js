@@ -342,6 +342,7 @@
       for (let k = 0; k < NN * 3; k++) np[k] = netRest[k] + netDisp[k];
       netPositions.needsUpdate = true;
     }
+    drawEdges(pos);
     showGrab();
     renderer.render(scene, camera);
   }
