@@ -162,3 +162,22 @@ def test_a_body_of_trimmed_faces_is_drawn_on_their_regions_and_meets_along_the_t
     assert np.abs(jump).max() <= 2e-3 * np.abs(d).max()
     # the circle moves (not held): 3.6e-2 of the membrane's peak under its point force
     assert np.abs(d[at]).max() > 0.02 * np.abs(d).max()
+
+
+def test_a_bake_keeps_the_trim(served):
+    """Bake: the shape now becomes the rest shape of the same trimmed disc (its trim table
+    kept with the baked net), solved again: the same unknowns, samples and triangles."""
+    from splinedeform.sculpt.messages import BakeMessage
+
+    _, session = served
+    before = session.basis
+    q = np.zeros((before.lam.size, 3))
+    q[0, 2] = 0.1                                           # lift the lowest mode
+    session.bake(BakeMessage(version=session.version, q=q.ravel().tolist()))
+    after = session.basis
+    assert session.scenario.surface.shape == "file" and after.model.surface.trim is not None
+    assert after.model.n_free == before.model.n_free
+    assert np.array_equal(after.trimmed.triangles, before.trimmed.triangles)   # integers
+    # the baked rest shape is the shape of q: rest + Φ_s q, to round-off of the net (1e-12)
+    shape = before.rest_samples() + before.phi_samples @ q
+    assert np.abs(after.rest_samples() - shape).max() <= 1e-12

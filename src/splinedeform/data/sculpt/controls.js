@@ -324,7 +324,7 @@
     get bodyEdges() { return data.body ? data.body.edges.map((e) => Object.assign({}, e)) : null; },
     get edgeSegments() { return edgeLines ? edgeLines.geometry.attributes.position.count / 2 : 0; },
     inside(n) { return !inside || Boolean(inside[n]); },
-    nearestNet(n) { return nearestNetPoint(data.u[Math.floor(n / rv)], data.v[n % rv]); },
+    nearestNet(n) { const at = sampleAt(n); return nearestNetPoint(at.u, at.v); },
     get grabView() { return grabEnds && { point: grabEnds.point.slice(), pointer: grabEnds.pointer && grabEnds.pointer.slice(),
                                           marker: grabMarker.visible, spring: springLine.visible }; },
     get hud() { return hudBox.textContent; },
