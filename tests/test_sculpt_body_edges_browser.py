@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 # skips this module, saying why, without Chromium or Playwright
-from chromium import sculpt_page, sculpt_server  # noqa: E402
+from chromium import resolve_in_page, sculpt_page, sculpt_server, shoot  # noqa: E402
 
 pytest.importorskip("OCP", reason="the body's STEP shell needs OpenCASCADE (the extra 'step')")
 from sculpt_body_files import BODY, two_faces  # noqa: E402
@@ -27,10 +27,7 @@ def test_each_boundary_edge_of_a_body_takes_its_own_preset(browser, tmp_path):
         assert names == ["face 0 u0", "face 0 v0", "face 0 v1", "face 1 u1", "face 1 v0", "face 1 v1"]
         page.select_option("#edge-1-u1", "free")
         page.select_option("#edge-1-v0", "free")
-        page.click("#resolve")
-        page.wait_for_function("sculptState.version === 2 || sculptState.errors.length > 0",
-                               timeout=60000)
-        assert page.evaluate("sculptState.errors") == []
+        resolve_in_page(page, 2)
         edges = page.evaluate("sculptState.bodyEdges")
         assert {(e["face"], e["edge"]): e["preset"] for e in edges} == {
             (0, "u0"): "clamped", (0, "v0"): "clamped", (0, "v1"): "clamped",
@@ -50,9 +47,7 @@ def test_each_boundary_edge_of_a_body_takes_its_own_preset(browser, tmp_path):
         page.evaluate(f"sculptState.hold({corner}, [0, 0, -0.05])")    # a gentler pull, seen
         page.uncheck("#colour")
         page.wait_for_timeout(600)
-        shot = tmp_path / "sculpt-body-edges.png"
-        page.screenshot(path=str(shot))
-        print(f"\nscreenshot: {shot}")
+        shoot(page, tmp_path / "sculpt-body-edges.png")
         # the edges drawn: one segment per pair of samples along each of the 6 edges
         assert page.evaluate("sculptState.edgeSegments") == 6 * (R - 1)
         assert not page.problems

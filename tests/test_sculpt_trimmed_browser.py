@@ -8,14 +8,13 @@ from __future__ import annotations
 import numpy as np
 
 # skips this module, saying why, without Chromium or Playwright
-from chromium import grab_and_pull, sculpt_page, sculpt_server  # noqa: E402
+from chromium import grab_and_pull, sculpt_page, sculpt_server, shoot  # noqa: E402
 from test_sculpt_trimmed import CENTRE, DISC, R
 
 
 def test_a_trimmed_disc_is_drawn_grabbed_inside_and_refused_outside(browser, tmp_path):
-    from splinedeform.scenario import parse_scenario
+    from splinedeform.scenario import build, parse_scenario
     from splinedeform.sculpt.modal import sculpt_basis
-    from splinedeform.scenario import build
 
     basis = sculpt_basis(build(parse_scenario(DISC, source="disc.toml")).model, R)
     with sculpt_server(tmp_path, "disc.toml", DISC, "--resolution", str(R),
@@ -46,9 +45,7 @@ def test_a_trimmed_disc_is_drawn_grabbed_inside_and_refused_outside(browser, tmp
         # Nitsche's held rim moves by the discretisation error only (3e-4 of the centre in
         # the static test; 1e-3 allowed, float32 modes add 1e-5)
         assert np.linalg.norm(d[R * R:], axis=1).max() <= 1e-3 * centre
-        shot = tmp_path / "sculpt-trimmed.png"
-        page.screenshot(path=str(shot))
-        print(f"\nscreenshot: {shot}")
+        shoot(page, tmp_path / "sculpt-trimmed.png")
         page.mouse.up()
         assert not page.problems
         page.close()
