@@ -153,11 +153,12 @@ class SculptBasis:
         return np.concatenate([s.control_points.reshape(-1, 3) for s in self.patches])
 
     def sample_matrix(self) -> sp.csr_matrix:
-        """``diag(E_1, …, E_P)``: the full net to the sample points, ``(P ru rv, N)``."""
+        """``diag(E_1, …, E_P)`` (and the trim crossings' rows): the full net to the sample
+        points, ``(sample_count, N)``."""
         return sample_evaluation(self.patches, self.samples, self.trimmed)
 
     def rest_samples(self) -> Array:
-        """Rest positions of the sample points, ``(P ru rv, 3)``."""
+        """Rest positions of the sample points, ``(sample_count, 3)``."""
         return np.asarray(self.sample_matrix() @ self.rest_net())
 
     def participation(self, u: float, v: float, patch: int = 0) -> Array:
