@@ -61,3 +61,16 @@ def hemisphere(radius: float, start: float, cells: int = 8) -> Surface:
         return radius * np.stack([np.sin(v) * np.cos(phi), np.sin(v) * np.sin(phi),
                                   -np.cos(v)], axis=-1)
     return from_function(f, cells=(cells, cells), domain=((0, pi), (0, pi)))
+
+
+def rhino3dm_box(folder, units: str, size=(1.0, 2.0, 3.0)):
+    """``box.3dm`` in ``folder``: rhino3dm's box ``[0, size]`` (6 bilinear faces of one
+    Brep) in the unit named ``units`` (a ``rhino3dm.UnitSystem`` member); its path."""
+    import rhino3dm as r3
+
+    path = folder / "box.3dm"
+    model = r3.File3dm()
+    model.Settings.ModelUnitSystem = getattr(r3.UnitSystem, units)
+    model.Objects.AddBrep(r3.Brep.CreateFromBox(r3.Box(r3.BoundingBox(0, 0, 0, *size))))
+    assert model.Write(str(path), 7)
+    return path

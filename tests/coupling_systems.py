@@ -111,3 +111,13 @@ def single(cells: int, material: Material, edge: str, f: Callable = uniform, deg
     """Centre deflection of the unit square as one patch, ``cells × cells`` spans."""
     s = flat_patch(0.0, 1.0, cells, cells, degree)
     return value(s, solve([s], [0.0], [edge], material, 0.0, f)[0], 0.5, 0.5)
+
+
+def slope_jump(surface: Surface, net: np.ndarray) -> float:
+    """``max |∂_u d(1/2⁺) − ∂_u d(1/2⁻)|`` along u = 1/2 over the largest ``|∂_u d|``."""
+    v = np.linspace(0.0, 1.0, 41)
+    below = surface.derivative(0.5 - 1e-12, v, 1, 0, net)      # the left span's last point
+    above = surface.derivative(0.5, v, 1, 0, net)
+    x = np.linspace(0.0, 1.0, 81)
+    slopes = surface.derivative(x[:, None], x[None, :], 1, 0, net)
+    return float(np.abs(above - below).max() / np.abs(slopes).max())

@@ -1,5 +1,5 @@
 """Bodies coupled by their models: non-conforming interfaces, bending across interfaces and
-C0 knot lines, through BodyModel, Model and ShellModel.
+C0 knot lines, through BodyModel and Model (the shell's: tests/test_shell_ties.py).
 
 The clamped unit square under a unit load, Hessian energy ``∫ (Δw)²`` (the Kirchhoff plate
 with ``D = 1``): centre ``w = 0.00126532 q a⁴ / D``. Its reference is one patch of 48 × 48
@@ -15,11 +15,9 @@ import pytest
 
 import splinedeform as sd
 from splinedeform.physics import coupling
-from splinedeform.physics.shell import ShellMaterial
-from splinedeform.physics.shell_model import ShellModel
 
 from coupling_systems import (CLAMPED_PLATE_CENTRE, PLATE, c0_basis, c1_basis, flat_patch,
-                              single)
+                              single, slope_jump)
 
 LOAD = sd.Uniform((0.0, 0.0, 1.0))
 
@@ -164,16 +162,6 @@ def test_a_creased_interface_keeps_its_rotation_penalty():
     assert flat.constraints.ties.interfaces == {0}
 
 
-def slope_jump(surface: sd.Surface, net: np.ndarray) -> float:
-    """``max |∂_u d(1/2⁺) − ∂_u d(1/2⁻)|`` along u = 1/2 over the largest ``|∂_u d|``."""
-    v = np.linspace(0.0, 1.0, 41)
-    below = surface.derivative(0.5 - 1e-12, v, 1, 0, net)      # the left span's last point
-    above = surface.derivative(0.5, v, 1, 0, net)
-    x = np.linspace(0.0, 1.0, 81)
-    slopes = surface.derivative(x[:, None], x[None, :], 1, 0, net)
-    return float(np.abs(above - below).max() / np.abs(slopes).max())
-
-
 def test_a_plate_with_a_c0_line_has_no_slope_jump():
     # the issue's check for the plate: a clamped square whose u = 1/2 is repeated 3 times,
     # as one patch (Model) and as a body of one patch (BodyModel): the centre within 0.1 %
@@ -190,26 +178,6 @@ def test_a_plate_with_a_c0_line_has_no_slope_jump():
         net = static.control_points()[0] if body else static.control_points()
         assert slope_jump(surface, (net - surface.control_points)[..., 2:]) <= 1e-6
     assert model.constraints.ties.lines == {(0, "u", 0.5)}
-
-
-def test_a_shell_with_a_c0_line_sags_like_the_smooth_shell():
-    # the issue's case: a flat clamped square whose u = 1/2 is repeated 3 times sagged 1.553
-    # times the closed form, with a slope jump of 0.0104
-    shell = ShellMaterial(E=1.0, nu=0.3, thickness=0.01)
-    D = shell.E * shell.thickness ** 3 / (12 * (1 - shell.nu ** 2))
-    clamped = {e: "clamped" for e in ("u0", "u1", "v0", "v1")}
-    smooth = ShellModel(flat_patch(0.0, 1.0, 8, 8), shell, clamped)
-    kinked_surface = flat_patch(0.0, 1.0, 8, 8, basis_u=c0_basis(3, 8))
-    kinked = ShellModel(kinked_surface, shell, clamped)
-    w_smooth, w = (float(m.static(LOAD).displacement(0.5, 0.5)[2]) * D
-                   for m in (smooth, kinked))
-    # the smooth 8 × 8 shell is 1.4e-4 off the closed form; the coupled C0 line within a
-    # tenth of that of it (the penalty's error; measured 1.7e-6)
-    assert abs(w_smooth / CLAMPED_PLATE_CENTRE - 1) <= 2e-4
-    assert abs(w - w_smooth) <= 1.4e-5 * w_smooth
-    net = kinked.static(LOAD).net_displacement()[..., 2:]
-    # the slope jump across the line against the largest slope: 1e-5 (measured 7.6e-6)
-    assert slope_jump(kinked_surface, net) <= 1e-5
 
 
 def test_modes_and_damped_motion_of_a_coupled_body(reference):

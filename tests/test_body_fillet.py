@@ -1,5 +1,6 @@
 """A filleted box from OpenCASCADE deformed as one body: no seam opens, and the STEP file of
-the deformed body, read back by OpenCASCADE, is as closed as its source.
+the deformed body, read back by OpenCASCADE, and its .3dm, read back by rhino3dm, are as
+closed as its source.
 
 The box ``2 × 3 × 1`` with every edge rounded (radius 0.3) has 26 faces: 6 planes, 12
 quarter cylinders and 8 corner patches (each with a pole), joined along 48 shared edges
@@ -89,7 +90,7 @@ def test_a_filleted_box_deforms_as_one_body_and_its_step_file_stays_closed(
     from splinedeform.cad_body import read_body
     from splinedeform.export.body import write_body_step
 
-    surfaces, topology, _ = read_body(filleted_box)
+    surfaces, topology, info = read_body(filleted_box)
     assert len(surfaces) == 26
     assert topology.counts == {"shared": 48, "boundary": 0, "seam": 0, "non_manifold": 0,
                                "off_sides": 0}
@@ -121,6 +122,22 @@ def test_a_filleted_box_deforms_as_one_body_and_its_step_file_stays_closed(
     # one of the 48 edges free
     loose = write_body_step(tmp_path / "loose.step", patches, nets, shell=False)
     assert free_edges(loose) == 2 * 48
+    # the deformed body's .3dm, read back by rhino3dm: one valid Brep of the 26 faces,
+    # its 48 edges each used by two faces, as many naked edges as the source (none), solid
+    r3 = pytest.importorskip("rhino3dm", reason="the 'cad' extra (rhino3dm) is not installed")
+    from splinedeform.export.body import write_body_3dm
+    from test_cad_brep_3dm import trims_per_edge
+
+    oriented = sd.Body(patches, body.interfaces,           # the file's outward normals
+                       orientation=[-1 if r else 1 for r in info["reversed"]])
+    model = r3.File3dm.Read(str(write_body_3dm(tmp_path / "deformed.3dm", patches, nets,
+                                               body=oriented)))
+    (obj,) = list(model.Objects)
+    brep = obj.Geometry
+    assert brep.IsValid and len(brep.Faces) == 26 and len(brep.Edges) == 48
+    uses = trims_per_edge(brep)
+    assert uses.count(1) == free_edges(filleted_box) and set(uses) == {2}
+    assert brep.IsSolid
 
 
 def centre(surface: sd.Surface) -> tuple[float, float]:

@@ -104,8 +104,10 @@ def test_a_cubic_box_bends_under_internal_pressure_closed_and_symmetric(box_3dm,
     assert report["body"]["degrees"] == [[3, 3]] * 6
     assert report["body"]["nets"] == ["6 x 6"] * 6
 
-    written = r3.File3dm.Read(str(out / "body.3dm"))
-    deformed = [grid_of(o.Geometry) for o in written.Objects]
+    written = r3.File3dm.Read(str(out / "body.3dm"))       # one Brep, a face per patch
+    deformed = [grid_of(face.UnderlyingSurface()) for o in written.Objects
+                for face in o.Geometry.Faces]
+    assert len(deformed) == 6 and written.Objects[0].Geometry.IsSolid
     source = r3.File3dm.Read(str(box_3dm))
     rest = [grid_of(face.UnderlyingSurface()) for o in source.Objects
             for face in o.Geometry.Faces]

@@ -76,12 +76,15 @@ def test_a_closed_box_under_internal_pressure_runs_from_the_command_line(box_3dm
     assert body["topology"]["shared"] == 12 and body["topology"]["boundary"] == 0
     assert body["patches"] == 6 and body["interfaces"] == 12
 
-    # the deformed body read back by rhino3dm: in inches, one named surface per face
+    # the deformed body read back by rhino3dm: in inches, one closed Brep of six named
+    # faces, its edges joined
     written = r3.File3dm.Read(str(out / "box.3dm"))
     assert str(written.Settings.ModelUnitSystem).endswith("Inches")
-    objects = list(written.Objects)
-    assert [o.Attributes.Name for o in objects] == [f"box face {k}" for k in range(6)]
-    deformed = [grid_of(o.Geometry) for o in objects]
+    (brep,) = list(written.Objects)
+    assert brep.Attributes.Name == "box" and [brep.Attributes.GetUserString(
+        f"splinedeform.face {k}") for k in range(6)] == [f"box face {k}" for k in range(6)]
+    assert brep.Geometry.IsValid and brep.Geometry.IsSolid and len(brep.Geometry.Edges) == 12
+    deformed = [grid_of(face.UnderlyingSurface()) for face in brep.Geometry.Faces]
     source = r3.File3dm.Read(str(box_3dm))
     rest = [grid_of(face.UnderlyingSurface()) for o in source.Objects
             for face in o.Geometry.Faces]

@@ -43,14 +43,15 @@ def drum(formats: str, modes: int = 3, frames: int = 5, animated: str = "[1, 3]"
 
 
 def test_the_per_mode_files_are_counted_and_bound_what_is_written(tmp_path):
-    # 3 modes: <name>_modes.vtu, 3 x (json, npz) mode nets, mode 3's GIF, besides the run's
-    # 5 frames + .pvd, its nets and its GIF: 5 + 1 + 2 + 1 + 1 + 6 + 1 = 17 files, counted
-    # exactly (the manifest is the run's own, one more)
+    # 3 modes: <name>_modes.vtu, 3 x (json, npz) mode nets, mode 3's GIF and its series of
+    # 5 frames + .pvd, besides the run's 5 frames + .pvd, its nets and its GIF:
+    # 5 + 1 + 2 + 1 + 1 + 6 + 1 + 6 = 23 files, counted exactly (the manifest is the run's
+    # own, one more)
     s = drum('["vtu", "json", "npz", "gif"]')
     found = estimate(s, build(s).model)
     mode_files = sum(t.amount for t in found.files if "mode" in t.formula)
-    assert mode_files == 1 + 3 * 2 + 1
-    assert found.total("files") == 17
+    assert mode_files == 1 + 3 * 2 + 1 + 6
+    assert found.total("files") == 23
     out = tmp_path / "out"
     run(s, out)
     written = list(out.iterdir())

@@ -121,8 +121,9 @@ def test_faces_are_chosen_by_number_name_or_layer(solids_3dm):
 def test_the_faces_command_reports_the_topology(solids_3dm):
     result = runner.invoke(cli.app, ["faces", str(solids_3dm)])
     assert result.exit_code == 0, result.output
+    # the two cap circles are each shared by a cap and the can's wall: trim edges
     assert ("edges: 14 shared, 0 boundary, 2 seam(s), 0 non-manifold, 2 on trimming loops "
-            "(not joined); 14 interface(s), 14 conforming") in result.output
+            "(2 shared by two faces, 0 free); 14 interface(s), 14 conforming") in result.output
     result = runner.invoke(cli.app, ["faces", "--json", str(solids_3dm)])
     topology = json.loads(result.output)["topology"]
     assert (topology["shared"], topology["seam"], len(topology["interfaces"])) == (14, 2, 14)

@@ -237,16 +237,51 @@ def test_a_loop_along_the_far_side_of_the_box(trimmed_plane):
     assert quadrature_of(built.surface).weights.sum() == pytest.approx(4.0, rel=1e-12)
 
 
-def test_a_face_the_trimmed_model_cannot_take(trimmed_plane):
-    shell = 'physics = "intrinsic"'
-    built, said = _built(trimmed_plane, physics=shell)
-    whole = [s for s in said if "whole underlying surface" in s]
-    assert len(whole) == 1 and "face 0" in whole[0] and "intrinsic" in whole[0]
-    assert built.surface.trim is None
+def test_a_face_the_trimmed_model_cannot_take(trimmed_plane, monkeypatch):
+    # every physics takes a trimmed face now; a face the model cannot hold (here one
+    # made so) is taken whole with one warning line, or refused under trimmed = true
+    built, said = _built(trimmed_plane, physics='physics = "intrinsic"')
+    assert built.surface.trim is not None
+    assert not [s for s in said if "whole underlying surface" in s]
     from splinedeform.errors import ScenarioError
+    from splinedeform.scenario import cad_trim
 
+    monkeypatch.setattr(cad_trim, "why_untrimmable", lambda *a, **k: "a reason")
+    built, said = _built(trimmed_plane)
+    whole = [s for s in said if "whole underlying surface" in s]
+    assert len(whole) == 1 and "face 0" in whole[0] and "a reason" in whole[0]
+    assert built.surface.trim is None
     with pytest.raises(ScenarioError, match="surface.trimmed"):
-        _built(trimmed_plane, switch="trimmed = true", physics=shell)
+        _built(trimmed_plane, switch="trimmed = true")
     built, said = _built(trimmed_plane, switch="trimmed = false")
     assert built.surface.trim is None
     assert not [s for s in said if "whole underlying surface" in s]
+
+
+def test_the_run_of_a_trimmed_face_writes_trimmed_brep_faces(trimmed_plane, tmp_path):
+    """The .3dm of a run on the trimmed plane: every frame one trimmed Brep face, valid
+    for openNURBS, whose loop read back from it lies on the model's trim loop."""
+    r3 = pytest.importorskip("rhino3dm", reason="the 'cad' extra (rhino3dm) is not installed")
+    from splinedeform.cad_trims_3dm import brep_face_trims
+    from splinedeform.pipeline import run
+    from splinedeform.scenario import load_scenario
+    from splinedeform.trim.bezier import evaluate
+
+    path = trimmed_plane / "plane.toml"
+    path.write_text(THREEDM.format(switch="", physics="")
+                    + 'frames = 2\n[boundary.loops]\nouter = "clamped"\n'
+                    '[output]\nformats = ["3dm"]\n')
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = run(load_scenario(path), tmp_path / "out", None)
+    loop = result.built.surface.trim.outer
+    objects = list(r3.File3dm.Read(str(tmp_path / "out" / "plane.3dm")).Objects)
+    assert len(objects) == 3                               # the rest shape and 2 frames
+    for obj in objects:
+        brep = obj.Geometry
+        assert isinstance(brep, r3.Brep) and brep.IsValidWithLog == (True, "")
+        (pieces,) = brep_face_trims(brep, brep.Faces[0], obj.Attributes.Name)["loops"]
+        x = evaluate(pieces, np.linspace(0.0, 1.0, 9)).reshape(-1, 2)
+        # the edges are the loop on the plane (exact), projected back to round-off and
+        # fitted by the reader to 1e-10 of the box: on the model's loop to 1e-9
+        assert np.abs(loop.distance(x)).max() < 1e-9

@@ -15,6 +15,7 @@ from splinedeform.export.body import (write_body_3dm, write_body_mesh, write_bod
 r3 = pytest.importorskip("rhino3dm", reason="the 'cad' extra (rhino3dm) is not installed")
 meshio = pytest.importorskip("meshio")
 
+from body_patches import rhino3dm_box  # noqa: E402
 from splinedeform.cad_body import read_body  # noqa: E402
 
 #: samples per direction of each patch in the meshes
@@ -27,12 +28,7 @@ def box(tmp_path_factory):
     face: the smooth field ``d(x) = 0.01 (sin x_1, cos x_2, x_0 x_1)`` applied to the
     control points of every face, which moves the points of a shared edge alike (they are
     the same points), so the seams stay closed."""
-    path = tmp_path_factory.mktemp("box") / "box.3dm"
-    model = r3.File3dm()
-    model.Settings.ModelUnitSystem = r3.UnitSystem.Inches
-    model.Objects.AddBrep(r3.Brep.CreateFromBox(r3.Box(r3.BoundingBox(0, 0, 0, 1, 2, 3))))
-    assert model.Write(str(path), 7)
-    surfaces, topology, info = read_body(path)
+    surfaces, topology, info = read_body(rhino3dm_box(tmp_path_factory.mktemp("box"), "Inches"))
     field = lambda P: 0.01 * np.stack([np.sin(P[..., 1]), np.cos(P[..., 2]),  # noqa: E731
                                        P[..., 0] * P[..., 1]], axis=-1)
     rest = [s.control_points for s in surfaces]
@@ -41,14 +37,18 @@ def box(tmp_path_factory):
 
 
 def test_3dm_holds_every_face_in_the_file_unit(box, tmp_path):
+    from splinedeform.cad import FACE_NAME
+
     surfaces, _, nets, units = box
     path = write_body_3dm(tmp_path / "body.3dm", surfaces, nets, units=units)
     model = r3.File3dm.Read(str(path))
     assert str(model.Settings.ModelUnitSystem).endswith("Inches")
-    objects = list(model.Objects)
-    assert [o.Attributes.Name for o in objects] == [s.name for s in surfaces]
-    for obj, P in zip(objects, nets):
-        srf = obj.Geometry
+    (obj,) = list(model.Objects)                       # one Brep, its faces named
+    assert isinstance(obj.Geometry, r3.Brep) and obj.Geometry.IsValid
+    assert [obj.Attributes.GetUserString(f"{FACE_NAME}{k}") for k in range(6)] == \
+        [s.name for s in surfaces]
+    for face, P in zip(obj.Geometry.Faces, nets):
+        srf = face.UnderlyingSurface().ToNurbsSurface()
         got = np.array([[[srf.Points[i, j].X, srf.Points[i, j].Y, srf.Points[i, j].Z]
                           for j in range(srf.Points.CountV)] for i in range(srf.Points.CountU)])
         # weights 1: the numbers written, read back as doubles (1e-12 of the size for the

@@ -8,8 +8,6 @@ from splinedeform.cad import (NurbsPatch, patch_from_surface, read_3dm, surface_
                               write_3dm)
 from splinedeform.errors import InputError
 from splinedeform.knots import KnotVectorBasis, RationalBasis
-from splinedeform.physics.shell import ShellMaterial
-from splinedeform.physics.shell_model import ShellModel
 
 KNOTS_U = [0, 0, 0, 0, 0.2, 0.45, 0.7, 1, 1, 1, 1]          # degree 3, 7 functions
 KNOTS_V = [0, 0, 0, 0.3, 0.5, 0.8, 1, 1, 1]                 # degree 2, 6 functions
@@ -176,13 +174,6 @@ def test_refinement_keeps_a_general_weight_surface():
     assert fine.net_weights is not None and fine.shape != surface.shape
     u, v = np.linspace(0, 1, 11), np.linspace(0, 1, 13)
     assert np.abs(fine.evaluate_grid(u, v) - surface.evaluate_grid(u, v)).max() <= 1e-12
-
-
-def test_the_shell_refuses_general_weights():
-    surface = surface_from_patch(_rational_patch())
-    with pytest.raises(InputError, match="shell does not take NURBS weights that are not a "
-                                         "product"):
-        ShellModel(surface, ShellMaterial(E=1.0, nu=0.3, thickness=0.01))
 
 
 def test_bad_general_weights_are_refused():

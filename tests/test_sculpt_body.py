@@ -110,10 +110,14 @@ def test_the_exported_body_keeps_every_face_and_the_closed_seam(served, tmp_path
     path = tmp_path / "got.3dm"
     path.write_bytes(reply.content)
     model = rhino3dm.File3dm.Read(str(path))
-    assert len(model.Objects) == 2 and model.Settings.ModelUnitSystem == rhino3dm.UnitSystem.Millimeters
-    assert [o.Attributes.Name for o in model.Objects] == ["two faces face 0", "two faces face 1"]
-    for obj, net in zip(model.Objects, nets):
-        srf = obj.Geometry
+    assert len(model.Objects) == 1 and model.Settings.ModelUnitSystem == rhino3dm.UnitSystem.Millimeters
+    (obj,) = model.Objects                    # one Brep, its two faces joined along the seam
+    assert [obj.Attributes.GetUserString(f"splinedeform.face {k}") for k in range(2)] == \
+        ["two faces face 0", "two faces face 1"]
+    brep = obj.Geometry
+    assert brep.IsValid and len(brep.Faces) == 2 and len(brep.Edges) == 7
+    for face, net in zip(brep.Faces, nets):
+        srf = face.UnderlyingSurface().ToNurbsSurface()
         got = np.array([[[srf.Points[i, j].X, srf.Points[i, j].Y, srf.Points[i, j].Z]
                          for j in range(srf.Points.CountV)] for i in range(srf.Points.CountU)])
         # doubles through openNURBS: 1e-12 of the body's size (2)

@@ -70,20 +70,31 @@ def test_refusals_name_the_problem():
         sd.Model(surface, membrane, boundary={"hole7": "clamped"})
     with pytest.raises(InputError, match="every control point is fixed"):
         sd.Model(surface, membrane, boundary="pinned", fixed=np.ones(surface.shape, bool))
-    with pytest.raises(InputError, match="parametric"):
-        sd.Model(surface, membrane, boundary="pinned", physics="intrinsic")
+    with pytest.raises(InputError, match="ShellModel"):
+        sd.Model(surface, membrane, boundary="pinned", physics="shell")
     with pytest.raises(InputError, match="rest = 'none'"):
         sd.Model(surface, membrane, boundary="pinned", rest="none")
-    with pytest.raises(InputError, match="shell is not trimmed"):
-        sd.ShellModel(surface, sd.ShellMaterial(1.0, 0.3, 0.01, 1.0))
+    with pytest.raises(InputError, match="fixed components"):
+        sd.ShellModel(surface, sd.ShellMaterial(1.0, 0.3, 0.01, 1.0),
+                      fixed=np.ones(surface.shape, bool))
     with pytest.raises(InputError, match="outside the trimmed region"):
         sd.Model(surface, membrane, boundary="pinned").static(
             sd.Point(0.05, 0.05, [0.0, 0.0, 1.0]))
     with pytest.raises(InputError, match="reaches outside the parameter domain"):
         surface.with_trim(TrimDomain(CircleLoop((0.5, 0.5), 0.6)))
-    with pytest.raises(InputError, match="uniform or open knots"):
+    with pytest.raises(InputError, match="uniform or open knots.*closed .periodic. "
+                       "direction.*knots='open'"):
         sd.shapes.cylinder(cells=(8, 4)).with_trim(
             TrimDomain(PolygonLoop([[1, 0.5], [3, 0.5], [3, 1.5], [1, 1.5]])))
+    from splinedeform.knots import KnotVectorBasis
+
+    kinked = KnotVectorBasis(3, [0, 0, 0, 0, 0.5, 0.5, 1, 1, 1, 1])
+    bv = sd.shapes.plane(cells=(4, 4)).basis_v
+    net = np.zeros((kinked.size, bv.size, 3))
+    with pytest.raises(InputError, match=r"'kinked'.*in u .*interior knot\(s\) \[0.5\].*"
+                       "split the surface"):
+        sd.Surface(net, kinked, bv, name="kinked").with_trim(TrimDomain(CircleLoop(
+            (0.5, 0.5), 0.3)))
 
 
 def test_a_holed_rectangle_keeps_its_edges_in_the_mesh():

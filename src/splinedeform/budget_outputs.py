@@ -201,7 +201,10 @@ def mode_terms(scenario: Any, model: Any, frames: int, frames_key: str
         mode over its frames held, ``F G 24`` bytes;
     ``<name>_mode<k>.gif/.mp4``
         ``A`` animations per format, each as the run's own animation: ``F`` frames
-        sampled and rendered, ``F (1.5·10⁸ + 1.5·10⁴ r² + 10⁷)`` operations.
+        sampled and rendered, ``F (1.5·10⁸ + 1.5·10⁴ r² + 10⁷)`` operations;
+    ``<name>_mode<k>.pvd`` + ``<name>_mode<k>_0000.vtu`` … (vtu)
+        ``A`` series, each as the run's own: ``F + 1`` files, ``F r² 104`` bytes and
+        ``F (2·10⁶ + 1.5·10³ r²)`` operations.
     """
     from .budget import Term, net_size
 
@@ -240,6 +243,12 @@ def mode_terms(scenario: Any, model: Any, frames: int, frames_key: str
         disk.append(Term(A * F * sum(ANIMATION_BYTES[e] for e in animated), what, keys))
         files.append(Term(float(A * len(animated)), what, keys))
         memory.append(Term(animation_memory(F) + F * r2 * 48.0, what, keys))
+    if "vtu" in formats and A:
+        what = f"{A} mode series of {F} .vtu files of {r}² points"
+        keys = ("output.animate_modes", frames_key, res, fmt)
+        disk.append(Term(A * F * r2 * 104.0, what, keys))
+        files.append(Term(A * (F + 1.0), what, keys))
+        work.append(Term(A * F * (2e6 + 1.5e3 * r2), what, keys))
     if (animated and A) or any(e in formats for e in ("json", "npz")):
         memory.append(Term(F * G * 24.0, f"the nets of one mode over {F} frames",
                            (frames_key, fmt)))

@@ -18,7 +18,7 @@ import os
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,6 +34,7 @@ from .rational import clamped, product_factors
 from .surface import Basis, Surface
 
 if TYPE_CHECKING:
+    from .cad_brep_3dm import BrepTopology
     from .trim.loops import TrimDomain
 
 #: relative tolerance for weights to count as a product ``a_i b_j`` (or as all equal)
@@ -53,6 +54,8 @@ class NurbsPatch:
     weights: NDArray[np.float64]
     #: length unit of ``points`` (a key of :data:`splinedeform.cad_units.UNITS`), None: unknown
     units: str | None = None
+    #: whether its Brep marks the face reversed (outward normal ``-(S_u × S_v)``)
+    reversed: bool = False
 
     def __post_init__(self) -> None:
         check_units(self.units, "NURBS patch units")
@@ -111,7 +114,7 @@ def refine(patch: NurbsPatch, splits: int) -> NurbsPatch:
     hom = np.concatenate([patch.points * w[..., None], w[..., None]], axis=-1)
     hom = np.einsum("ai,ijc,bj->abc", Su, hom, Sv)
     return NurbsPatch(patch.degrees, fu.knots, fv.knots, hom[..., :3] / hom[..., 3:],
-                      hom[..., 3], patch.units)
+                      hom[..., 3], patch.units, patch.reversed)
 
 
 def surface_from_patch(patch: NurbsPatch, name: str = "cad surface",
@@ -140,11 +143,12 @@ def surface_from_patch(patch: NurbsPatch, name: str = "cad surface",
                                  "knots repeated degree + 1 times); general weights need "
                                  "clamped knots: re-export the surface with clamped knots")
         return Surface(np.asarray(patch.points, dtype=float), bu, bv, name=name,
-                       net_weights=w)
+                       net_weights=w, orientation=-1 if patch.reversed else 1)
     a, b = factors
     basis_u: Basis = bu if np.ptp(a) <= WEIGHT_TOL * a.max() else RationalBasis(bu, a)
     basis_v: Basis = bv if np.ptp(b) <= WEIGHT_TOL * b.max() else RationalBasis(bv, b)
-    return Surface(np.asarray(patch.points, dtype=float), basis_u, basis_v, name=name)
+    return Surface(np.asarray(patch.points, dtype=float), basis_u, basis_v, name=name,
+                   orientation=-1 if patch.reversed else 1)
 
 
 def warn_open_seams(patch: NurbsPatch, source: str = "NURBS patch") -> None:
@@ -226,14 +230,23 @@ def read_cad(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
 
 def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch],
               names: list[str] | None = None, units: str | None = None,
-              trims: list[TrimDomain | None] | None = None) -> Path:
+              trims: list[TrimDomain | None] | None = None,
+              body: BrepTopology | None = None) -> Path:
     """Write ``patches`` as NURBS surfaces to a ``.3dm`` file (atomically); return its path.
 
     ``names`` label the objects (openNURBS object names), one per patch. ``units`` (a key
     of :data:`splinedeform.cad_units.UNITS`; default: the first patch's) is the file's
     ``ModelUnitSystem``; ``None`` when not known (openNURBS ``UnitSystem.None``).
-    ``trims`` (one per patch, None for an untrimmed one) are written beside their surface
-    as curves in its ``(u, v)`` (:func:`splinedeform.cad_trims_3dm.add_trim_curves`).
+    A patch with a trim (``trims``: one per patch, None for an untrimmed one) is a
+    one-face Brep with those loops (:mod:`splinedeform.cad_brep_trims`); where openNURBS
+    refuses it, its surface with the loops beside it as curves in its ``(u, v)``
+    (:func:`splinedeform.cad_trims_3dm.add_trim_curves`), and a warning.
+
+    With ``body`` (the patches' topology) the patches are one Brep object instead, its
+    edges joined where the faces meet (:func:`splinedeform.cad_brep_3dm.body_brep`),
+    named ``body.name`` with each face's name as the user string ``splinedeform.face k``;
+    where the Brep cannot be formed, a one-line warning says why and the patches are
+    written one surface each as without ``body``.
     """
     r3 = _rhino3dm()
     path = Path(path)
@@ -245,6 +258,8 @@ def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch],
         units = patches[0].units
     model = r3.File3dm()
     model.Settings.ModelUnitSystem = getattr(r3.UnitSystem, rhino_name(units))
+    if body is not None and add_body_brep(model, r3, patches, names, trims, body):
+        patches = []
     for index, patch in enumerate(patches):
         (nu, nv), w = patch.degrees, np.asarray(patch.weights)
         cu, cv = w.shape
@@ -259,16 +274,60 @@ def write_3dm(path: str | os.PathLike, patches: list[NurbsPatch],
         attributes = r3.ObjectAttributes()
         if names is not None:
             attributes.Name = names[index]
+        trim = trims[index] if trims is not None else None
+        if trim is not None and _add_trimmed_face(model, r3, patch, trim, attributes):
+            continue
         model.Objects.AddSurface(srf, attributes)
-        if trims is not None and trims[index] is not None:
+        if trim is not None:
             from .cad_trims_3dm import add_trim_curves
 
-            add_trim_curves(model, r3, trims[index], len(model.Objects) - 1,
+            add_trim_curves(model, r3, trim, len(model.Objects) - 1,
                             names[index] if names is not None else f"surface {index}")
     with atomic_path(path) as tmp:
         if not model.Write(str(tmp), 7):
             raise InputError(f"{path}: openNURBS could not write the file")
     return path
+
+
+def add_body_brep(model: Any, r3: Any, patches: list[NurbsPatch], names: list[str] | None,
+                  trims: list[TrimDomain | None] | None, body: BrepTopology) -> bool:
+    """Add ``patches`` to ``model`` as the one Brep of ``body`` (see :func:`write_3dm`);
+    False, with a one-line warning naming the reason, where it cannot be formed."""
+    from .cad_brep_3dm import BrepError, body_brep
+
+    try:
+        brep = body_brep(patches, body, r3, trims)
+    except BrepError as exc:
+        warnings.warn(f"the body is written as {len(patches)} separate surfaces, not one "
+                      f"Brep: {exc}", InputWarning, stacklevel=3)
+        return False
+    attributes = r3.ObjectAttributes()
+    attributes.Name = body.name
+    for k, name in enumerate(names or []):
+        attributes.SetUserString(f"{FACE_NAME}{k}", name)
+    model.Objects.AddBrep(brep, attributes)
+    return True
+
+
+def _add_trimmed_face(model: Any, r3: Any, patch: NurbsPatch, trim: TrimDomain,
+                      attributes: Any) -> bool:
+    """Add ``patch`` trimmed by ``trim`` to ``model`` as a one-face Brep; False, with a
+    one-line warning naming the reason, where openNURBS refuses it."""
+    from .cad_brep_3dm import BrepError, BrepTopology, body_brep
+
+    try:
+        brep = body_brep([patch], BrepTopology(()), r3, [trim])
+    except BrepError as exc:
+        warnings.warn(f"{attributes.Name or 'a trimmed surface'} is written with its trim "
+                      f"loops as curves beside it, not as a trimmed Brep face: {exc}",
+                      InputWarning, stacklevel=3)
+        return False
+    model.Objects.AddBrep(brep, attributes)
+    return True
+
+
+#: user-string key (followed by the face number) of a Brep face's name
+FACE_NAME = "splinedeform.face "
 
 
 def frame_patches(surface: Surface, times: NDArray[np.float64], nets: NDArray[np.float64],
@@ -316,4 +375,5 @@ def read_3dm(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
         raise InputError(f"{path}: face {face!r} out of range; faces are numbered from 0")
     data = read_in_child(read_3dm_arrays, path, face, library="openNURBS (rhino3dm)")
     return NurbsPatch(tuple(data["degrees"]), data["knots_u"], data["knots_v"],
-                      data["points"], data["weights"], units=data["units"])
+                      data["points"], data["weights"], units=data["units"],
+                      reversed=bool(data.get("reversed", False)))

@@ -54,6 +54,7 @@ def read_3dm_arrays(path: Path, face: int) -> dict[str, Any]:
                          f"{len(found)} surface(s), numbered 0..{len(found) - 1}")
     surface, in_brep = found[face]
     source = f"{path} face {face}"
+    reversed_ = in_brep and bool(surface.OrientationIsReversed)
     if in_brep:
         if _is_trimmed(geometry_of[face], surface):
             warnings.warn(f"{source} is a trimmed Brep face; its whole underlying surface "
@@ -61,6 +62,7 @@ def read_3dm_arrays(path: Path, face: int) -> dict[str, Any]:
         surface = surface.UnderlyingSurface()
     data = _patch_from_rhino(surface.ToNurbsSurface(), source)
     data["units"] = units_from_rhino(str(model.Settings.ModelUnitSystem).split(".")[-1])
+    data["reversed"] = reversed_
     return data
 
 

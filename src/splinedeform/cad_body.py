@@ -6,7 +6,9 @@ child (:func:`splinedeform.cad_3dm_read.list_3dm_body`,
 face numbers as ``splinedeform faces`` lists them, or object names and layers), makes
 each a deformable :class:`~splinedeform.surface.Surface`
 (:func:`splinedeform.cad.surface_from_patch`) and finds the interfaces between them from
-the file's edges (:func:`splinedeform.cad_topology.body_topology`). A face that cannot
+the file's edges (:func:`splinedeform.cad_topology.body_topology`), and where the file
+mixes Breps and plain surfaces, those of the plain surfaces from the geometry
+(:mod:`splinedeform.cad_join`). A face that cannot
 be deformed (unreadable, general weights on unclamped knots) is skipped, and ``info``
 says why; a trimmed face is taken untrimmed, with one warning line naming it.
 """
@@ -21,6 +23,7 @@ from typing import Any, Sequence, Union
 from .cad import CAD_SUFFIXES, NurbsPatch, surface_from_patch
 from .cad_child import check_cad_file, read_in_child
 from .cad_faces import is_trimmed
+from .cad_join import join_loose_faces, loose_faces
 from .cad_topology import Topology, body_topology
 from .errors import InputError, InputWarning
 
@@ -54,7 +57,8 @@ def patches_of(listing: dict[str, Any]) -> list[NurbsPatch | None]:
     """The NURBS patch of every face of a listing (None where the face has an ``error``)."""
     return [None if "error" in f else
             NurbsPatch(tuple(int(n) for n in f["degrees"]), f["knots_u"], f["knots_v"],
-                       f["points"], f["weights"], units=listing["units"])
+                       f["points"], f["weights"], units=listing["units"],
+                       reversed=bool(f.get("reversed")))
             for f in listing["faces"]]
 
 
@@ -118,7 +122,11 @@ def read_body(path: str | os.PathLike, faces: FaceChoice = "all"
         ``units`` (the file's), ``faces`` (the file face number of each surface),
         ``names`` (object name of each, or None), ``reversed`` (whether each is marked
         reversed in its Brep: its outward normal is ``-(S_u × S_v)``), ``trimmed`` (file
-        face numbers taken untrimmed) and ``skipped`` (``{face number: why}``).
+        face numbers taken untrimmed), ``skipped`` (``{face number: why}``) and
+        ``joined_by_geometry``: where the file mixes Breps and plain surfaces, the
+        interfaces found by matching the plain surfaces' sides
+        (:mod:`splinedeform.cad_join`), ``{"face_a", "edge_a", "face_b", "edge_b"}`` in
+        file face numbers; the file's own interfaces come first in ``topology``.
     """
     path = Path(path)
     listing = read_listing(path)
@@ -157,10 +165,17 @@ def body_of(path: Path, listing: dict[str, Any], chosen: list[int]
         raise InputError(f"{path}: none of the faces chosen can be deformed: "
                          + "; ".join(f"face {k}: {why}" for k, why in skipped.items()))
     topology = body_topology(patches, listing["edges"], kept)
+    file_count = len(topology.interfaces)
+    loose = loose_faces(listing, kept)
+    if loose and len(loose) < len(kept):     # Breps and loose surfaces: join them
+        topology = join_loose_faces(surfaces, topology, loose)
     info = {"units": listing["units"], "faces": kept,
             "names": [listing["faces"][k].get("name") for k in kept],
             "reversed": [bool(listing["faces"][k].get("reversed")) for k in kept],
-            "trimmed": trimmed, "skipped": skipped}
+            "trimmed": trimmed, "skipped": skipped,
+            "joined_by_geometry": [
+                {"face_a": kept[i.a], "edge_a": i.edge_a, "face_b": kept[i.b],
+                 "edge_b": i.edge_b} for i in topology.interfaces[file_count:]]}
     return surfaces, topology, info
 
 

@@ -183,7 +183,9 @@ def topology_line(topology: dict[str, Any]) -> str:
     line = (f"edges: {topology['shared']} shared, {topology['boundary']} boundary, "
             f"{topology['seam']} seam(s), {topology['non_manifold']} non-manifold")
     if topology["off_sides"]:
-        line += f", {topology['off_sides']} on trimming loops (not joined)"
+        trims = topology.get("trim_edges") or {}
+        line += (f", {topology['off_sides']} on trimming loops ({trims.get('shared', 0)} "
+                 f"shared by two faces, {trims.get('free', 0)} free)")
     return (line + f"; {len(topology['interfaces'])} interface(s), {conforming} conforming")
 
 

@@ -206,4 +206,5 @@ def read_step(path: str | os.PathLike, face: int = 0) -> NurbsPatch:
         raise InputError(f"{path}: face {face!r} out of range; faces are numbered from 0")
     data = read_in_child(read_arrays, path, face, library="OpenCASCADE")
     return NurbsPatch(tuple(data["degrees"]), data["knots_u"], data["knots_v"],
-                      data["points"], data["weights"], units=data["units"])
+                      data["points"], data["weights"], units=data["units"],
+                      reversed=bool(data.get("reversed", False)))

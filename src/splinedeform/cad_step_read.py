@@ -68,8 +68,11 @@ def read_arrays(path: Path, face: int) -> dict[str, Any]:
     if bad_weights:
         _refuse_bad_weights(reader, faces[face], bad_weights, source)
     arrays = face_arrays(faces[face], source)
+    from OCP.TopAbs import TopAbs_REVERSED
+
     arrays["points"] /= millimetres(units)
     arrays["units"] = units
+    arrays["reversed"] = bool(faces[face].Orientation() == TopAbs_REVERSED)
     return arrays
 
 

@@ -50,15 +50,20 @@ class Topology:
     counts : dict
         ``shared`` (two faces), ``boundary`` (one use), ``seam`` (one face twice),
         ``non_manifold`` (more than two uses), and ``off_sides``: edges with a use that
-        lies on no side of its face's rectangle (a trimmed face's loop), not coupled.
+        lies on no side of its face's rectangle (a trimmed face's loop), not coupled here.
+    trim_edges : dict
+        Of the ``off_sides`` edges: ``shared`` (two faces use it: a body whose faces are
+        simulated trimmed couples them along it, :mod:`splinedeform.body.trim_edges`) and
+        ``free`` (one face).
     """
 
     interfaces: list[Interface] = field(default_factory=list)
     counts: dict[str, int] = field(default_factory=lambda: dict.fromkeys(EDGE_KINDS, 0))
+    trim_edges: dict[str, int] = field(default_factory=lambda: {"shared": 0, "free": 0})
 
     def as_dict(self) -> dict[str, Any]:
         """Plain data (for JSON): the counts and one dict per interface."""
-        return {**self.counts, "interfaces": [
+        return {**self.counts, "trim_edges": dict(self.trim_edges), "interfaces": [
             {"a": i.a, "edge_a": i.edge_a, "b": i.b, "edge_b": i.edge_b,
              "reversed": i.reversed, "conforming": i.conforming} for i in self.interfaces]}
 
@@ -176,6 +181,8 @@ def body_topology(patches: Sequence[NurbsPatch | None], edges: Sequence[dict[str
                     break
         if len(placed) < sum(patches[f] is not None for f in uses):
             topology.counts["off_sides"] += 1
+            if kind in ("shared", "boundary"):
+                topology.trim_edges["shared" if kind == "shared" else "free"] += 1
         if len(placed) < 2:
             continue
         fa, side_a, forward_a = placed[0]

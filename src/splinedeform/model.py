@@ -72,8 +72,9 @@ class Model:
         ``parametric``: the paper's energy per unit parameter area (Kronecker matrices);
         ``intrinsic``: the same plate under tension measured on the initial surface
         (:mod:`splinedeform.physics.intrinsic`), independent of the parametrisation.
-        A trimmed surface (``surface.trim``) takes ``parametric`` over its trimmed region
-        (:mod:`splinedeform.trim.model_matrices`), with ``boundary`` naming its loops
+        A trimmed surface (``surface.trim``) takes either over its trimmed region
+        (:mod:`splinedeform.trim.model_matrices`, :mod:`splinedeform.trim.intrinsic_trimmed`;
+        the shell's is :mod:`splinedeform.trim.shell_trimmed`), with ``boundary`` naming its loops
         (``{"outer": "clamped", "hole1": "free"}``). With bending weights, the tangent
         continuity across each C0 knot line where the rest shape is smooth is imposed
         exactly by the constraint map (:mod:`splinedeform.physics.coupling_ties`), the
@@ -355,9 +356,10 @@ class Model:
             of the largest static displacement ``max_t ‖K⁻¹F(t)‖_∞``, in the largest
             control-point coordinate (``c_∞ ≥ max_p √((M⁻¹)_pp)``,
             :mod:`splinedeform.solvers.mode_select`) at ``times`` (default 201 on
-            ``[0, t_end]``; one time for one state). It holds at **any** time asked later:
-            ``E`` never grows between jumps, and a time where the basis' bound misses
-            (just after a jump) is computed with modes chosen for it
+            ``[0, t_end]`` and half their spacing after each jump; one time for one
+            state). It holds at **any** time asked later: the bound is evaluated there,
+            and a time where the basis' bound misses (just after a jump) is computed with
+            modes chosen for it
             (``solution.accuracy``); the bound reached is ``solution.truncation["bound"]``.
             ``modes`` (keep the lowest k modes) or ``omega_max`` (keep ``ω <= omega_max``),
             both with the exact static part of the omitted modes (mode acceleration) and a

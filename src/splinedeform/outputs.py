@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
-from .mode_outputs import animated_modes, mode_file_names, mode_frames
+from .mode_outputs import mode_file_names, viewer_modes, write_mode_files
 from .outputs_body import body_outputs, write_body_files
 from .scenario.body import is_body
 
@@ -163,9 +163,10 @@ def _write_files(result: RunResult, folder: Path, stages: Stages) -> None:
         with stages.stage("viewer"):
             result.outputs.append(("viewer", write_viewer(
                 folder / "viewer.html", surface, rest, times, nets, resolution=res,
-                title=scenario.title or scenario.name)))
+                title=scenario.title or scenario.name, modes=viewer_modes(result))))
     if mode_file_names(result):
-        _write_mode_files(result, folder, stages)
+        write_mode_files(result, folder, stages, lambda path, mode_nets, what, label:
+                         _write_animation(result, path, stages, mode_nets, what, label))
     if "report" in formats:
         write_report(result, folder, stages)
 
@@ -289,33 +290,6 @@ def _write_animation(result: RunResult, path: Path, stages: Stages, nets: Any = 
             fps=result.scenario.output.fps, warp=picture_warp(result),
             camera=result.scenario.output.camera,
             label=label or FRAME_LABELS[result.scenario.solve.kind])))
-
-
-def _write_mode_files(result: RunResult, folder: Path, stages: Stages) -> None:
-    """The files of :func:`mode_file_names`: mode fields, per-mode nets and animations."""
-    from . import export
-
-    s = result.scenario
-    formats, name, res = s.output.formats, s.name, s.output.resolution
-    surface = result.built.surface
-    if "vtu" in formats:
-        with stages.stage("mode fields .vtu"):
-            result.outputs.append(("mode fields .vtu", export.write_mode_fields(
-                folder / f"{name}_modes.vtu", surface, result.mode_nets, resolution=res)))
-    wanted = [ext for ext in export.CONTROL_NET_FORMATS if ext in formats]
-    if wanted:
-        with stages.stage("mode nets"):
-            for k in range(1, len(result.mode_nets) + 1):
-                for path in export.write_control_nets(folder, f"{name}_mode{k}_nets", surface,
-                                                      result.times, mode_frames(result, k),
-                                                      formats=wanted):
-                    result.outputs.append((f"mode {k} nets {path.suffix}", path))
-    for k in animated_modes(result):
-        for ext in ("gif", "mp4"):
-            if k != 1 and ext in formats:
-                _write_animation(result, folder / f"{name}_mode{k}.{ext}", stages,
-                                 mode_frames(result, k), f"mode {k}",
-                                 f"mode {k} (ω = {float(result.omegas[k - 1]):.5g}), phase")
 
 
 def make_report(result: RunResult) -> dict[str, Any]:

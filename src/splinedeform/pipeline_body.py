@@ -50,7 +50,8 @@ def solve_body(scenario: Scenario, built: Built, stages: Any) -> Any:
                        else np.linspace(0.0, 1.0, solve.frames))
     solution, omegas, shapes = solve_and_modes(scenario, built, stages, times, body_static)
     patches = built.surface.patches
-    mode_nets = None if shapes is None else body_mode_displacements(patches, shapes)
+    mode_nets = None if shapes is None else body_mode_displacements(
+        patches, shapes, getattr(built.surface, "orientation", ()))
     with stages.stage("frames"), _located(scenario, "solve"):
         nets = _frames(scenario, patches, solution, times, mode_nets)
     shell_modes = None
@@ -65,18 +66,44 @@ def solve_body(scenario: Scenario, built: Built, stages: Any) -> Any:
     return result
 
 
-def body_mode_displacements(patches: Any, shapes: list[Any]) -> list[Any]:
-    """Per patch the modes as net displacements ``φ_k n`` (a shell's modes ``(k, n_u, n_v,
-    3)`` are displacements already) scaled over the whole body."""
-    from .pipeline import _net_normals
+def body_mode_displacements(patches: Any, shapes: list[Any],
+                            orientation: Any = ()) -> list[Any]:
+    """Per patch the modes as net displacements, scaled over the whole body.
 
-    D = [phi if phi.ndim == 4 else phi[..., None] * _net_normals(s)[None]
-         for s, phi in zip(patches, shapes)]
+    A scalar mode ``φ_k`` moves each control point along ``n̄``, the outward unit net normal
+    (:func:`splinedeform.pipeline._net_normals` turned by the face's ``orientation``)
+    averaged over every control point of the body that coincides with it at rest:
+    ``D_k = φ_k n̄``. The control points merged across a shared edge, a seam or at a pole
+    have one ``φ_k`` and one ``n̄``, so the drawn mode keeps the body closed. A shell's
+    modes ``(k, n_u, n_v, 3)`` are displacements already.
+    """
+    normals = body_net_normals(patches, orientation)
+    D = [phi if phi.ndim == 4 else phi[..., None] * n[None]
+         for phi, n in zip(shapes, normals)]
     rest = np.concatenate([s.control_points.reshape(-1, 3) for s in patches])
     size = float(np.ptp(rest, axis=0).max()) or 1.0
     peak = np.max([np.linalg.norm(d, axis=-1).max(axis=(1, 2)) for d in D], axis=0)
     factor = 0.1 * size / np.where(peak > 0, peak, 1.0)
     return [d * factor[:, None, None, None] for d in D]
+
+
+def body_net_normals(patches: Any, orientation: Any = ()) -> list[Any]:
+    """Per patch ``(n_u, n_v, 3)``: ``n̄`` of :func:`body_mode_displacements`, the sum of
+    the outward net normals ``σ_p n_p`` over the control points that coincide at rest (to
+    1e-9 of the body's size, or 1e-9 below a size of 1), normalised; a point whose sum
+    vanishes keeps its own."""
+    from .pipeline import _net_normals
+    from .viz.plots import _mean_per_point
+
+    signs = list(orientation) or [1] * len(patches)
+    own = [sign * _net_normals(s) for s, sign in zip(patches, signs)]
+    rest = np.concatenate([s.control_points.reshape(-1, 3) for s in patches])
+    flat = np.concatenate([n.reshape(-1, 3) for n in own])
+    total = _mean_per_point(rest, flat)
+    length = np.linalg.norm(total, axis=1, keepdims=True)
+    mean = np.where(length > 1e-9, total / np.where(length > 1e-9, length, 1.0), flat)
+    sizes = np.cumsum([0] + [s.shape[0] * s.shape[1] for s in patches])
+    return [mean[a:b].reshape(n.shape) for a, b, n in zip(sizes[:-1], sizes[1:], own)]
 
 
 def _frames(scenario: Scenario, patches: Any, solution: Any, times: Any, mode_nets: Any

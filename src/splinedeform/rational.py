@@ -15,7 +15,8 @@ Leibniz' rule applied to ``A = W f`` (Piegl & Tiller, *The NURBS Book*, eq. 4.20
 Points are evaluated in homogeneous coordinates ``(w p, w)`` on the polynomial bases
 (every fast path of :class:`~splinedeform.surface.Surface` serves the numerator), the
 basis ``R_kl`` from its local functions (:func:`basis_derivatives`), which the plate
-(:mod:`splinedeform.physics.rational_plate`), the intrinsic physics and the evaluation
+(:mod:`splinedeform.physics.rational_plate`), the intrinsic physics, the Kirchhoff–Love
+shell (:mod:`splinedeform.physics.shell`, through the metric's grid) and the evaluation
 matrices share. Weights of the form ``a_k b_l`` keep per-direction
 :class:`~splinedeform.knots.RationalBasis` objects instead (:func:`product_factors`).
 """
@@ -162,19 +163,30 @@ def derivative(surface: Surface, u: ArrayLike, v: ArrayLike, du: int = 0, dv: in
                control_points: ArrayLike | None = None) -> Array:
     """``∂^{du+dv} x / ∂u^du ∂v^dv`` at points ``(u, v)`` (broadcast), ``S + (c,)``.
 
-    ``control_points`` is another net on the same rational basis (``Σ R_kl d_kl``).
+    ``control_points`` is another net on the same rational basis (``Σ R_kl d_kl``); its
+    trailing axes after ``(n_u, n_v)`` (several nets, ``(n_u, n_v, F, 3)``) are kept,
+    ``S + (F, 3)``, as for polynomial bases.
     """
     twin, hom = polynomial(surface), homogeneous(surface, control_points)
-    return _from_homogeneous(lambda i, j: twin.derivative(u, v, i, j, control_points=hom),
-                             du, dv)
+    out = _from_homogeneous(lambda i, j: twin.derivative(u, v, i, j, control_points=hom),
+                            du, dv)
+    return out.reshape(out.shape[:-1] + _trailing(surface, control_points))
+
+
+def _trailing(surface: Surface, control_points: ArrayLike | None) -> tuple[int, ...]:
+    """The axes of a net after its ``(n_u, n_v)`` (``(3,)`` for the surface's own)."""
+    if control_points is None:
+        return surface.control_points.shape[2:]
+    return np.shape(control_points)[2:]
 
 
 def evaluate_grid(surface: Surface, u: ArrayLike, v: ArrayLike, du: int = 0, dv: int = 0,
                   control_points: ArrayLike | None = None) -> Array:
     """Tensor grid evaluation of :func:`derivative`, ``(len(u), len(v), c)``."""
     twin, hom = polynomial(surface), homogeneous(surface, control_points)
-    return _from_homogeneous(lambda i, j: twin.evaluate_grid(u, v, i, j, control_points=hom),
-                             du, dv)
+    out = _from_homogeneous(lambda i, j: twin.evaluate_grid(u, v, i, j, control_points=hom),
+                            du, dv)
+    return out.reshape(out.shape[:-1] + _trailing(surface, control_points))
 
 
 def grid_nets(surface: Surface, u: ArrayLike, v: ArrayLike, nets: ArrayLike) -> Array:
@@ -235,11 +247,3 @@ def rational_operators(V: sp.spmatrix, derivatives: Iterable[sp.spmatrix], weigh
     R = (inverse @ V @ scale).tocsr()
     return R, [(inverse @ (D @ scale - sp.diags(D @ w) @ R)).tocsr() for D in derivatives]
 
-
-def refuse(surface: Surface, what: str) -> None:
-    """InputError where ``what`` cannot take a surface with general (non-product) weights."""
-    if getattr(surface, "net_weights", None) is not None:
-        raise InputError(f"{what} does not take NURBS weights that are not a product "
-                         f"w_kl = a_k b_l (surface {surface.name!r}); its basis evaluation "
-                         "is a tensor product of 1-D bases. Use physics 'parametric' or "
-                         "'intrinsic', whose rational basis is assembled element by element")

@@ -177,5 +177,5 @@ def refine_surface(surface: Surface, elevate: tuple[int, int] = (0, 0),
         bases.append(new)
     if surface.net_weights is not None:
         return Surface(P[..., :3] / P[..., 3:], bases[0], bases[1], name=surface.name,
-                       net_weights=P[..., 3])
-    return Surface(P, bases[0], bases[1], name=surface.name)
+                       net_weights=P[..., 3], orientation=surface.orientation)
+    return Surface(P, bases[0], bases[1], name=surface.name, orientation=surface.orientation)

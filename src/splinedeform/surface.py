@@ -83,6 +83,11 @@ class Surface:
     trim : TrimDomain or None
         The trimmed region in ``(u, v)`` (:mod:`splinedeform.trim`); ``None``: the whole
         rectangle. Set by :meth:`with_trim`.
+    orientation : {1, -1}
+        The side a pressure pushes towards: ``orientation · x_u × x_v``. ``-1`` for a CAD
+        face its Brep marks reversed (its outward normal is ``-(x_u × x_v)``); the
+        parameters stay as they are. A body's default
+        (:attr:`splinedeform.body.Body.orientation`).
     """
 
     control_points: NDArray[np.float64]
@@ -92,6 +97,7 @@ class Surface:
     name: str = "surface"
     trim: Any = None
     net_weights: NDArray[np.float64] | None = None
+    orientation: int = 1
     _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -117,6 +123,9 @@ class Surface:
         object.__setattr__(self, "control_points", P)
         if self.net_weights is not None:
             self._check_net_weights()
+        if isinstance(self.orientation, bool) or self.orientation not in (1, -1):
+            raise InputError(f"orientation must be +1 or -1, got {self.orientation!r}")
+        object.__setattr__(self, "orientation", int(self.orientation))
 
     def _check_net_weights(self) -> None:
         """General weights: one per control point, > 0, on polynomial bases."""

@@ -12,6 +12,7 @@ The geometry does not move (``P' = T (a P) / a'`` in homogeneous coordinates).
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Iterator, Sequence
 
 import numpy as np
@@ -22,10 +23,12 @@ from ..errors import InputError
 from ..knots import KnotVectorBasis, RationalBasis
 from ..refine import boehm_insert
 from ..surface import Surface
-from .interface import Interface, TrimInterface
+from .interface import Interface, TrimEdgeInterface, TrimInterface
 from .topology import (KNOT_TOLERANCE, Topology, body_size, edge_basis, edges_of,
                        find_topology, normalised_knots)
-from .trimmed import checked_trim_interfaces, find_trim_interfaces, without_trimmed_edges
+from .trim_edges import find_edge_interfaces, labelled, trim_edge_summary
+from .trimmed import (checked_trim_interfaces, find_trim_interfaces, unmerged_at_trims,
+                      without_trimmed_edges)
 
 Array = NDArray[np.float64]
 MAX_PASSES = 16
@@ -47,11 +50,16 @@ class Body:
         (:func:`~.trimmed.find_trim_interfaces`) if not given.
     orientation : sequence of {+1, -1}, optional
         Per patch the sign ``s`` that makes ``s x_u × x_v`` the body's normal (a CAD face
-        marked reversed in its Brep has ``-1``); a pressure pushes along it. Default
-        ``+1`` for every patch. The parametrisations are left as they are.
+        marked reversed in its Brep has ``-1``); a pressure pushes along it. Default: each
+        patch's own :attr:`~splinedeform.Surface.orientation` (``+1`` unless it was read
+        reversed). The parametrisations are left as they are.
 
     Trimmed faces (``surface.trim``) meet along their trim curves: pairs of loops tracing
-    one curve are found geometrically (:mod:`.trimmed`), :attr:`trim_interfaces`.
+    one curve are found geometrically (:mod:`.trimmed`), :attr:`trim_interfaces`; then
+    the trim edges of the other loops with each other and with the boundary iso-edges of
+    other faces, in whole or in part (:mod:`.trim_edges`), :attr:`edge_interfaces`. An
+    iso-edge shared that way is no boundary edge, and an iso-edge interface of a trimmed
+    face (a rectangle with holes) is coupled by penalties, not merged.
 
     Examples
     --------
@@ -67,8 +75,11 @@ class Body:
                  tol: float | None = None,
                  trim_interfaces: Sequence[TrimInterface] | None = None,
                  orientation: Sequence[int] | None = None):
-        self.patches: tuple[Surface, ...] = tuple(patches)
-        self.orientation: tuple[int, ...] = _orientation(orientation, len(self.patches))
+        self.patches: tuple[Surface, ...] = tuple(
+            labelled(s) if isinstance(s, Surface) else s for s in patches)
+        self.orientation: tuple[int, ...] = _orientation(
+            [getattr(s, "orientation", 1) for s in self.patches] if orientation is None
+            else orientation, len(self.patches))
         found = without_trimmed_edges(self.patches, find_topology(self.patches, tol))
         if interfaces is None:
             self.topology = found
@@ -80,6 +91,18 @@ class Body:
             if trim_interfaces is not None
             else find_trim_interfaces(self.patches, self.topology.tol)
             if any(s.trim is not None for s in self.patches) else ())
+        self.edge_interfaces: tuple[TrimEdgeInterface, ...] = ()
+        if any(s.trim is not None for s in self.patches):
+            topology = unmerged_at_trims(self.patches, self.topology)
+            whole = {(i.a, i.loop_a) for i in self.trim_interfaces} | {
+                (i.b, i.loop_b) for i in self.trim_interfaces}
+            self.edge_interfaces = find_edge_interfaces(self.patches, topology.boundary,
+                                                        whole, topology.tol)
+            iso = {(i.a, i.edge_a) for i in self.edge_interfaces} | {
+                (i.b, i.edge_b) for i in self.edge_interfaces}
+            self.topology = replace(topology, boundary=tuple(
+                e for e in topology.boundary if e not in iso))
+            self.interfaces = self.topology.interfaces
 
     @classmethod
     def from_surfaces(cls, surfaces: Sequence[Surface], tol: float | None = None) -> Body:
@@ -104,6 +127,12 @@ class Body:
         non-conforming interfaces (:meth:`~.topology.Topology.summary`)."""
         return self.topology.summary()
 
+    def trim_summary(self) -> dict[str, int]:
+        """Counts of the trim edges of the body's trimmed faces: ``shared`` with another
+        face (in whole or in part), ``free``, and the coupled ``stretches``
+        (:func:`~.trim_edges.trim_edge_summary`)."""
+        return trim_edge_summary(self.patches, self.trim_interfaces, self.edge_interfaces)
+
     def evaluate(self, patch: int, u: ArrayLike, v: ArrayLike) -> Array:
         """Points ``x(u, v)`` of patch ``patch`` (:meth:`Surface.evaluate`)."""
         return self.patches[self._index(patch)].evaluate(u, v)
@@ -120,13 +149,15 @@ class Body:
 
     def conforming(self) -> Body:
         """The same body with every interface of equal degrees made conforming by exact knot
-        insertion (module docstring); interfaces of different degrees stay as they are."""
+        insertion (module docstring); interfaces of different degrees stay as they are,
+        and so do those of trimmed faces (coupled by penalties, never merged)."""
         patches = list(self.patches)
+        trims = {p for p, s in enumerate(patches) if s.trim is not None}
         for _ in range(MAX_PASSES):
             topology = find_topology(patches, self.topology.tol)
             if not insert_missing_knots(patches, [
                     i for i, aligned in zip(topology.interfaces, topology.aligned)
-                    if aligned and not i.conforming]):
+                    if aligned and not i.conforming and not {i.a, i.b} & trims]):
                 return Body(patches, None, self.topology.tol, orientation=self.orientation)
         raise InputError(f"knot insertion did not make the interfaces conform in {MAX_PASSES} "
                          "rounds; refine the patches to common knots")

@@ -62,3 +62,29 @@ class TrimInterface:
     def __str__(self) -> str:
         return (f"the trim interface of face {self.a} loop {self.loop_a} and face {self.b} "
                 f"loop {self.loop_b}")
+
+
+@dataclass(frozen=True)
+class TrimEdgeInterface:
+    """Edge ``edge_a`` of face ``a`` meets edge ``edge_b`` of face ``b`` along a common
+    stretch of both: the parameters ``part_a`` of ``a``'s curve and ``part_b`` of ``b``'s.
+
+    An edge is a trim edge (``outer``, ``hole1`` for a loop of one edge; ``outer.2`` for
+    edge 2 of a loop of several, as a boundary mapping names them) or an iso-edge of the
+    face's rectangle (``u0`` …). The curve of a trim edge is its loop (parameters as in
+    :func:`splinedeform.physics.coupling_curves.period`); that of an iso-edge the
+    rectangle's polygon ``(0, 0), (L_u, 0), (L_u, L_v), (0, L_v)`` (``v0`` is
+    ``t ∈ [0, 1]``, ``u1`` ``[1, 2]``, ``v1`` ``[2, 3]``, ``u0`` ``[3, 4]``). Found by
+    :func:`splinedeform.body.trim_edges.find_edge_interfaces`.
+    """
+
+    a: int
+    edge_a: str
+    part_a: tuple[float, float]
+    b: int
+    edge_b: str
+    part_b: tuple[float, float]
+
+    def __str__(self) -> str:
+        return (f"the shared trim edge of face {self.a} edge {self.edge_a} and face {self.b} "
+                f"edge {self.edge_b}")

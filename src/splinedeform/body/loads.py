@@ -6,7 +6,9 @@ patch, so on a body it must be (``OnPatch(Point(u, v, force), patch=i)``).
 
 A pressure pushes along ``s x_u × x_v`` on each patch, ``s`` the body's
 :attr:`~splinedeform.body.Body.orientation` of that patch (:func:`along_normal`): on a
-closed Brep the outward normal of every face, also where a face is marked reversed.
+closed Brep the outward normal of every face, also where a face is marked reversed. A
+single surface's pressure pushes along its own :attr:`~splinedeform.Surface.orientation`
+(:func:`surface_field`).
 """
 
 from __future__ import annotations
@@ -60,6 +62,14 @@ class OnPatch(Load):
     def field_vector(self, surface: Surface, t: float = 0.0) -> NDArray[np.float64]:
         """The wrapped load's vector on ``surface`` (the patch it acts on)."""
         return self.load.field_vector(surface, t)
+
+
+def surface_field(term: Load, surface: Surface, t: float = 0.0) -> NDArray[np.float64]:
+    """One load term's vector on a single surface, a pressure along
+    ``surface.orientation · x_u × x_v`` (the outward normal of a CAD face its Brep marks
+    reversed, as on a body's patch)."""
+    part = term.field_vector(surface, t)
+    return -part if along_normal(term) and getattr(surface, "orientation", 1) < 0 else part
 
 
 def along_normal(term: Load) -> bool:

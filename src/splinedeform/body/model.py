@@ -1,80 +1,32 @@
 """A body of patches deformed as one model: one energy, one constraint map, one solve.
 
-The unknowns are all patches' control points (patch after patch); per patch the matrices
-are those of a single surface (:func:`splinedeform.assembly.patch_matrices`), so that
-
-.. math:: K = \\operatorname{diag}(K_1, …, K_P), \\qquad M = \\operatorname{diag}(M_1, …, M_P),
-
-plus the penalties coupling non-conforming interfaces and, with bending, the rotation
-across every interface and C0 line (:mod:`splinedeform.physics.coupling_model`); the
-constraint map ``d = T d_free`` of :mod:`.constraints` merges the control points of
-conforming interfaces and poles and applies the edge conditions of boundary edges:
-``K_r = Tᵀ K T``, ``M_r = Tᵀ M T``, ``F_r = Tᵀ F``. Everything a solver or a solution needs
-(static, modes, the closed-form and numerical dynamics) is the single-surface model's
-(:class:`splinedeform.Model`), on these matrices.
+:class:`BodyModel` is the single-surface model (:class:`splinedeform.Model`: static, modes,
+the closed-form and numerical dynamics) on the system of the plate of a body, assembled
+by :func:`splinedeform.physics.plate_body.body_system`: the patches' own matrices on the
+diagonal, the couplings across interfaces, C0 lines and shared trim curves, and the
+constraint map ``d = T d_free`` that merges conforming interfaces and poles,
+``K_r = Tᵀ K T``, ``M_r = Tᵀ M T``, ``F_r = Tᵀ F``.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
-from functools import partial
-from typing import Any, Mapping, Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
-import scipy.linalg as sla
-import scipy.sparse as sp
 from numpy.typing import NDArray
-from scipy.sparse.csgraph import connected_components
 
-from ..assembly import check_bending, patch_matrices
-from ..errors import InputError
-from ..loads import Point
-from ..material import Material
 from ..model import Model, check_options
-from ..solvers.rigid import UnresolvedSpectrum, count_by_gap
-from ..solvers.system import Reduction
+from ..material import Material
+from ..physics.plate_body import BodyReduction, body_system, known_fields, rigid_count
+from ..physics.plate_body import refuse as _refuse
+from ..solvers.rigid import UnresolvedSpectrum, null_space
 from ..surface import Surface
-from ..physics.coupling_curves import curve_penalty
-from ..physics.coupling_model import bends, c0_coupling, interface_coupling
-from ..physics.plate import PlateFormulation
-from ..trim.model_matrices import trimmed_system
 from .body import Body
-from .constraints import boundary_presets, build_body_constraints
-from .interface import EDGES
-from .loads import OnPatch, along_normal
-from .trimmed import edge_boundary, face_boundary, loop_presets, with_trimmed_faces
+
+__all__ = ["BodyModel", "BodyReduction", "_refuse"]
 
 Array = NDArray[np.float64]
-PROBE_LIMIT = 1500
-"""Most free coordinates whose rigid modes a bending body without a clamped part counts on
-its dense spectrum (:attr:`BodyModel.rigid_modes`): a few seconds of ``eigh``."""
-
-
-@dataclass(frozen=True)
-class BodyReduction(Reduction):
-    """:class:`~splinedeform.solvers.system.Reduction` of a body: a load's vector is the
-    patches' vectors, patch after patch; :class:`.OnPatch` loads act on their patch only.
-    ``signs`` is the body's :attr:`~.Body.orientation` (empty: ``+1`` on every patch): a
-    pressure's vector on patch ``p`` is ``signs[p] ∫ q (x_u × x_v) N_k``
-    (:func:`.loads.along_normal`)."""
-
-    signs: tuple[int, ...] = ()
-
-    def field(self, term: Any, t: float = 0.0) -> Array:
-        parts = []
-        turned = along_normal(term)
-        for p, surface in enumerate(self.surface):
-            if isinstance(term, OnPatch):
-                part = (term.load.field_vector(surface, t) if term.patch == p
-                        else np.zeros((surface.shape[0] * surface.shape[1], 3)))
-            elif isinstance(term, Point):
-                raise InputError("a point load on a body needs its patch: "
-                                 "splinedeform.body.OnPatch(Point(u, v, force), patch=i)")
-            else:
-                part = term.field_vector(surface, t)
-            parts.append(-part if turned and self.signs and self.signs[p] < 0 else part)
-        return np.concatenate(parts)
 
 
 class BodyModel(Model):
@@ -114,10 +66,11 @@ class BodyModel(Model):
     edge's splines (a penalised mortar condition); with bending weights, every interface
     and C0 knot line also by a penalty on the slope jump across it. The factors come from
     the material and the mesh (:mod:`splinedeform.physics.coupling_model`); the mass is
-    the patches' own. A trimmed face (``physics = "parametric"`` only) brings the matrices
+    the patches' own. A trimmed face (``parametric`` or ``intrinsic``) brings the matrices
     and the extension map of :func:`~splinedeform.trim.model_matrices.trimmed_system`,
     and the faces sharing a trim curve are coupled along it by the same penalties
-    (:func:`~splinedeform.physics.coupling_curves.curve_penalty`).
+    (:func:`~splinedeform.physics.coupling_curves.curve_penalty`), those sharing a
+    stretch of a trim edge along it (:func:`~.trim_edges.edge_penalty`).
 
     Examples
     --------
@@ -138,66 +91,19 @@ class BodyModel(Model):
         if not isinstance(body, Body):
             body = Body(body)
         check_options(material, mass_matrix, rest, physics)
-        topology = body.topology
-        _refuse(topology)
+        system = body_system(body, material, boundary, mass_matrix, rest, physics)
         self.body = body
         self.patches: tuple[Surface, ...] = body.patches
         self.surface = None            # no single surface: the read-out has the patches
         self.gram_u = self.gram_v = None
         self.material, self.mass_matrix, self.rest, self.physics = (material, mass_matrix,
                                                                     rest, physics)
-        for surface in self.patches:
-            check_bending(surface, material)
-        trims = body.trim_interfaces
-        faces = {p for p, s in enumerate(self.patches) if s.trim is not None}
-        if faces and physics != "parametric":
-            raise InputError(f"a body with trimmed faces ({sorted(faces)}) takes physics "
-                             f"'parametric' (each face's energy over its trimmed region); "
-                             f"{physics!r} is not trimmed yet")
-        loops = loop_presets(self.patches, trims, boundary)
-        presets = boundary_presets(edge_boundary(boundary, loops), topology)
-        self.constraints = build_body_constraints(
-            self.patches, topology, {k: "free" if k[0] in faces else v
-                                     for k, v in presets.items()}, bends(material))
-        systems = {p: trimmed_system(self.patches[p], material,
-                                     face_boundary(p, self.patches[p], presets, loops),
-                                     mass_matrix == "lumped", physics, rest=rest)
-                   for p in sorted(faces)}
-        if systems:
-            self.constraints = replace(with_trimmed_faces(
-                self.constraints, self.patches, {p: s.constraints for p, s in systems.items()},
-                loops), edges={**presets, **loops})
-        if self.constraints.n_free == 0:
-            error = InputError(f"no free coordinate: the boundary fixes every control point of "
-                               f"the {len(self.patches)} patches; free an edge or refine them")
-            error.key = "boundary"  # type: ignore[attr-defined]
-            raise error
-        blocks = [(systems[p].stiffness, systems[p].mass) if p in systems
-                  else patch_matrices(s, material, physics, mass_matrix == "lumped")[2:]
-                  for p, s in enumerate(self.patches)]
-        K = sp.block_diag([k for k, _ in blocks], format="csr")
-        M = sp.block_diag([m for _, m in blocks], format="csr")
-        offsets = self.constraints.offsets
-        size = int(offsets[-1])
-        ties = self.constraints.ties
-        couplings = [interface_coupling(self.patches, topology.interfaces, material,
-                                        self.constraints.edges, offsets[:-1], ties.interfaces)]
-        couplings += [curve_penalty(self.patches, i, material, offsets[:-1]) for i in trims]
-        couplings += [c0_coupling(s, material, {e: self.constraints.edges.get((p, e), "free")
-                                                for e in EDGES}, int(offsets[p]), size,
-                                  {(d, k) for q, d, k in ties.lines if q == p})
-                      for p, s in enumerate(self.patches)]
-        for penalty in (c for c in couplings if c is not None):
-            K = (K + penalty).tocsr()
-        reduction = partial(BodyReduction, signs=body.orientation)
-        self.formulation = PlateFormulation(physics, material, patches=self.patches,
-                                            reduction_type=reduction,
-                                            unconstrained=self.constraints.unconstrained)
-        self._full = (K, M)
-        T = self.constraints.T
-        self._K = (T.T @ K @ T).tocsc()
-        self._M = (T.T @ M @ T).tocsc()
+        self.constraints = system.constraints
+        self.formulation = system.formulation
+        self._full = system.full
+        self._K, self._M = system.reduced
         self._C = None
+        self._null: tuple[Array | None] | None = None
         self._finish(start)
 
     # -- layout ------------------------------------------------------------------------
@@ -214,64 +120,36 @@ class BodyModel(Model):
 
     @property
     def rigid_modes(self) -> int | None:
-        """Dimension of ``null K_r``: with tension in both directions the energy vanishes on
-        constant displacements only, one per connected part of the body that no pinned or
-        clamped edge holds. Without tension but with bending in both directions
-        (``w20, w02 > 0``) it is 0 where a clamped edge holds every part: a field without
-        energy is a polynomial with ``d_uu = d_vv = 0`` (``Δ d = 0`` intrinsic) on each span,
-        which vanishes with its value and slope on a segment (unique continuation), and the
-        merged points, the ties and the penalties carry value and slope across every span
-        border and interface. Otherwise (a bending body with a free part) it is counted on
-        the matrices themselves, up to :data:`PROBE_LIMIT` free coordinates: the
-        eigenvalues of ``K_r φ = λ M_r φ`` at round-off level behind a clear gap
-        (:func:`~splinedeform.solvers.rigid.count_by_gap`; a connected closed body: 1, the
-        constants, as ``Δ_S d = 0`` on a closed surface leaves nothing else; a free flat
-        plate: the fields linear in ``x, y``). ``None`` (unknown) beyond that size, with
-        no bending in both directions, or without a clear gap."""
+        """Dimension of ``null K_r``: from the weights and the constraints where they decide
+        it (:func:`splinedeform.physics.plate_body.rigid_count`: with tension one constant
+        per part that nothing holds; with bending 0 where a clamped edge holds every part),
+        else (a bending body with a free part) counted on the matrices at any size
+        (:func:`~splinedeform.solvers.rigid.null_space`: dense ``eigh`` up to 1500 free
+        coordinates, shift-invert Lanczos near 0 beyond), whose basis is
+        :attr:`rigid_fields`. A connected closed body has 1, the constants, as
+        ``Δ_S d = 0`` on a closed surface leaves nothing else; a free flat plate its discrete
+        harmonic fields (``physics = "intrinsic"``: ``1, x, y, xy, x² − y², …`` as far as
+        the degree reaches; ``parametric`` with ``w11 > 0``: ``1, u, v``). ``None`` (unknown) with no bending in both directions or
+        without a clear gap between round-off and the elastic eigenvalues."""
         if self._rigid is None:
-            self._rigid = (self._rigid_count(),)
+            count = rigid_count(self.body, self.material, self.constraints)
+            if count is None and self.rigid_fields is not None:
+                count = int(self.rigid_fields.shape[1])
+            self._rigid = (count,)
         return self._rigid[0]
 
-    def _rigid_count(self) -> int | None:
-        m = self.material
-        if m.w10 > 0 and m.w01 > 0:
-            holds = ("pinned", "clamped")
-        elif m.w20 > 0 and m.w02 > 0:
-            holds = ("clamped",)
-        else:
-            return None
-        n = len(self.patches)
-        links = [(i.a, i.b) for i in self.body.topology.interfaces + self.body.trim_interfaces
-                 ] or [(0, 0)]
-        graph = sp.coo_matrix((np.ones(len(links)), np.array(links).T), shape=(n, n))
-        parts, label = connected_components(graph, directed=False)
-        held = np.zeros(parts, dtype=bool)
-        for (p, _), preset in self.constraints.edges.items():
-            held[label[p]] |= preset in holds
-        if holds == ("pinned", "clamped"):
-            return int(np.sum(~held))
-        if held.all():
-            return 0
-        if self.n_free > PROBE_LIMIT:
-            return None
-        lam = sla.eigh(self._K.toarray(), self._M.toarray(), eigvals_only=True,
-                       check_finite=False)
-        try:
-            return count_by_gap(lam, "the rigid modes of a free bending body")
-        except UnresolvedSpectrum:
-            return None
-
-
-def _refuse(topology: Any) -> None:
-    """Refuse what neither the constraint map nor a penalty couples (see :class:`BodyModel`)."""
-    if topology.non_manifold:
-        group = topology.non_manifold[0]
-        names = ", ".join(f"patch {p} edge {e}" for p, e in group)
-        raise InputError(f"non-manifold edge: {len(group)} patch edges meet on one curve "
-                         f"({names}); a body's edge joins at most two patch edges")
-    for i, aligned in zip(topology.interfaces, topology.aligned):
-        if not aligned:
-            raise InputError(f"interface between patch {i.a} edge {i.edge_a} and patch {i.b} "
-                             f"edge {i.edge_b}: the edges meet, but their parametrisations "
-                             "along the curve are not an affine map of each other, which the "
-                             "coupling follows; reparametrise one of the two patches")
+    @property
+    def rigid_fields(self) -> Array | None:
+        """An ``M_r``-orthonormal basis ``(n_free, k)`` of ``null K_r`` found on the
+        matrices (module docstring of :mod:`splinedeform.solvers.rigid`), or ``None``
+        where the weights leave no clear gap; for the fields of every control point,
+        :meth:`to_full` of its columns."""
+        if self._null is None:
+            m = self.material
+            try:
+                known = known_fields(self.patches, self.constraints)
+                self._null = (null_space(self._K, self._M, "the rigid modes of a body",
+                                         known) if m.w20 > 0 and m.w02 > 0 else None,)
+            except UnresolvedSpectrum:
+                self._null = (None,)
+        return self._null[0]

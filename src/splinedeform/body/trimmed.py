@@ -68,6 +68,16 @@ def without_trimmed_edges(patches: Sequence[Surface], topology: Topology) -> Top
                     topology.tol)
 
 
+def unmerged_at_trims(patches: Sequence[Surface], topology: Topology) -> Topology:
+    """``topology`` with every interface of a trimmed face (an iso-edge of a rectangle with
+    holes) marked non-conforming, so that it is coupled by penalties: a trimmed face's
+    control points follow its own extension map and are merged with no other face's."""
+    faces = {p for p, s in enumerate(patches) if trimmed(s)}
+    turned = tuple(replace(i, conforming=False) if {i.a, i.b} & faces else i
+                   for i in topology.interfaces)
+    return replace(topology, interfaces=turned)
+
+
 def curve_loops(surface: Surface) -> list[int]:
     """Indices of a face's trim loops that are curves of its region's boundary (all but
     the rectangle of a rectangle with holes)."""
@@ -142,23 +152,38 @@ def _nearest(a: Array, b: Array) -> float:
 
 
 def loop_presets(patches: Sequence[Surface], interfaces: Sequence[TrimInterface],
-                 boundary: str | Mapping[Any, str]) -> dict[Edge, str]:
+                 boundary: str | Mapping[Any, str],
+                 edge_interfaces: Sequence[Any] = ()) -> dict[Edge, str]:
     """The preset of every trim loop of a trimmed face, keyed ``(face, loop name)``
-    (``outer``, ``hole1`` …): ``free`` where it is a trim interface, else the body's
-    preset name or ``boundary[(face, name)]`` (missing: free)."""
+    (``outer``, ``hole1`` …), and of its trim edges named in ``boundary`` or shared,
+    keyed ``(face, "outer.2")``: ``free`` where the loop is a trim interface or the edge
+    is shared with another face (:class:`~.interface.TrimEdgeInterface`, in whole or in
+    part), else the body's preset name or ``boundary[key]`` (an edge missing there takes
+    its loop's, a loop missing there is free)."""
     shared = {(i.a, i.loop_a) for i in interfaces} | {(i.b, i.loop_b) for i in interfaces}
+    edges = {(i.a, i.edge_a) for i in edge_interfaces} | {(i.b, i.edge_b) for i in
+                                                           edge_interfaces}
+    given = {} if isinstance(boundary, str) else boundary
     out: dict[Edge, str] = {}
     for p, surface in enumerate(patches):
         names = loop_names(surface.trim) if trimmed(surface) else ()
         for k in curve_loops(surface):
             key = (p, names[k])
-            if (p, k) in shared:
-                if not isinstance(boundary, str) and key in boundary:
-                    raise InputError(f"boundary[{key!r}]: loop {names[k]} of face {p} is a "
-                                     "trim interface, not a boundary loop")
+            count = surface.trim.edge_count(k)
+            keys = [key] + [(p, f"{names[k]}.{e}") for e in range(count) if count > 1]
+            for one in keys:
+                if ((p, k) in shared or one in edges) and one in given:
+                    raise InputError(f"boundary[{one!r}]: {one[1]} of face {p} is shared with "
+                                     "another face, not a boundary loop or edge")
+            if (p, k) in shared or key in edges:
                 out[key] = "free"
-            else:
-                out[key] = boundary if isinstance(boundary, str) else boundary.get(key, "free")
+                continue
+            out[key] = boundary if isinstance(boundary, str) else given.get(key, "free")
+            for one in keys[1:]:
+                if one in edges:
+                    out[one] = "free"
+                elif one in given:
+                    out[one] = given[one]
     return out
 
 

@@ -8,7 +8,8 @@ in the target folder, which then replaces the target with :func:`os.replace`.
 * :mod:`.weld` — welded meshes of closed and degenerate surfaces, vertex normals;
 * :mod:`.series` — ParaView ``.pvd`` + ``.vtu`` time series;
 * :mod:`.body` — a body's patches in one .3dm / STEP file, one welded mesh or series;
-* :mod:`.modes` — vibration modes as displacement fields of one ``.vtu``;
+* :mod:`.modes` — vibration modes as displacement fields of one ``.vtu`` (a surface's or
+  a body's, welded);
 * :mod:`.nets` — control nets as JSON / NPZ with their full knot vectors;
 * :mod:`.report` — ``report.json`` and ``report.md``;
 * :mod:`.run_folder` — a run's manifest, stale files of earlier runs, the folder lock.
@@ -26,7 +27,7 @@ from .report import (REPORT_TABLE_ROWS, format_value, plain, report_markdown, se
                      write_report)
 from .weld import WELD_TOLERANCE, vertex_normals, weld
 from .series import frame_file_names, pvd_text, write_time_series
-from .modes import mode_field_names, write_mode_fields
+from .modes import mode_field_names, write_body_mode_fields, write_mode_fields
 
 __all__ = ["FolderClaim", "MANIFEST_FORMAT", "claim_folder", "file_digest", "manifest_name",
            "read_manifest", "CONTROL_NET_FORMAT", "CONTROL_NET_FORMATS", "CONTROL_NET_VERSION", "CONVENTION",
@@ -35,4 +36,4 @@ __all__ = ["FolderClaim", "MANIFEST_FORMAT", "claim_folder", "file_digest", "man
            "read_control_net", "report_markdown", "section_markdown", "tessellate_frames",
            "write_control_nets", "write_mesh", "write_report", "write_text", "write_time_series",
            "write_with", "write_obj", "weld", "vertex_normals", "WELD_TOLERANCE",
-           "mode_field_names", "write_mode_fields"]
+           "mode_field_names", "write_body_mode_fields", "write_mode_fields"]

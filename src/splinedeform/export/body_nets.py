@@ -4,10 +4,11 @@
   [k, …], "times": [...], "nets": {"k": document, …}}``, where each ``document`` is the
   face's own control-net document (:func:`.nets.control_net_document`: name, bases with
   their knots, weights, the times and the nets ``(F, n_u, n_v, 3)``, the convention that
-  evaluates them), keyed by the face's number in the file;
+  evaluates them) and ``reversed`` (whether the face's Brep marks it reversed: its outward
+  normal is ``-(x_u × x_v)``), keyed by the face's number in the file;
 * ``stem.npz``: ``format``, ``version``, ``faces`` ``(P,)`` and ``times`` ``(F,)``, and per
   face ``k`` the arrays of its single-net ``.npz`` named ``face<k>/<field>``
-  (``face3/control_points``, ``face3/knots_u``, …).
+  (``face3/control_points``, ``face3/knots_u``, …, ``face3/reversed``).
 
 :func:`read_body_control_nets` reads either back as ``{face: Surface}`` at one frame.
 """
@@ -35,14 +36,19 @@ BODY_NETS_VERSION = 1
 
 
 def body_nets_document(surfaces: Sequence[Surface], faces: Sequence[int], times: ArrayLike,
-                       nets: Sequence[ArrayLike]) -> dict[str, Any]:
-    """The content of a body's control-net file as JSON types (see the module docstring)."""
+                       nets: Sequence[ArrayLike], orientation: Sequence[int] = ()
+                       ) -> dict[str, Any]:
+    """The content of a body's control-net file as JSON types (see the module docstring);
+    ``orientation`` has ``-1`` per reversed patch (empty: none is)."""
+    from .body import _signs
+
     if not (len(surfaces) == len(faces) == len(nets)) or not surfaces:
         raise InputError(f"a body's control nets need one face number and one set of nets "
                          f"per patch: got {len(surfaces)} patch(es), {len(faces)} face "
                          f"number(s) and {len(nets)} set(s) of nets")
-    documents = {str(int(f)): control_net_document(s, times, n)
-                 for s, f, n in zip(surfaces, faces, nets)}
+    signs = _signs(orientation, len(surfaces))
+    documents = {str(int(f)): {**control_net_document(s, times, n), "reversed": sign < 0}
+                 for s, f, n, sign in zip(surfaces, faces, nets, signs)}
     return {"format": BODY_NETS_FORMAT, "version": BODY_NETS_VERSION,
             "faces": [int(f) for f in faces],
             "times": next(iter(documents.values()))["times"], "nets": documents}
@@ -51,13 +57,15 @@ def body_nets_document(surfaces: Sequence[Surface], faces: Sequence[int], times:
 def write_body_control_nets(directory: str | os.PathLike[str], stem: str,
                             surfaces: Sequence[Surface], faces: Sequence[int],
                             times: ArrayLike, nets: Sequence[ArrayLike],
-                            formats: Sequence[str] = CONTROL_NET_FORMATS) -> list[Path]:
-    """Write every face's nets at every frame as ``stem.json`` and/or ``stem.npz``."""
+                            formats: Sequence[str] = CONTROL_NET_FORMATS,
+                            orientation: Sequence[int] = ()) -> list[Path]:
+    """Write every face's nets at every frame as ``stem.json`` and/or ``stem.npz``, each
+    face marked ``reversed`` where ``orientation`` has ``-1``."""
     folder = _require_folder(directory)
     _check_stem(stem)
     if not formats or any(f not in CONTROL_NET_FORMATS for f in formats):
         raise InputError(f"control nets are written as {CONTROL_NET_FORMATS}, got {list(formats)}")
-    document = body_nets_document(surfaces, faces, times, nets)
+    document = body_nets_document(surfaces, faces, times, nets, orientation)
     paths = []
     if "json" in formats:
         paths.append(write_text(folder / f"{stem}.json", json.dumps(document) + "\n"))

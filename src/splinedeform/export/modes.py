@@ -1,8 +1,10 @@
-"""Vibration modes for ParaView: one ``.vtu`` with a displacement field per mode."""
+"""Vibration modes for ParaView: one ``.vtu`` with a displacement field per mode, of one
+surface (:func:`write_mode_fields`) or of every face of a body (:func:`write_body_mode_fields`)."""
 
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -42,3 +44,36 @@ def write_mode_fields(path: str | os.PathLike[str], surface: Surface, mode_nets:
     keep, faces = weld(np.concatenate([X0[None], X0[None] + fields]), faces)
     data = {name: fields[k, keep] for k, name in enumerate(mode_field_names(len(D)))}
     return write_mesh(path, X0[keep], faces, data)
+
+
+def write_body_mode_fields(path: str | os.PathLike[str], surfaces: Sequence[Surface],
+                           mode_nets: Sequence[ArrayLike], resolution: int = 32,
+                           orientation: Sequence[int] = ()) -> Path:
+    """:func:`write_mode_fields` of a body: every face in one welded mesh.
+
+    ``mode_nets[p]`` ``(K, n_u, n_v, 3)`` holds the modes of patch ``p`` as control-net
+    displacements. The points are the rest geometry of every patch sampled on its ``r × r``
+    grid and welded where the patches meet at rest and in every mode
+    (:func:`.body.welded_body_points`, triangles wound along ``orientation``); the point
+    data ``mode_k = X(P_rest + D_k) − X(P_rest)`` is mode ``k`` as a displacement and
+    ``patch`` the patch each point was first sampled on.
+    """
+    from .body import _check_body, welded_body_points
+
+    rests = _check_body(surfaces, [s.control_points for s in surfaces], "rest net")
+    if len(mode_nets) != len(surfaces):
+        raise InputError(f"a body of {len(surfaces)} patch(es) needs as many mode sets, got "
+                         f"{len(mode_nets)}")
+    D = [np.asarray(d, dtype=float) for d in mode_nets]
+    for k, (s, d) in enumerate(zip(surfaces, D)):
+        if d.ndim != 4 or d.shape[0] == 0 or d.shape[1:] != (*s.shape, 3) \
+                or d.shape[0] != D[0].shape[0] or not np.all(np.isfinite(d)):
+            raise InputError(f"the modes of patch {k} must be a finite array (K, {s.shape[0]}, "
+                             f"{s.shape[1]}, 3) with the same K >= 1 for every patch, got "
+                             f"shape {d.shape}")
+    X, faces, patch, _ = welded_body_points(
+        surfaces, [np.concatenate([r[None], r[None] + d]) for r, d in zip(rests, D)],
+        resolution, orientation)
+    data = {name: X[k + 1] - X[0] for k, name in enumerate(mode_field_names(len(D[0])))}
+    data["patch"] = patch.astype(float)
+    return write_mesh(path, X[0], faces, data)

@@ -46,6 +46,7 @@ from ..trim.loops import CircleLoop, PolygonLoop
 from ..trim.spline_loop import SplineLoop
 from ..trim.values import tensor_values
 from .coupling import line_penalty, penalty_factors
+from .coupling_parts import kinks, running_space, stretch_space
 from .coupling_traces import (EXTRA_POINTS, Line, Trace, check_meet, gauss, trace_of,
                               union)
 
@@ -125,19 +126,25 @@ class CurveSide:
     """One side of a coupling curve: ``surface`` along its curve ``loop`` (in ``(u, v)``).
 
     ``outward`` is ``+1`` when the face's region lies on the left of the curve's direction
-    (so the right-hand normal ``ν`` points out of it), ``−1`` otherwise.
+    (so the right-hand normal ``ν`` points out of it), ``−1`` otherwise. ``part`` is the
+    stretch ``[t_0, t_1]`` of the curve's parameter that the side covers (a trim edge, or
+    the common part of two edges; ``t_1`` may pass the period of a closed curve), None for
+    the whole closed curve.
     """
 
     surface: Surface
     loop: Any
     outward: int
+    part: tuple[float, float] | None = None
 
     @classmethod
-    def of_loop(cls, surface: Surface, loop: Any) -> CurveSide:
+    def of_loop(cls, surface: Surface, loop: Any,
+                part: tuple[float, float] | None = None) -> CurveSide:
         """The side with its ``outward`` sign found by testing a point just left of the curve
         against the face's region (its trim, or the parameter rectangle)."""
         from ..trim.surface_trim import region_contains
-        t = curve_breaks(loop, *_grid(surface))
+        t = curve_breaks(loop, *_grid(surface)) if part is None else \
+            _within(curve_breaks(loop, *_grid(surface)), period(loop), part)
         mid = 0.5 * (t[:-1] + t[1:])
         p, d = curve_points(loop, mid)
         (_, lu), (_, lv) = surface.domain
@@ -145,11 +152,17 @@ class CurveSide:
         left = p + step * np.stack([-d[:, 1], d[:, 0]], axis=-1) / np.hypot(*d.T)[:, None]
         inside = (region_contains(surface, left) if surface.trim is not None else
                   (left[:, 0] > 0) & (left[:, 0] < lu) & (left[:, 1] > 0) & (left[:, 1] < lv))
-        return cls(surface, loop, 1 if np.mean(inside) >= 0.5 else -1)
+        return cls(surface, loop, 1 if np.mean(inside) >= 0.5 else -1, part)
+
+    def bounds(self) -> tuple[float, float]:
+        """``(t_0, t_1)``: the part, or ``(0, period)`` for the whole curve."""
+        return (0.0, period(self.loop)) if self.part is None else self.part
 
     def breaks(self) -> Array:
-        """Parameters where the curve crosses this face's knot lines (:func:`curve_breaks`)."""
-        return curve_breaks(self.loop, *_grid(self.surface))
+        """Parameters where the curve crosses this face's knot lines (:func:`curve_breaks`),
+        on the part only (its ends included) where the side has one."""
+        every = curve_breaks(self.loop, *_grid(self.surface))
+        return every if self.part is None else _within(every, period(self.loop), self.part)
 
     def points(self) -> int:
         """Gauss points per piece: ``n + 1 +`` :data:`EXTRA_POINTS` (the face's degree)."""
@@ -183,39 +196,69 @@ class CurveSide:
         return trace_of(V, Df.tocsr(), Dr.tocsr(),
                         self.surface.control_points.reshape(-1, 3), self.outward)
 
-    def closest(self, x: Array) -> Array:
+    def closest(self, x: Array, start: Array | None = None) -> Array:
         """Curve parameters of the points of the curve closest to ``x`` ``(Q, 3)``:
-        Gauss–Newton on ``g(t) = (X(t) − x) · X'(t) = 0`` from the nearest sample."""
+        Gauss–Newton on ``g(t) = (X(t) − x) · X'(t) = 0`` from ``start`` or else the
+        nearest sample; on a part, ``t`` is kept in it."""
         T = period(self.loop)
         t0 = self.breaks()
-        sample = (t0[:-1, None] + np.diff(t0)[:, None]
-                  * (np.arange(SAMPLES_PER_PIECE) / SAMPLES_PER_PIECE)).ravel()
-        X, _ = self.position(sample)
-        nearest = np.argmin(((x[:, None, :] - X[None]) ** 2).sum(-1), axis=1)
-        t = sample[nearest]
+        lo, hi = self.bounds()
+        if start is None:
+            sample = np.append((t0[:-1, None] + np.diff(t0)[:, None]
+                                * (np.arange(SAMPLES_PER_PIECE) / SAMPLES_PER_PIECE)).ravel(),
+                               t0[-1])
+            X, _ = self.position(sample)
+            t = sample[np.argmin(((x[:, None, :] - X[None]) ** 2).sum(-1), axis=1)]
+        else:
+            t = np.asarray(start, dtype=float).copy()
+        limit = 0.5 * (hi - lo) / max(len(t0) - 1, 1)
         for _ in range(NEWTON_STEPS):
             X, dX = self.position(t)
             step = np.einsum("qi,qi->q", X - x, dX) / np.einsum("qi,qi->q", dX, dX)
-            step = np.clip(step, -0.5 * T / len(t0), 0.5 * T / len(t0))
-            t = np.mod(t - step, T)
-            if np.max(np.abs(step)) <= 1e-14 * T:
+            step = np.clip(step, -limit, limit)
+            t = np.mod(t - step, T) if self.part is None else np.clip(t - step, lo, hi)
+            if np.max(np.abs(step), initial=0.0) <= 1e-14 * T:
                 break
         return t
 
 
-def curve_line(side_a: CurveSide, side_b: CurveSide, where: str) -> tuple[Line, float]:
+def _within(breaks: Array, T: float, part: tuple[float, float]) -> Array:
+    """The breaks of a closed curve (on ``[0, T]``, repeated with its period) inside
+    ``part``, and the part's two ends."""
+    lo, hi = part
+    turns = np.arange(np.floor(lo / T) - 1, np.ceil(hi / T) + 1)
+    every = (breaks[None, :] + T * turns[:, None]).ravel()
+    inner = every[(every > lo) & (every < hi)]
+    return lo + union((np.concatenate([[lo, hi], inner]) - lo) / (hi - lo),
+                      np.zeros(0), 1e-10) * (hi - lo)
+
+
+def curve_line(side_a: CurveSide, side_b: CurveSide, where: str,
+               start: Any = None, running: int | None = None) -> tuple[Line, float]:
     """Both sides' traces on ``Γ`` (module docstring) and the element size ``h`` along it
     (the smaller of the two sides' mean piece lengths). Raises where the two rest curves do
-    not coincide."""
-    T = period(side_a.loop)
+    not coincide.
+
+    Sides with parts (two trim edges, or a trim edge and an iso-edge, meeting along a
+    common stretch): Gauss points on ``a``'s part only, the trace space open B-splines on
+    it (:func:`~.coupling_parts.stretch_space`); ``start(t)`` maps ``a``'s parameters to
+    first guesses of ``b``'s (a monotone map of the part's ends,
+    :func:`~splinedeform.body.trim_edges.common_parts`). ``running = 0`` or ``1`` names a
+    side that is an iso-edge: the trace space is then its own running basis
+    (:func:`~.coupling_parts.running_space`), the mortar choice of an iso-edge interface."""
+    lo, hi = side_a.bounds()
     breaks_a = side_a.breaks()
     breaks_b = side_b.breaks()
-    Xb, _ = side_b.position(breaks_b[:-1])
-    mapped = side_a.closest(Xb)
-    breaks = union(breaks_a / T, np.concatenate([[0.0, 1.0], np.sort(mapped) / T])) * T
+    ends_b = breaks_b[:-1] if side_b.part is None else breaks_b
+    Xb, _ = side_b.position(ends_b)
+    guess = None if start is None else np.interp(ends_b, *_inverse(start, lo, hi))
+    mapped = np.clip(side_a.closest(Xb, guess), lo, hi)
+    breaks = lo + union((breaks_a - lo) / (hi - lo),
+                        np.concatenate([[0.0, 1.0], np.sort(mapped - lo) / (hi - lo)]),
+                        1e-9 if side_a.part is not None else 1e-12) * (hi - lo)
     t, w = gauss(breaks, max(side_a.points(), side_b.points()))
     trace_a = side_a.traces(t)
-    s = side_b.closest(trace_a.points)
+    s = side_b.closest(trace_a.points, None if start is None else start(t))
     trace_b = side_b.traces(s)
     check_meet((trace_a, trace_b), (side_a.surface, side_b.surface), t,
                f"{where}: the two trim curves do not meet; at t = {{at}} of the first")
@@ -225,9 +268,27 @@ def curve_line(side_a: CurveSide, side_b: CurveSide, where: str) -> tuple[Line, 
     fine = side_b if pieces[1] > pieces[0] else side_a
     degree = max(fine.surface.basis_u.degree, fine.surface.basis_v.degree)
     spans = max(pieces)
-    space = BSplineBasis(degree, max(spans, degree + 1), T, "periodic")
-    return (Line((trace_a, trace_b), weights, space.matrix(t).tocsr(), False),
-            length / spans)
+    if running is not None:
+        space = running_space((side_a, side_b)[running], (t, s)[running])
+    elif side_a.part is None:
+        space = BSplineBasis(degree, max(spans, degree + 1), hi, "periodic").matrix(t)
+    else:
+        corners = [kinks(side_a)]
+        if len(kinks(side_b)):
+            Xk = side_b.position(kinks(side_b))[0]
+            corners.append(side_a.closest(Xk, None if start is None else
+                                          np.interp(kinks(side_b), *_inverse(start, lo, hi))))
+        own = breaks_a if fine is side_a else np.sort(mapped)
+        space = stretch_space(t, (lo, hi), own, degree, np.concatenate(corners))
+    return Line((trace_a, trace_b), weights, space.tocsr(), False), length / spans
+
+
+def _inverse(start: Any, lo: float, hi: float) -> tuple[Array, Array]:
+    """Samples ``(s, t)`` of the inverse of a monotone map ``s = start(t)`` on
+    ``[lo, hi]``, increasing in ``s`` (for :func:`numpy.interp`)."""
+    t = np.linspace(lo, hi, 17)
+    s = np.asarray(start(t), dtype=float)
+    return (s, t) if s[-1] >= s[0] else (s[::-1], t[::-1])
 
 
 def loop_of(surface: Surface, index: int) -> Any:
@@ -254,9 +315,16 @@ def curve_penalty(patches: Sequence[Surface], interface: TrimInterface, material
     sides = [CurveSide.of_loop(patches[p], loop_of(patches[p], k))
              for p, k in ((interface.a, interface.loop_a), (interface.b, interface.loop_b))]
     line, h = curve_line(sides[0], sides[1], str(interface))
+    return line_penalties(line, h, material, interface.a, interface.b, patches, offsets)
+
+
+def line_penalties(line: Line, h: float, material: Material, a: int, b: int,
+                   patches: Sequence[Surface], offsets: Sequence[int]) -> sp.csr_matrix:
+    """The displacement penalty and, where the energy bends, the slope penalty of
+    :func:`curve_penalty` on ``line`` between faces ``a`` and ``b``, at element size ``h``."""
     alpha, beta = penalty_factors(material, h)
     size = int(offsets[-1]) + patches[-1].shape[0] * patches[-1].shape[1]
-    layout = (int(offsets[interface.a]), int(offsets[interface.b]), size)
+    layout = (int(offsets[a]), int(offsets[b]), size)
     space = line.space(0)
     K = line_penalty(line, "values", layout, alpha, space)
     return K if beta == 0 else (K + line_penalty(line, "slopes", layout, beta, space)).tocsr()

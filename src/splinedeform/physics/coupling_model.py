@@ -15,8 +15,9 @@ mesh (:func:`~.coupling.penalty_factors`)::
   the energy bends, ``K_β``: :func:`~.coupling.interface_penalty`;
 * a ``C^0`` knot line inside a patch is the interface between its two sides, whose
   displacement is continuous already: ``K_β`` only (:func:`~.coupling.c0_rotation_penalty`);
-* a plate body's smooth conforming interfaces and C0 lines have their tangent continuity
-  tied exactly by the constraint map (:mod:`.coupling_ties`), and no ``K_β``.
+* smooth conforming interfaces and C0 lines (of a plate or a shell, one patch or a body)
+  have their tangent continuity tied exactly by the constraint map (:mod:`.coupling_ties`),
+  and no ``K_β``.
 
 Each penalty's ends take the boundary condition of the edges they lie on (the crosspoints
 those hold, :data:`~.coupling.HELD`): an end on a clamped edge has its first two trace

@@ -28,7 +28,12 @@ The ties are rows ``C d = 0`` on the concatenated control points; on a map ``d =
 they are imposed by :func:`impose`: ``T E`` with ``range E = null(C T)``, each group of
 coordinates that shares a row eliminated on its own (a single row: its largest coefficient
 solved for; rows that share coordinates, where lines cross: a pivoted QR), so that ``E``
-is the identity on every coordinate it keeps and stays sparse.
+is the identity on every coordinate it keeps and stays sparse. The plate's one unknown per
+control point takes ``C`` as it is; the shell's three interleaved displacement components
+(dof ``3k + c``) take ``C ⊗ I₃``, the same relation on each component
+(:func:`tie_components`): the rest shape and the displacement are then both ``C^1`` across
+the line with one ratio, so the shell's rotation ``δa_3`` (which depends on the two tangents
+only through their directions and the plane they span) is continuous exactly.
 """
 
 from __future__ import annotations
@@ -236,3 +241,12 @@ def tie_c0_lines(surface: Surface, constraints: Constraints
     tied = Constraints(T, None, None, constraints.free_index[kept], constraints.edges,
                        constraints.has_fixed_points)
     return tied, {(direction, knot) for _, direction, knot in ties.lines}
+
+
+def tie_components(T: sp.csr_matrix, C: sp.spmatrix, components: int = 3) -> sp.csr_matrix:
+    """The map ``T`` of interleaved displacements (dof ``components · k + c``) with the ties
+    ``C`` (over control points) imposed on every component: ``C ⊗ I`` (module docstring)."""
+    if C.shape[0] == 0:
+        return T
+    rows = sp.kron(C, sp.identity(components), format="csr")
+    return impose(T, rows @ T)[0]

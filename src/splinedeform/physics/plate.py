@@ -24,6 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..assembly import (ReducedFactors, full_matrices, gram_matrices, patch_matrices,
                         reduced_factors, reduced_matrices)
+from ..body.loads import surface_field
 from ..boundary import Constraints, build_constraints
 from ..errors import InputError, SingularSystemError
 from ..material import Material
@@ -46,7 +47,7 @@ class PlateFormulation:
     """The plate of one surface (``surface``) or of a body's patches (``patches``).
 
     ``reduction_type`` makes the load vectors (a body's
-    :class:`~splinedeform.body.model.BodyReduction` reads its patches one after another).
+    :class:`~splinedeform.physics.plate_body.BodyReduction` reads its patches one after another).
     """
 
     physics: str
@@ -73,6 +74,8 @@ class PlateFormulation:
         return self.material.rayleigh
 
     def reduction(self, T: sp.spmatrix, rest: Array | None) -> Reduction:
+        if self.patches is None and self.reduction_type is Reduction:
+            return SurfaceReduction(T, self.surface, rest)
         return self.reduction_type(T, self.surface if self.patches is None else self.patches,
                                    rest)
 
@@ -96,6 +99,15 @@ class PlateFormulation:
         if self.patches is None:
             return Readout(self.surface, T, M_r, K_r)
         return BodyReadout(self.patches, T, M_r, K_r)
+
+
+@dataclass(frozen=True)
+class SurfaceReduction(Reduction):
+    """The :class:`~splinedeform.solvers.system.Reduction` of one surface, a pressure along
+    its :attr:`~splinedeform.Surface.orientation` (:func:`~splinedeform.body.loads.surface_field`)."""
+
+    def field(self, term: Any, t: float = 0.0) -> Array:
+        return surface_field(term, self.surface, t)
 
 
 @dataclass(frozen=True)
@@ -148,8 +160,8 @@ def surface_system(surface: Surface, material: Material, boundary: str | Mapping
                                    unconstrained=constraints.unconstrained)
     general = surface.net_weights is not None         # weights that do not factor
     gram_u, gram_v = (None, None) if general else gram_matrices(surface)
-    full = (intrinsic.matrices(surface, material, lumped) if physics == "intrinsic"
-            else (trimmed.stiffness, trimmed.mass) if trimmed
+    full = ((trimmed.stiffness, trimmed.mass) if trimmed
+            else intrinsic.matrices(surface, material, lumped) if physics == "intrinsic"
             else patch_matrices(surface, material, physics, lumped)[2:] if general else None)
     tied: set[tuple[str, float]] = set()
     if not trimmed and bends(material):    # smooth C0 lines: C1 in the constraint map

@@ -17,6 +17,16 @@ Energy ``½ ∫ (E t/(1−ν²)) εᵀ H ε + (E t³/(12(1−ν²))) κᵀ H κ 
          [·,     ·,    ½((1−ν) g¹¹g²² + (1+ν) g¹²²)]]
 
 and mass ``ρ t ∫ |d|² dA``.
+
+The shape functions are the surface's basis: the tensor products ``N_k(u) N_l(v)`` of its
+1-D bases (polynomial or rational with product weights ``w_kl = a_k b_l``), or, with
+general weights (:attr:`~splinedeform.Surface.net_weights`), the rational
+``R_kl = w_kl N_k N_l / W``, whose derivatives up to second order come from the quotient
+rule at every Gauss point (:func:`splinedeform.rational.basis_derivatives`, computed with
+the metric's grid, :func:`.metric.grid`). The quadrature is the same ``p + 2`` points per
+cell and direction for both: the integrand is rational already for polynomial bases (the
+inverse metric), and the rule is held to the discretisation error by the convergence tests
+(``tests/test_shell_weights.py``).
 """
 
 from __future__ import annotations
@@ -28,12 +38,13 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from ..errors import InputError
-from ..rational import refuse
 from ..surface import Surface
 from . import metric
 from .shell_assembly import Pattern, assemble_cells
 
 Array = NDArray[np.float64]
+#: derivative orders ``(p, r)`` of the five shape derivatives ``s`` of :func:`cell_shapes`
+SLOTS = ((1, 0), (0, 1), (2, 0), (1, 1), (0, 2))
 
 
 @dataclass(frozen=True)
@@ -115,11 +126,12 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
 
     ``K = Σ_cells Σ_q Bᵀ D B`` with ``B = [B_m; B_b]`` (6 rows) and
     ``D = √g w_q diag(E t/(1−ν²) H, E t³/(12(1−ν²)) H)``, ``M = ρ t ∫ N_k N_l dA ⊗ I₃``;
-    cell by cell into a precomputed pattern (:mod:`.shell_assembly`). Across a ``C^0``
-    knot line the cells hold nothing: :class:`~.shell_model.ShellModel` adds its rotation
-    penalty (:mod:`.coupling_model`).
+    cell by cell into a precomputed pattern (:mod:`.shell_assembly`); ``N_k`` is the
+    surface's basis (the module docstring), general weights included. Across a ``C^0``
+    knot line the cells hold nothing: :class:`~.shell_formulation.ShellFormulation` ties
+    the slopes exactly where the rest shape is smooth across it
+    (:mod:`.coupling_ties`) and adds its rotation penalty elsewhere (:mod:`.coupling_model`).
     """
-    refuse(surface, "the Kirchhoff–Love shell")
     if min(surface.basis_u.degree, surface.basis_v.degree) < 2:
         raise InputError("the Kirchhoff–Love shell needs degree >= 2 in u and v (curvatures)")
     G = metric.grid(surface, extra_points=1)
@@ -152,8 +164,11 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
 
     def mass(rows: slice) -> Array:
         points = slice(rows.start * q[0], rows.stop * q[0])
-        N0 = (G.values_u[0][points, None, :, None] * G.values_v[0][None, :, None, :])
-        N0 = by_cell(N0.reshape(N0.shape[:2] + (-1,)), q)              # (A, B, qu qv, k)
+        if G.shapes is not None:                                    # R_kl, general weights
+            N0 = by_cell(G.shapes[0, 0][points], q)                 # (A, B, qu qv, k)
+        else:
+            N0 = (G.values_u[0][points, None, :, None] * G.values_v[0][None, :, None, :])
+            N0 = by_cell(N0.reshape(N0.shape[:2] + (-1,)), q)
         w = by_cell(material.density * t * dA[points], q)[..., None]
         return np.swapaxes(N0, -1, -2) @ (w * N0)
 
@@ -165,12 +180,16 @@ def matrices(surface: Surface, material: ShellMaterial) -> tuple[sp.csr_matrix, 
 def cell_shapes(G: metric.Grid, points: slice, q: tuple[int, int]) -> Array:
     """``N_,1, N_,2, N_,11, N_,12, N_,22`` at the grid rows ``points`` by cells,
     ``(A, B, q_u q_v, 5, k)``, the layout of :func:`by_cell` without its copy:
-    ``N_{,u^p v^r}[(x, y), (k_u, k_v)] = B_u^(p)[x, k_u] B_v^(r)[y, k_v]``."""
+    ``N_{,u^p v^r}[(x, y), (k_u, k_v)] = B_u^(p)[x, k_u] B_v^(r)[y, k_v]``; with general
+    weights the rational ``D^(p,r) R_k`` of the grid (:attr:`.metric.Grid.shapes`), by cells
+    (a copy)."""
+    if G.shapes is not None:
+        R = np.stack([G.shapes[order][points] for order in SLOTS], axis=2)   # (Qa, Qv, 5, k)
+        return by_cell(R, q)
     (qu, qv), (_, Qa, pu), (_, Qv, pv) = q, G.values_u[:, points].shape, G.values_v.shape
     Bu = G.values_u[:, points].reshape(3, Qa // qu, 1, qu, 1, pu, 1)
     Bv = G.values_v.reshape(3, 1, Qv // qv, 1, qv, 1, pv)
-    S = np.stack([Bu[p] * Bv[r] for p, r in ((1, 0), (0, 1), (2, 0), (1, 1), (0, 2))],
-                 axis=4)                                   # (A, B, qu, qv, 5, pu, pv)
+    S = np.stack([Bu[p] * Bv[r] for p, r in SLOTS], axis=4)      # (A, B, qu, qv, 5, pu, pv)
     return S.reshape(S.shape[:2] + (qu * qv, 5, pu * pv))
 
 

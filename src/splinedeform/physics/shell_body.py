@@ -6,8 +6,8 @@ in each), interleaved (dof ``3k + c``). Per patch the shell's own matrices, so t
 .. math:: K = \\operatorname{diag}(K_1, …, K_P) + K_\\text{coupling}, \\qquad
           M = \\operatorname{diag}(M_1, …, M_P),
 
-where ``K_coupling`` is the rotation penalty across every interface and C0 line, and
-across a non-conforming interface also the displacement penalty
+where ``K_coupling`` is the rotation penalty across every interface and C0 line that is
+not tied, and across a non-conforming interface also the displacement penalty
 (:mod:`.coupling_model`, factors from the material and the mesh). The constraint map
 ``d = T d_free`` is ``T = T_b S``: ``T_b = diag(T_p)`` the edge conditions of each patch
 (:func:`.shell_edges.constraint_matrix`: the body's kinds on boundary edges, free on
@@ -19,7 +19,10 @@ class, the classes being the connected components of that graph); where one row 
 (the component is held) the other's column is held too. Where a row combines several
 columns (the points of a pole, tied to one point by a null-space basis of ``T_p``) the pair
 is imposed instead, ``T = T_b S N`` with ``range N = null((T_b S)[r_a] − (T_b S)[r_b])``.
-So merged control points share all three displacements exactly.
+So merged control points share all three displacements exactly. Last, across every
+conforming interface, seam and C0 line where the rest shape is smooth, the slopes are tied
+on each component, ``T ← T E`` (:func:`.coupling_ties.tie_components`), with no rotation
+penalty there: the rotation is continuous exactly.
 """
 
 from __future__ import annotations
@@ -40,6 +43,7 @@ from ..body.model import _refuse as refuse
 from ..errors import InputError
 from ..surface import Surface
 from .coupling_model import c0_coupling, interface_coupling
+from .coupling_ties import Ties, smooth_ties, tie_components
 from .shell import ShellMaterial, matrices
 from .shell_edges import KINDS, check_edges, constraint_matrix
 from .shell_edges import _impose as impose
@@ -59,6 +63,8 @@ class ShellBodySystem:
         The kind of each boundary edge, keyed ``(patch, edge)``.
     offsets : ndarray of int
         First control point of each patch (``len(patches) + 1`` values).
+    ties : :class:`~.coupling_ties.Ties`
+        The interfaces and C0 lines whose slopes ``T`` ties exactly.
     """
 
     K: sp.csr_matrix
@@ -66,6 +72,7 @@ class ShellBodySystem:
     T: sp.csr_matrix
     edges: dict[tuple[int, str], str]
     offsets: NDArray[np.int64]
+    ties: Ties
 
 
 def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
@@ -95,9 +102,11 @@ def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
     K = sp.block_diag([k for k, _ in blocks], format="csr")
     M = sp.block_diag([m for _, m in blocks], format="csr")
     size = int(offsets[-1])
+    ties = smooth_ties(patches, topology.interfaces, offsets)
     couplings = [interface_coupling(patches, topology.interfaces, material, presets,
-                                    offsets[:-1])]
-    couplings += [c0_coupling(s, material, e, int(offsets[p]), size)
+                                    offsets[:-1], exact=ties.interfaces)]
+    couplings += [c0_coupling(s, material, e, int(offsets[p]), size,
+                              exact={(d, k) for q, d, k in ties.lines if q == p})
                   for p, (s, e) in enumerate(zip(patches, own))]
     for penalty in (c for c in couplings if c is not None):
         K = (K + penalty).tocsr()
@@ -112,10 +121,11 @@ def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
     T = (Tb @ S).tocsr()
     if len(rest):                     # rows combining columns (poles): d_ra = d_rb imposed
         T = impose(T, T[rest[:, 0]] - T[rest[:, 1]])
+    T = tie_components(T, ties.C)
     if T.shape[1] == 0:
         raise InputError("no free displacement: the boundary holds every control point of "
                          f"the {len(patches)} patches")
-    return ShellBodySystem(K, M, T, presets, offsets)
+    return ShellBodySystem(K, M, T, presets, offsets, ties)
 
 
 def merge_columns(Tb: sp.csr_matrix, pairs: NDArray[np.int64]

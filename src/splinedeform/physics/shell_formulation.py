@@ -3,8 +3,11 @@
 Three unknowns per control point, interleaved (row ``3k + c`` of ``T`` is component ``c``
 of control point ``k``), coupled by the shell's energy (:mod:`.shell`); a free state is
 ``(n_free,)``. On one surface ``T`` imposes the edge kinds (:mod:`.shell_edges`); on a body
-of patches :mod:`.shell_body` merges conforming interfaces and couples the others and every
-rotation by penalties. Damping ``C_r = (γ/(ρt)) M_r + β K_r``.
+of patches :mod:`.shell_body` merges conforming interfaces and couples the others by
+penalties. Across every conforming line where the rest shape is smooth (a ``C^0`` knot line
+inside a patch, a conforming interface or seam of a body) ``T`` also ties the slopes
+exactly (:mod:`.coupling_ties`), so the rotation is continuous there; creases and
+non-conforming interfaces keep the rotation penalty (:mod:`.coupling_model`). Damping ``C_r = (γ/(ρt)) M_r + β K_r``.
 
 The rigid motions ``r = t + ω × p`` the boundary leaves free span ``null K_r`` (the shell's
 energy vanishes on rigid motions only); every combination of translations and rotations
@@ -27,10 +30,12 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from ..body.body import Body
+from ..body.loads import surface_field
 from ..errors import InputError, SingularSystemError
 from ..solvers.system import Reduction
 from ..surface import Surface
 from .coupling_model import c0_coupling
+from .coupling_ties import smooth_ties, tie_components
 from .shell import ShellMaterial, matrices
 from .shell_body import body_field, body_system
 from .shell_edges import check_edges, constraint_matrix
@@ -52,7 +57,7 @@ class ShellReduction(Reduction):
 
     def field(self, term: Any, t: float = 0.0) -> Array:
         if isinstance(self.surface, Surface):
-            return np.asarray(term.field_vector(self.surface, t)).reshape(-1, 1)
+            return np.asarray(surface_field(term, self.surface, t)).reshape(-1, 1)
         return body_field(self.surface, term, t, self.signs)[:, None]
 
 
@@ -75,6 +80,8 @@ class ShellFormulation:
     T : sparse ``(3N, n_free)``
     edges : dict
         The kind of each edge (a body's keyed ``(patch, edge)``).
+    ties : :class:`~.coupling_ties.Ties`
+        The smooth lines whose slopes ``T`` ties exactly (the others keep the penalty).
     """
 
     physics = "shell"
@@ -87,6 +94,7 @@ class ShellFormulation:
         if not isinstance(material, ShellMaterial):
             raise InputError("a shell needs a ShellMaterial(E, nu, thickness, density)")
         self.material = material
+        motions = None
         if isinstance(surface, (Body, list, tuple)):
             if fixed is not None:
                 raise InputError("a shell body is held by its boundary edges; fixed "
@@ -97,23 +105,36 @@ class ShellFormulation:
             self.surface, self.offsets = None, system.offsets
             self.K_full, self.M_full, self.T, self.edges = (system.K, system.M, system.T,
                                                             system.edges)
+            self.ties = system.ties
             points = np.concatenate([s.control_points.reshape(-1, 3) for s in self.patches])
+        elif getattr(surface, "trim", None) is not None:     # loops held by Nitsche
+            from ..trim.shell_trimmed import trimmed_shell
+
+            trim = trimmed_shell(surface, material, boundary, fixed)
+            self.surface, self.patches, points = surface, None, surface.control_points
+            self.K_full, self.M_full, self.T, self.edges = (trim.stiffness, trim.mass, trim.T,
+                                                            trim.edges)
+            motions = trim.motions
+            self.ties = smooth_ties([surface], (), np.array([0, surface.shape[0]
+                                                             * surface.shape[1]]))
         else:
-            if getattr(surface, "trim", None) is not None:
-                raise InputError("the shell is not trimmed yet: a trimmed surface takes the "
-                                 "parametric Model (docs/trim.md)")
             if isinstance(boundary, str):
                 raise InputError("a single surface's shell boundary is a mapping edge -> "
                                  f"kind, got {boundary!r}")
             self.surface, self.patches = surface, None
             self.K_full, self.M_full = matrices(surface, material)
             self.edges = check_edges(surface, dict(boundary or {}))
-            kinks = c0_coupling(surface, material, self.edges)
+            self.ties = smooth_ties([surface], (), np.array([0, surface.shape[0]
+                                                             * surface.shape[1]]))
+            kinks = c0_coupling(surface, material, self.edges,
+                                exact={(d, k) for _, d, k in self.ties.lines})
             if kinks is not None:                  # the crease kept across each C0 line
                 self.K_full = (self.K_full + kinks).tocsr()
-            self.T = constraint_matrix(surface, self.edges, fixed)
+            # the slopes tied exactly across each smooth C0 line
+            self.T = tie_components(constraint_matrix(surface, self.edges, fixed), self.ties.C)
             points = surface.control_points
-        motions = free_rigid_motions(self.T, points)
+        if motions is None:
+            motions = free_rigid_motions(self.T, points)
         self.rigid_basis: Array = motions.reduced
         #: words for a basis of the free rigid motions (rotation axes, translations)
         self.rigid_motions = describe(motions.twists,

@@ -45,6 +45,12 @@ class AreaForce(Load):
         object.__setattr__(self, "profile", _profile(self.profile))
 
     def field_vector(self, surface: Surface, t: float = 0.0) -> Array:
+        if surface.trim is not None:             # over the trimmed region, dA = √g du dv
+            from ..loads import project
+
+            return project(surface, lambda U, V: np.linalg.norm(np.cross(
+                surface.derivative(U, V, 1, 0), surface.derivative(U, V, 0, 1)),
+                axis=-1)[..., None] * np.asarray(self.force, dtype=float))
         G = metric.grid(surface, extra_points=1)
         N = metric.shape_derivatives(G)[0, 0]
         index = metric.global_index(G, surface.basis_v.size)
@@ -66,8 +72,9 @@ class ShellModel(Model):
     ----------
     surface : Surface, or Body (or list of Surface)
         One patch, or a body of patches deformed as one shell (:mod:`.shell_body`:
-        conforming interfaces merged, non-conforming ones and every interface's rotation
-        coupled by penalties).
+        conforming interfaces merged, their slopes tied where the rest shape is smooth
+        across them, the others and every crease coupled by penalties); general NURBS
+        weights (``net_weights``) included.
     material : ShellMaterial
     boundary : mapping edge -> kind, optional
         See the module docstring; missing edges are free. For a body one kind for every

@@ -18,7 +18,10 @@ along it (Gauss quadrature, ``n + 3`` points per cell)::
 with the scale ``s = |a_u|`` keeping the rows bounded at a pole (where ``a_u → 0``). Where
 ``β = 0`` it is the strong condition (the slope is a spline in ``v`` and the weighted Gram
 matrix is positive definite). The rows ``C = b'(0) ⊗ G_α + b(0) ⊗ G'_β`` over the control
-points are a Kronecker sum, sparse.
+points are a Kronecker sum, sparse. With general weights
+(:attr:`~splinedeform.Surface.net_weights`) the slopes are the rational basis' own,
+``C = B_0ᵀ diag(w s α) E_cross + B_0ᵀ diag(w s β) E_along`` with the evaluation matrices
+``E`` of ``∂ R_kl`` at the edge's Gauss points (:meth:`~splinedeform.Surface.evaluation_matrix`).
 """
 
 from __future__ import annotations
@@ -64,15 +67,20 @@ def slope_rows(surface: Surface, edge: str, axis: int) -> sp.csr_matrix:
     scale = np.linalg.norm(a_cross, axis=-1)
     alpha, beta = w * scale * coef[:, 0], w * scale * coef[:, 1]
     B0 = along.matrix(s, 0).toarray()
-    B1 = along.matrix(s, 1).toarray()
-    G_alpha = B0.T @ (alpha[:, None] * B0)                            # [k, j]
-    G_beta = B0.T @ (beta[:, None] * B1)
-    b0, b1 = across.matrix(x0, 0), across.matrix(x0, 1)
-    if across_u:
-        C = sp.kron(b1, G_alpha) + sp.kron(b0, G_beta)               # over (i n_v + j)
+    if surface.net_weights is not None:           # ∂R_kl on the edge: the quotient rule
+        E_u, E_v = (surface.evaluation_matrix(u, v, *order) for order in ((1, 0), (0, 1)))
+        E_cross, E_along = (E_u, E_v) if across_u else (E_v, E_u)
+        C = sp.csr_matrix(B0.T @ (sp.diags(alpha) @ E_cross + sp.diags(beta) @ E_along))
     else:
-        C = sp.kron(G_alpha, b1) + sp.kron(G_beta, b0)
-    C = sp.csr_matrix(C)
+        B1 = along.matrix(s, 1).toarray()
+        G_alpha = B0.T @ (alpha[:, None] * B0)                        # [k, j]
+        G_beta = B0.T @ (beta[:, None] * B1)
+        b0, b1 = across.matrix(x0, 0), across.matrix(x0, 1)
+        if across_u:
+            C = sp.kron(b1, G_alpha) + sp.kron(b0, G_beta)           # over (i n_v + j)
+        else:
+            C = sp.kron(G_alpha, b1) + sp.kron(G_beta, b0)
+        C = sp.csr_matrix(C)
     n = C.shape[1]
     rows = []
     for b in np.delete(np.arange(3), axis):

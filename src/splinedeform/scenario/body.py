@@ -195,9 +195,6 @@ def check_body_scenario(scenario: Scenario, body: FileBody) -> None:
         if ext not in BODY_FORMATS:
             raise s.error("output.formats", f"{ext} is not written for a body of "
                           f"{len(body)} faces yet; a body writes {', '.join(BODY_FORMATS)}")
-    if s.output.animate_modes not in (None, (1,)):
-        raise s.error("output.animate_modes", "a body animates its lowest mode (as the "
-                      "gif / mp4 of a modes solve); its other modes are not animated yet")
     for i, spec in enumerate(s.loads, start=1):
         if spec.face is None:
             if spec.kind == "point":
@@ -317,6 +314,9 @@ def describe_body(built: Any) -> list[tuple[str, str]]:
     rows = [("faces", f"{len(body)} ({', '.join(str(f) for f in body.faces)})"),
             ("control nets", f"{points} points in {len(body)} nets"),
             ("edges", ", ".join(f"{v} {k.replace('_', '-')}" for k, v in counts.items())),
+            *([("trim edges", "{shared} shared, {free} free, {stretches} stretches coupled"
+                .format(**body.trim_summary()))] if any(s.trim is not None for s in body)
+              else []),
             (getattr(built.model, "unknowns_label", "free control points"),
              str(built.model.n_free))]
     return rows + ([("length unit", built.units)] if built.units is not None else [])

@@ -339,7 +339,7 @@ def _model_on(scenario: Scenario, surface: Any, units: str | None) -> Built:
                                if scenario.surface.shape == "cad" else None)
     fixed = free_region_mask(scenario, surface)
     if scenario.material.physics == "shell":
-        return Built(surface=surface, model=_shell_model(scenario, surface, fixed),
+        return Built(surface=surface, model=_shell_model(scenario, surface, fixed, loops),
                      load=None, fixed=fixed, units=units)
     with _located(scenario, "material"):
         material = Material(**scenario.material.weights())
@@ -352,15 +352,20 @@ def _model_on(scenario: Scenario, surface: Any, units: str | None) -> Built:
     return Built(surface=surface, model=model, load=None, fixed=fixed, units=units)
 
 
-def _shell_model(scenario: Scenario, surface: Any, fixed: Any) -> Any:
-    """The Kirchhoff–Love shell of ``physics = "shell"``."""
+def _shell_model(scenario: Scenario, surface: Any, fixed: Any, loops: dict[str, str]
+                 ) -> Any:
+    """The Kirchhoff–Love shell of ``physics = "shell"`` (a trimmed surface's loops held
+    as ``[boundary.loops]`` or the loops' ``edge`` say)."""
     from ..physics.shell import ShellMaterial
     from ..physics.shell_model import ShellModel
 
     with _located(scenario, "material"):
         material = ShellMaterial(**scenario.material.shell())
     with _located(scenario, "boundary"):
-        return ShellModel(surface, material, scenario.boundary.edges(), fixed=fixed)
+        boundary = scenario.boundary.edges()
+        if getattr(surface, "trim", None) is not None:
+            boundary = {**boundary, **loop_presets(scenario), **loops}
+        return ShellModel(surface, material, boundary, fixed=fixed)
 
 
 def describe(scenario: Scenario, built: Built | None = None) -> list[tuple[str, str]]:

@@ -4,8 +4,9 @@ Face ``face`` of a ``.3dm``, STEP or IGES file is read as its whole underlying s
 its loops (:func:`splinedeform.cad_trims.read_trims`) are attached after ``elevate`` and
 ``refine`` (the loops live in parameter space, refinement does not move them), so the
 model and every output use the trimmed region only. ``surface.trimmed`` switches this:
-by default the trim is taken where the trimmed model can hold the surface (physics
-``parametric``, clamped knots with simple interior knots, not periodic;
+by default the trim is taken where the trimmed model can hold the surface (any physics
+for one face, the plate's for a face of a body; clamped knots with simple interior
+knots, not periodic;
 :func:`~splinedeform.trim.surface_trim.trim_grid`) and the whole face
 is used otherwise, with one warning line naming the face and the reason; ``trimmed =
 true`` refuses such a face, ``trimmed = false`` takes the whole face without a word.
@@ -55,11 +56,13 @@ def _face_number(spec: Any) -> int:
     return int(chosen[0])
 
 
-def why_untrimmable(scenario: Any, surface: Any) -> str | None:
-    """Why the trimmed model cannot hold ``surface`` in this scenario; None when it can."""
-    if scenario.material.physics != "parametric":
-        return (f"physics {scenario.material.physics!r} is not trimmed yet (a trimmed "
-                "surface takes \"parametric\")")
+def why_untrimmable(scenario: Any, surface: Any, body: bool = False) -> str | None:
+    """Why the trimmed model cannot hold ``surface`` in this scenario; None when it can
+    (one face takes every physics; a face of a body, the plate's ``parametric`` and
+    ``intrinsic``)."""
+    if body and scenario.material.physics == "shell":
+        return ("the shell is not trimmed in a body of faces yet (a trimmed face of a body "
+                "takes physics \"parametric\" or \"intrinsic\")")
     return None
 
 
@@ -168,7 +171,7 @@ def with_body_trims(scenario: Any, body: Any, caught: list[warnings.WarningMessa
         else:
             if domain is None or (not domain.holes and whole_rectangle(surface, domain.outer)):
                 continue
-            reason = why_untrimmable(scenario, surface)
+            reason = why_untrimmable(scenario, surface, body=True)
         if reason is None:
             try:
                 patches[p] = equal_cell_form(surface).with_trim(domain)

@@ -305,7 +305,8 @@ class Output(_Table):
     animate_modes: Optional[list[Annotated[int, Strict(), Field(ge=1, le=1000)]]] = Field(
         None, title="mode numbers", description=(
             "modes: the modes animated, mode 1 as `<name>.gif`, mode k as "
-            "`<name>_mode<k>.gif`"), json_schema_extra={"doc_default": "[1]"})
+            "`<name>_mode<k>.gif` and the series `<name>_mode<k>.pvd`"),
+        json_schema_extra={"doc_default": "[1]"})
 
 
 class ScenarioFile(_Table):

@@ -29,10 +29,6 @@ def trimmed(scenario: Any, surface: Any) -> Any:
     trim = scenario.surface.trim
     if trim is None:
         return surface
-    if scenario.material.physics != "parametric":
-        raise scenario.error("surface.trim", f"a trimmed surface takes physics \"parametric\" "
-                             f"(its energy over the trimmed region); "
-                             f"{scenario.material.physics!r} is not trimmed yet")
     labels = loop_labels(trim)
     where = [f"surface.trim.loops[{k}]" for k in range(1, len(labels) + 1)]
     for k, label in enumerate(labels):

@@ -9,10 +9,10 @@ write_obj` (the surface sampled on the page's grid, clipped to its trims, vertex
 ``shape = "file"`` reads back). Each is written to a private temporary folder and its
 bytes returned; nothing is written beside the save.
 
-A body keeps every face: the ``.3dm`` holds one named NURBS surface per face in the body's
-unit (:func:`splinedeform.export.body.write_body_3dm`), the OBJ one mesh welded across the
-shared edges (:func:`splinedeform.export.body.write_body_mesh`), the net file one net per
-face (``stem-face-k.json``, bundled as ``.zip``).
+A body keeps every face: the ``.3dm`` holds one Brep of the body's faces, its edges joined,
+in the body's unit (:func:`splinedeform.export.body.write_body_3dm`), the OBJ one mesh
+welded across the shared edges (:func:`splinedeform.export.body.write_body_mesh`), the net
+file one net per face (``stem-face-k.json``, bundled as ``.zip``).
 """
 
 from __future__ import annotations
@@ -84,7 +84,8 @@ def _body_file(basis: SculptBasis, nets: list[NDArray[np.float64]], fmt: str, fo
     faces = list(getattr(basis.model.body, "faces", range(len(patches))))
     path = folder / f"{stem}{SHAPE_FORMATS[fmt][0]}"
     if fmt == "3dm":
-        write_body_3dm(path, patches, nets, [f"{title} face {f}" for f in faces], basis.units)
+        write_body_3dm(path, patches, nets, [f"{title} face {f}" for f in faces], basis.units,
+                       body=basis.model.body, name=title)
     elif fmt == "obj":
         write_body_mesh(path, patches, nets, None, basis.grid[0])
     else:

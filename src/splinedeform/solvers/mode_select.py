@@ -29,13 +29,15 @@ control-point coordinate, since ``|x_p| ≤ c_∞ ‖x‖_M`` (:func:`pointwise_
 is extended: the LU and every solve so far are kept. An estimate of ``n/2`` modes or more
 made from at least 64 computed ends the search: all modes are cheaper then (a frame a few
 milliseconds after a jump of the bench plate needs them, as its over-damped modes relax
-no faster than ``1/β``) — unless the omitted modes are all over-damped and the transient
-correction (:mod:`.transient_correction`, bound ``Σ_j ‖R_j‖_M E_d``) meets the tolerance
-with fewer modes than the static one: then it is taken (:func:`_transient_count`), and the
-search does not stop before the computed modes reach the over-damped range; it grows
-straight to an estimate of the first over-damped mode (:func:`_over_damped_count`; at 64²
-the bench plate's 281 modes came from 17, 65 and 329 computed, where four-fold growth
-computed 1 025). From 16
+no faster than ``1/β``) — unless the transient correction (:mod:`.transient_correction`,
+bound ``Σ_j ‖R_j‖_M E_d``) meets the tolerance with fewer modes than the static one: then
+it is taken (:func:`.transient_count.transient_count`, evaluated only at the times where
+the static bound misses). With Rayleigh damping the correction follows the omitted modes'
+relaxation, under-damped ones included, so the search grows to the count it estimates
+(:func:`.transient_count.transient_grown`) or, at most, to the first over-damped mode
+(:func:`.transient_count.over_damped_count`): on the bench plate at 128² and the
+default call's times, 135 modes from 17, 65 and 154 computed (464 Krylov vectors), where
+the static estimate's growth computed 627 (1 376 vectors) to keep 281. From 16
 modes the estimate is not trusted: a uniform load's ``‖R‖``, flat over the symmetric
 modes it does not excite, predicted 2 400 where 33 did.
 """
@@ -55,7 +57,9 @@ from .modal_basis import DEFAULT_ADVICE
 from .mode_count import decay_bound, error_bound
 from .rigid import check_resolved
 from .sparse_eigen import BlockLanczos
-from .transient_correction import DEGREE, TransientCorrection, fitted, over_damped_from
+from .transient_correction import DEGREE, TransientCorrection, over_damped_from
+from .transient_count import (count_power, norm_power, over_damped_count, transient_bound,
+                              transient_count, transient_grown)
 
 Array = NDArray[np.float64]
 GRID = 3500
@@ -70,8 +74,9 @@ class ErrorEstimate:
     ``relative(t) = weight · Σ_j ‖R_j‖_M E(λ_{m+1}, t − t_j)``.
 
     ``weight`` is ``c_∞ / max_t ‖K⁻¹F(t)‖_∞`` (max norm, :func:`pointwise_bound`) or
-    ``1 / max_t ‖K⁻¹F(t)‖_M``. ``E`` is non-increasing in ``τ`` (each of its bounds is), so
-    the value at a time also bounds every later time up to the next jump.
+    ``1 / max_t ‖K⁻¹F(t)‖_M``. The static ``E`` is non-increasing in ``τ`` (each of its
+    bounds is), so the value at a time also bounds every later time up to the next jump;
+    the transient ``E_d`` (``degree > 0``) need not be, and is evaluated at each time asked.
     """
 
     jump_times: Array
@@ -91,20 +96,6 @@ class ErrorEstimate:
         return self.weight * transient_bound(self.norms[None, :], self.jump_times,
                                              self.lam_next, self.gamma, self.beta, times,
                                              self.degree)[0]
-
-
-def transient_bound(norms: Array, jump_times: Array, lam_next: float, gamma: float,
-                    beta: float, times: Array, degree: int = DEGREE) -> Array:
-    """``Σ_j ‖R_j‖_M E_d(λ_{m+1}, t − t_j) H(t − t_j)`` for rows of ``norms`` (``(r, J)``)
-    at ``times`` → ``(r, T)``: the bound of :class:`.transient_correction.TransientCorrection`."""
-    tau = times[None, :] - np.asarray(jump_times, dtype=float)[:, None]       # (J, T)
-    out = np.zeros((norms.shape[0], times.size))
-    on = tau > 0
-    if np.any(on):
-        E = np.zeros(tau.shape)
-        E[on] = fitted(lam_next, gamma, beta, tau[on], degree)[1]
-        out += norms @ E
-    return out
 
 
 def pointwise_bound(M: sp.spmatrix, T: sp.spmatrix | None = None,
@@ -163,11 +154,7 @@ def _grown(k: int, lam: Array, norms: Array, grid: Array, E: Array, column: Arra
     ``1.25 k`` and ``4 k``. An estimate too low costs one more round on the same Krylov
     space; one too high, modes never used.
     """
-    half = np.arange(k // 2, k + 1)
-    total = np.maximum(norms[:, half].sum(axis=0), 1e-300)
-    slope, count = 0.0, _count_power(lam, k)
-    if half.size > 2 and np.ptp(np.log(lam[half])) > 0:
-        slope = min(float(np.polyfit(np.log(lam[half]), np.log(total), 1)[0]), 0.0)
+    slope, count = norm_power(k, lam, norms), count_power(lam, k)
     decay = np.minimum((grid / lam[k]) ** slope, 1.0)
     at_grid = np.zeros((grid.size, column.shape[0]))
     for j in range(norms.shape[0]):
@@ -175,67 +162,6 @@ def _grown(k: int, lam: Array, norms: Array, grid: Array, E: Array, column: Arra
     ok = np.flatnonzero((at_grid.max(axis=1) * decay <= limit) & (grid >= lam[k]))
     grow = np.inf if not ok.size else 1.1 * (grid[ok[0]] / lam[k]) ** count
     return int(np.ceil(min(max(grow, 1.25), 4.0) * k)), grow * k
-
-
-def _count_power(lam: Array, k: int) -> float:
-    """The power ``q`` of ``m + 1 ≈ c λ_{m+1}^q`` fitted over ``m ∈ [k/2, k]``, clipped to
-    ``[0.3, 1.5]`` (``1`` where too few modes or eigenvalues are equal)."""
-    half = np.arange(k // 2, k + 1)
-    if half.size <= 2 or not np.ptp(np.log(lam[half])) > 0:
-        return 1.0
-    return float(np.clip(np.polyfit(np.log(lam[half]), np.log(half + 1.0), 1)[0], 0.3, 1.5))
-
-
-def _over_damped_count(k: int, lam: Array, gamma: float, beta: float) -> int:
-    """The modes to compute so that the first over-damped one (``λ ≥ λ_o``,
-    :func:`.transient_correction.over_damped_from`) is among them, from ``k + 1`` computed
-    (``k`` where none is over-damped or one is computed already):
-    the count below ``λ_o`` continued as the power of :func:`_count_power`, plus 10 % and
-    8 modes (an estimate too low costs one more round on the same Krylov space)."""
-    lam_o = over_damped_from(gamma, beta)
-    if lam[k] >= lam_o or not np.isfinite(lam_o):
-        return k
-    below = (k + 1.0) * (lam_o / lam[k]) ** _count_power(lam, k)
-    return int(np.ceil(1.1 * below)) + 8
-
-
-def _transient_count(upto: int, lam: Array, norms: Array, jump_times: Array, gamma: float,
-                     beta: float, times: Array, weight: float, tolerance: float
-                     ) -> tuple[int, float] | None:
-    """Fewer modes than ``upto + 1`` whose bound with the transient correction
-    (:func:`transient_bound`) meets ``tolerance`` at ``times``: ``(m, bound)``, or ``None``.
-
-    Only counts whose omitted modes are all over-damped are tried (below, the correction
-    is the static one); ten counts spaced geometrically up to ``upto``, then a bisection
-    between the last that missed and the first that met, to within 1/16 of it. Every count
-    returned has its bound evaluated (the bound need not fall monotonically with ``m``).
-    """
-    first = int(np.searchsorted(lam, over_damped_from(gamma, beta), side="left"))
-    first = max(first, 1)
-    if upto < first:
-        return None
-
-    def bound(m: int) -> float:
-        return float(weight * transient_bound(norms[:, m][None, :], jump_times, float(lam[m]),
-                                              gamma, beta, times)[0].max(initial=0.0))
-
-    low = first - 1
-    for m in np.unique(np.geomspace(first, upto, 10).astype(int)):
-        value = bound(int(m))
-        if value <= tolerance:
-            high, best = int(m), value
-            break
-        low = int(m)
-    else:
-        return None
-    while high - low > max(1, high // 16):
-        mid = (low + high) // 2
-        value = bound(mid)
-        if value <= tolerance:
-            high, best = mid, value
-        else:
-            low = mid
-    return high, best
 
 
 def _m_norm2(M: sp.spmatrix, x: Array) -> float:
@@ -335,8 +261,9 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
         report.update(computed=k, solves=modes.solves)
         last = (k, modes, lam, coef, norms, relative)
         weight = factor / max(scale, 1e-300)
-        dynamic = _transient_count(int(fits[0]) - 1 if fits.size else k, lam, norms,
-                                   jump_times, gamma, beta, times, weight, tolerance)
+        dynamic = transient_count(int(fits[0]) - 1 if fits.size else k, lam, norms,
+                                   jump_times, gamma, beta, times, weight, tolerance,
+                                   weight * bound)
         if fits.size or dynamic is not None:
             m, bound_m = dynamic if dynamic is not None else (int(fits[0]), relative[fits[0]])
             parts = statics - np.array([modes.combine(c[:m]) for c in coef])
@@ -362,11 +289,19 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
                 correction = StaticCorrection(jump_times, jump_parts, [])
             return basis, correction, report
         grown, needed = _grown(k, lam, norms, grid, E, column, tolerance * scale / factor)
-        if k >= 64 and np.isfinite(needed) and needed >= n // 2:
-            if lam[k] >= over_damped_from(gamma, beta):
-                break               # half the modes or more: all of them are cheaper
-            # the transient correction applies from the first over-damped mode on
-            grown = max(_over_damped_count(k, lam, gamma, beta), int(1.25 * k))
+        if k >= 64 and lam[k] < over_damped_from(gamma, beta):
+            # the transient correction applies from the first over-damped mode on: grow to
+            # it where the static correction is expected to need more modes (or half)
+            over = max(over_damped_count(k, lam, gamma, beta), int(1.25 * k))
+            if over < needed or needed >= n // 2:
+                grown, needed = over, over
+        elif k >= 64 and np.isfinite(needed) and needed >= n // 2:
+            break                   # half the modes or more: all of them are cheaper
+        if k >= 64 and beta > 0:    # and below λ_o with the under-damped modes' transient
+            estimate = transient_grown(k, lam, norms, jump_times, gamma, beta, times, weight,
+                                        tolerance, weight * bound[k])
+            if estimate < needed:
+                grown = max(int(np.ceil(estimate)), int(1.25 * k))
         k = min(grown, n // 2 - 1) if grown < n // 2 or k < n // 2 - 1 else grown
     if best_effort and last is not None:
         m, modes, lam, coef, norms, relative = last       # every mode computed, bound missed

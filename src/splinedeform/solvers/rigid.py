@@ -23,6 +23,10 @@ The intrinsic plate under tension ``T > 0`` vanishes only on constants. Where no
 is known (the intrinsic plate without tension), :func:`count_by_gap` counts eigenvalues
 at round-off level and refuses unless a clear gap separates them from the rest.
 
+Where the structure leaves the count open (a bending body with a free part, whose energy
+vanishes on fields that depend on its geometry), :func:`null_space` finds ``null K_r`` on the
+matrices: dense ``eigh`` of a small system, block shift-invert Lanczos near 0 of a large one.
+
 Trust: a backward-stable eigensolver resolves each eigenvalue to about ``ε λ_max``
 (LAPACK's backward error), so the lowest elastic eigenvalue ``λ_e`` has relative accuracy
 about ``ε κ`` with ``κ = λ_max/λ_e``. :func:`check_resolved` refuses when that exceeds
@@ -34,10 +38,13 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
 
 from ..errors import SingularSystemError
+from .sparse_eigen import lowest_modes
 
 Array = NDArray[np.float64]
 EPS = float(np.finfo(float).eps)
@@ -45,6 +52,14 @@ TRUST = 1e-4
 """Largest accepted relative error estimate ``ε λ_max/λ_e`` of the lowest elastic eigenvalue."""
 ROUNDOFF = 1e-6
 """A rigid mode's computed ``|λ|`` above ``ROUNDOFF · λ_max`` contradicts the structure."""
+DENSE_NULL = 1500
+"""Most unknowns whose null space :func:`null_space` finds by dense ``eigh`` (a few
+seconds); larger systems take shift-invert Lanczos near 0."""
+SHIFT = 1e-12
+"""The shift ``σ = SHIFT · λ_max`` of :func:`null_space`'s Lanczos: well below every
+eigenvalue that :func:`count_by_gap` accepts as elastic (``1e8 ε λ_max ≈ 2e-8 λ_max``),
+well above the round-off of ``K``'s null eigenvalues (``1e3 ε λ_max ≈ 2e-13 λ_max``), so
+that ``K + σ M`` is positive definite."""
 
 
 def polynomial_chain(basis: Any) -> list[Array]:
@@ -216,3 +231,83 @@ def check_resolved(lam: Array, rigid: int, what: str, advice: str, top: float | 
                 f"{min(EPS * kappa, 1.0):.1g} of itself (condition number {kappa:.3g}). "
                 f"{advice}")
     return lam
+
+
+def null_space(K: sp.spmatrix, M: sp.spmatrix, what: str, known: Array | None = None
+               ) -> Array:
+    """An M-orthonormal basis ``Z`` (``Zᵀ M Z = I``) of ``null K`` for ``K`` symmetric
+    positive semi-definite and ``M`` positive definite: the eigenvectors of
+    ``K φ = λ M φ`` at round-off level, ``λ <= 1e3 ε λ_max``.
+
+    Up to :data:`DENSE_NULL` unknowns by dense ``eigh``. Beyond, the lowest pairs of the
+    shifted pencil ``(K + σ M) φ = (λ + σ) M φ`` (positive definite) by block shift-invert
+    Lanczos (:func:`.sparse_eigen.lowest_modes`), ``σ = SHIFT λ_max``: the null space's
+    ``ν = 1/σ`` lie a factor ``≥ 2e4`` above every elastic ``ν = 1/(λ + σ)`` that
+    :func:`count_by_gap` accepts, so the Krylov space finds it in a few blocks. A block
+    Krylov space holds at most ``b`` independent eigenvectors of one eigenvalue, so ``b``
+    pairs are asked with blocks of ``b = 8``, then 16, … until fewer than ``b`` are
+    round-off. ``λ_max`` is estimated by ARPACK to 1e-2 (the thresholds of
+    :func:`count_by_gap` are decades apart).
+
+    Stiff penalties (a crease's rotation penalty) push ``λ_max`` so far up that the lowest
+    elastic eigenvalues fall below the clear gap of :func:`count_by_gap` while still
+    decades above round-off. ``known`` (``(n, c)``, motions known to cost no energy where
+    they are admissible: translations, rotations) then decides: the round-off eigenvalues
+    are accepted when the known motions explain every one of them, i.e. when as many
+    independent combinations ``Y a`` of them have ``aᵀ Yᵀ K Y a <= 1e3 ε λ_max aᵀ Yᵀ M Y a``
+    (the small pencil ``(Yᵀ K Y, Yᵀ M Y)``), and those combinations are the basis
+    returned (exact, where an eigenvector so close to the elastic ones is not); with no
+    eigenvalue at round-off level and none of the known motions admissible the null space
+    is ``{0}``.
+
+    Raises
+    ------
+    UnresolvedSpectrum
+        When no clear gap separates round-off from the elastic eigenvalues and the known
+        motions do not explain the round-off ones.
+    """
+    n = K.shape[0]
+    if n <= DENSE_NULL:
+        lam, phi = sla.eigh(K.toarray(), M.toarray(), check_finite=False)
+        count, Z = _rigid_count(lam, float(np.abs(lam).max(initial=0.0)), K, M, known, what)
+        return phi[:, :count] if Z is None else Z
+    try:
+        top = float(spla.eigsh(K, k=1, M=sp.csc_matrix(M), which="LA", tol=1e-2,
+                               return_eigenvectors=False)[0])
+    except spla.ArpackNoConvergence as exc:
+        if not len(exc.eigenvalues):
+            raise UnresolvedSpectrum(f"{what}: ARPACK found no estimate of the largest "
+                                     "eigenvalue") from None
+        top = float(np.max(exc.eigenvalues))
+    sigma = SHIFT * top
+    shifted = (K + sigma * M).tocsc()
+    block = 8
+    while True:
+        found = lowest_modes(shifted, M, block - 1, block=block)
+        count, Z = _rigid_count(found.lam - sigma, top, K, M, known, what)
+        if count < block or block >= n:
+            return found.columns(count) if Z is None else Z
+        block *= 2
+
+
+def _rigid_count(lam: Array, top: float, K: sp.spmatrix, M: sp.spmatrix,
+                 known: Array | None, what: str) -> tuple[int, Array | None]:
+    """:func:`count_by_gap` (and no basis: the eigenvectors are one), or where it finds no
+    clear gap the round-off eigenvalues that the ``known`` motions explain, with the
+    M-orthonormal basis of the combinations of them that ``K`` annihilates
+    (:func:`null_space`)."""
+    try:
+        return count_by_gap(lam, what, top), None
+    except UnresolvedSpectrum:
+        if known is None:
+            raise
+        zero = int(np.sum(lam <= 1e3 * EPS * top))
+        Y = np.asarray(known, dtype=float)
+        w, V = np.linalg.eigh(Y.T @ np.asarray(M @ Y))
+        keep = w > 1e-12 * w.max(initial=0.0)          # independent motions only
+        Y = Y @ (V[:, keep] / np.sqrt(w[keep]))          # M-orthonormal: Yᵀ M Y = I
+        low, A = np.linalg.eigh(Y.T @ np.asarray(K @ Y))
+        explained = low <= 1e3 * EPS * top
+        if int(explained.sum()) != zero:
+            raise
+        return zero, Y @ A[:, explained]

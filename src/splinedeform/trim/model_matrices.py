@@ -1,5 +1,7 @@
 """The parametric energy of a trimmed surface: matrices over the trimmed region, the WEB
-map as constraint map, and Nitsche's terms for the held trim loops.
+map as constraint map, and Nitsche's terms for the held trim loops; the loops' conditions,
+quadrature and penalty that the intrinsic plate and the shell share with it
+(:func:`loop_conditions`, :func:`form_matrices`, :mod:`.energy_forms`).
 
 With the surface's B-splines ``b_k`` (tensor, row-major ``k = i n_v + j``) and the
 trimmed quadrature ``(x_q, ω_q)`` of :func:`~splinedeform.trim.quadrature.trim_quadrature`
@@ -46,6 +48,7 @@ from ..errors import InputError
 from ..material import Material
 from ..solvers import rigid
 from .cells import Grid, loop_pieces
+from .energy_forms import Form, energy_matrix, nitsche_matrix, scalar_mass
 from .loops import TrimDomain
 from .quadrature import TrimQuadrature, trim_quadrature
 from .holed import holed_quadrature, with_edges
@@ -131,17 +134,13 @@ def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str
                    lumped: bool = False, physics: str = "parametric", fixed: Any = None,
                    rest: str = "initial") -> TrimmedSystem:
     """``K``, ``M`` (see the module docstring) and ``d = E d_free`` of a trimmed surface."""
-    if physics != "parametric":
-        raise InputError(f"a trimmed surface takes physics 'parametric' (its energy over the "
-                         f"trimmed region); {physics!r} is not trimmed yet")
-    domain: TrimDomain = surface.trim
+    if physics not in ("parametric", "intrinsic"):
+        raise InputError(f"a trimmed surface's plate takes physics 'parametric' or "
+                         f"'intrinsic' (its energy over the trimmed region), got {physics!r}; "
+                         "the shell is ShellModel")
     grid = trim_grid(surface)
-    names = loop_names(domain)
     rectangle = holed_rectangle(surface)
-    counts = {name: domain.edge_count(k) for k, name in enumerate(names)}
-    edges, loops = trim_conditions(boundary, names, rectangle, counts)
-    held = {k: v for k, v in enumerate(_loop_presets(loops, names, counts))
-            if set(np.atleast_1d(v)) != {"free"}}
+    edges, loops, held = loop_conditions(surface, boundary)
     if held and rest == "none":
         raise InputError("rest = 'none' (the energy of the position itself) is not combined "
                          "with pinned or clamped trim loops yet: Nitsche's terms hold the "
@@ -152,19 +151,16 @@ def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str
                          f">= 3 (third derivatives in Nitsche's terms), got "
                          f"{surface_degrees(surface)}")
     quad = quadrature_of(surface)
-    orders = [(0, 0)] + [ab for key, ab, _ in STIFFNESS_TERMS if getattr(material, key)]
-    B = surface_values(surface, _points(surface, quad), orders)
-    om = sp.diags(quad.weights)
-    K = sp.csr_matrix((B[(0, 0)].shape[1],) * 2)
-    for key, ab, factor in STIFFNESS_TERMS:
-        weight = factor * getattr(material, key)
-        if weight:
-            K = K + weight * (B[ab].T @ om @ B[ab])
-    M = material.mass * (B[(0, 0)].T @ om @ B[(0, 0)])
+    if physics == "intrinsic":
+        from .intrinsic_trimmed import intrinsic_matrices
+
+        K, M = intrinsic_matrices(surface, material, held)
+    else:
+        K, M = _parametric_matrices(surface, material, quad)
+        if held:
+            K = K + nitsche_terms(surface, material, grid, held)
     if lumped:
         M = sp.diags(np.asarray(M.sum(axis=1)).ravel())
-    if held:
-        K = K + nitsche_terms(surface, material, grid, held)
     mask = None if fixed is None else np.asarray(fixed, dtype=bool)
     if rectangle or mask is not None:
         T, free_index = with_edges(surface, edges, quad.classes, mask)
@@ -176,16 +172,73 @@ def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str
     constraints = Constraints(T, None, None, free_index, {**edges, **loops}, pinned_points)
     return TrimmedSystem(constraints, ((K + K.T) * 0.5).tocsr(), sp.csr_matrix(M),
                          _rigid_count(surface, material, bool(held) or pinned_points
-                                      or set(edges.values()) != {"free"}))
+                                      or set(edges.values()) != {"free"}, physics))
 
 
-def _rigid_count(surface: Any, material: Material, holds: bool) -> int | None:
+def _parametric_matrices(surface: Any, material: Material, quad: TrimQuadrature
+                         ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """``K = Σ_α w_α B_αᵀ Ω B_α``, ``M = μ B_0ᵀ Ω B_0`` (module docstring)."""
+    orders = [(0, 0)] + [ab for key, ab, _ in STIFFNESS_TERMS if getattr(material, key)]
+    B = surface_values(surface, _points(surface, quad), orders)
+    om = sp.diags(quad.weights)
+    K = sp.csr_matrix((B[(0, 0)].shape[1],) * 2)
+    for key, ab, factor in STIFFNESS_TERMS:
+        weight = factor * getattr(material, key)
+        if weight:
+            K = K + weight * (B[ab].T @ om @ B[ab])
+    return K, material.mass * (B[(0, 0)].T @ om @ B[(0, 0)])
+
+
+def loop_conditions(surface: Any, boundary: str | Mapping[str, str]
+                    ) -> tuple[dict[str, str], dict[str, str], dict[int, str | tuple[str, ...]]]:
+    """The rectangle's edges' and the loops' presets
+    (:func:`~splinedeform.boundary.trim_conditions`) and the held loops: ``{k: preset}``
+    of loop ``k``, or the tuple of its trim edges' presets, for those not wholly free."""
+    domain: TrimDomain = surface.trim
+    names = loop_names(domain)
+    counts = {name: domain.edge_count(k) for k, name in enumerate(names)}
+    edges, loops = trim_conditions(boundary, names, holed_rectangle(surface), counts)
+    held = {k: v for k, v in enumerate(_loop_presets(loops, names, counts))
+            if set(np.atleast_1d(v)) != {"free"}}
+    return edges, loops, held
+
+
+def form_nitsche(surface: Any, form: Form, held: Mapping[int, str | tuple[str, ...]]
+                 ) -> sp.csr_matrix:
+    """Nitsche's terms of an energy :class:`~.energy_forms.Form` on the ``held`` loops
+    (:func:`~.energy_forms.nitsche_matrix`; points of :func:`held_points`, ``h`` of
+    :func:`_cell_size`, ``β`` of :func:`nitsche_penalty`)."""
+    grid = trim_grid(surface)
+    p, ds, n, s, preset = held_points(surface, grid, held)
+    on = preset != "free"
+    return nitsche_matrix(surface, form, p[on], ds[on], n[on], s[on], preset[on] == "clamped",
+                          _cell_size(grid, p[on]), nitsche_penalty(max(surface_degrees(surface))))
+
+
+def form_matrices(surface: Any, form: Form, held: Mapping[int, str | tuple[str, ...]]
+                  ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """``K`` of an energy :class:`~.energy_forms.Form` over the trimmed region (with
+    :func:`form_nitsche` of the ``held`` loops) and the scalar mass
+    ``ρ ∫_Ω b_k b_l √g du dv`` of its density."""
+    quad = quadrature_of(surface)
+    points = _points(surface, quad)
+    K = energy_matrix(surface, form, points, quad.weights)
+    if held:
+        K = K + form_nitsche(surface, form, held)
+    return K.tocsr(), scalar_mass(surface, points, quad.weights, form.density)
+
+
+def _rigid_count(surface: Any, material: Material, holds: bool, physics: str = "parametric"
+                 ) -> int | None:
     """``dim null K_r``: 0 where loops, edges or fixed points hold the surface (Nitsche's
     penalty, the constraints); else the energy's polynomials, which the extension
-    reproduces; on a rational net the constants alone under tension in u and v (``Σ R_k =
-    1``), and None (not known from the structure) without it."""
+    reproduces; on a rational net, or for the intrinsic energy (``|∇_S d|² = 0`` only for
+    constants), the constants alone under tension in u and v (``Σ R_k = 1``), and None (not
+    known from the structure) without it."""
     if holds:
         return 0
+    if physics == "intrinsic":
+        return 1 if material.w10 else None
     if net_weights_of(surface) is not None:
         return 1 if material.w10 and material.w01 else None
     bases = (surface.basis_u, surface.basis_v)
@@ -236,11 +289,12 @@ def loop_quadrature(domain: TrimDomain, grid: Grid, order: int, loops: tuple | N
             loop.ravel(), edge.ravel())
 
 
-def nitsche_terms(surface: Any, material: Material, grid: Grid,
-                  held: Mapping[int, str | tuple[str, ...]]) -> sp.csr_matrix:
-    """Nitsche's symmetric terms and penalties of the held loops (module docstring):
-    ``held[k]`` the preset of loop ``k``, or a tuple of the presets of its trim edges."""
-    m = material
+def held_points(surface: Any, grid: Grid, held: Mapping[int, str | tuple[str, ...]]
+                ) -> tuple[NDArray[np.float64], ...]:
+    """Gauss points on the trim loops (:func:`loop_quadrature`, ``n + 2`` per piece; not
+    the rectangle of a holed one) with the preset of each: ``held[k]`` that of loop ``k``,
+    or a tuple of those of its trim edges. Points ``(P, 2)`` in the closed rectangle,
+    weights, normals, tangents, presets ``(P,)``."""
     domain = surface.trim
     first = 1 if holed_rectangle(surface) else 0       # the rectangle's edges are no loop
     p, ds, n, s, loop, edge = loop_quadrature(domain, grid, max(surface_degrees(surface)) + 2,
@@ -251,7 +305,15 @@ def nitsche_terms(surface: Any, material: Material, grid: Grid,
         on = loop == k
         preset[on] = value if isinstance(value, str) else np.asarray(value, object)[edge[on]]
     (_, lu), (_, lv) = surface.domain
-    p = np.clip(p, 0.0, [lu, lv])
+    return np.clip(p, 0.0, [lu, lv]), ds, n, s, preset
+
+
+def nitsche_terms(surface: Any, material: Material, grid: Grid,
+                  held: Mapping[int, str | tuple[str, ...]]) -> sp.csr_matrix:
+    """Nitsche's symmetric terms and penalties of the held loops (module docstring):
+    ``held[k]`` the preset of loop ``k``, or a tuple of the presets of its trim edges."""
+    m = material
+    p, ds, n, s, preset = held_points(surface, grid, held)
     orders = [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2), (3, 0), (2, 1), (1, 2), (0, 3)]
     if not (m.w20 or m.w11 or m.w02):
         orders = orders[:3]

@@ -37,16 +37,20 @@ def trim_grid(surface: Any) -> Grid:
     bases = tuple(polynomial_basis(b) for b in (surface.basis_u, surface.basis_v))
     equal = True
     for name, basis in zip("uv", bases):
+        needs = (f"a trimmed surface ({getattr(surface, 'name', None)!r}) needs in {name} "
+                 "uniform or open knots or a clamped knot vector with simple interior knots")
         if isinstance(basis, KnotVectorBasis):
             problem = _knot_problem(basis)
             if problem:
-                raise InputError(f"a trimmed surface needs in {name} uniform or open knots or "
-                                 f"a clamped knot vector with simple interior knots: {problem}")
+                raise InputError(f"{needs}: {problem}")
             equal = False
         elif not isinstance(basis, BSplineBasis) or basis.kind not in ("uniform", "open"):
             kind = getattr(basis, "kind", type(basis).__name__)
-            raise InputError(f"a trimmed surface needs in {name} uniform or open knots or a "
-                             f"clamped knot vector with simple interior knots, got {kind!r}")
+            advice = (": a closed (periodic) direction is not trimmed yet; make the surface "
+                      "with open knots in it (shapes …(knots='open'), its seam an edge of "
+                      "the rectangle), or take the whole surface (a scenario's "
+                      "surface.trimmed = false)") if kind == "periodic" else ""
+            raise InputError(f"{needs}, got {kind!r}{advice}")
     if equal:
         return Grid((bases[0].cells, bases[1].cells), (bases[0].length, bases[1].length))
     return Grid.of_breaks(*(_breaks(b) for b in bases))
@@ -89,7 +93,13 @@ def _knot_problem(basis: Any) -> str | None:
     if breaks[0] != 0.0 or np.any(t[:n + 1] != t[0]) or np.any(t[-n - 1:] != t[-1]):
         return f"its knots {t.tolist()} are not clamped from 0"
     if len(t) != len(breaks) + 2 * n:
-        return f"its knots {t.tolist()} repeat an interior knot"
+        inner = t[n + 1:len(t) - n - 1]
+        repeated = sorted({float(x) for x in inner if np.count_nonzero(inner == x) > 1})
+        return (f"its knots {t.tolist()} repeat the interior knot(s) {repeated} (C0 or "
+                "weaker lines), across which a trimmed surface is not simulated yet; split "
+                "the surface at those lines into patches of a Body, or take the whole "
+                "surface (a scenario's surface.trimmed = false); inserting knots "
+                "(surface.refine) does not remove a repeated one")
     return None
 
 

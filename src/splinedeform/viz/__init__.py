@@ -14,13 +14,14 @@ from .animation import (ANIMATION_PIXELS, animation_frames, mp4_available, write
                         write_body_animation)
 from .colour import COLORMAP, LIGHT, MODE_COLORMAP, colormap_table, displacement_colors, shade
 from .figures import COLORBAR_INCHES, DPI, PANEL_INCHES, RENDERER_VERSION
-from .plots import mode_geometry, plot_modes, plot_probes
+from .plots import mode_geometry, plot_body_modes, plot_modes, plot_probes
 from .surfaces import render_body_surfaces, render_surfaces
 from .viewer import content_security_policy, script_json, vertex_checksum, viewer_data, viewer_html, write_viewer
 
 __all__ = ["ANIMATION_PIXELS", "COLORBAR_INCHES", "COLORMAP", "DPI", "LIGHT", "MODE_COLORMAP",
            "PANEL_INCHES", "RENDERER_VERSION", "animation_frames", "colormap_table",
            "content_security_policy", "displacement_colors",
-           "mode_geometry", "mp4_available", "plot_modes", "plot_probes", "render_body_surfaces", "render_surfaces",
+           "mode_geometry", "mp4_available", "plot_body_modes", "plot_modes", "plot_probes",
+           "render_body_surfaces", "render_surfaces",
            "script_json", "shade", "vertex_checksum", "viewer_data", "viewer_html",
            "write_animation", "write_body_animation", "write_viewer"]

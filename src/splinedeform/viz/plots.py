@@ -1,9 +1,10 @@
-"""probes.png (displacement histories) and modes.png (mode shapes along the normal)."""
+"""probes.png (displacement histories) and modes.png (mode shapes along the normal, of a
+surface or of every face of a body)."""
 
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -188,6 +189,16 @@ def plot_modes(path: str | os.PathLike[str], surface: Surface, omegas: ArrayLike
                          f"{phis.shape}")
     if not (np.all(np.isfinite(w)) and np.all(np.isfinite(phis))):
         raise InputError("omegas and mode shapes must be finite")
+    return _modes_figure(path, w, [mode_geometry(surface, phi, resolution) for phi in phis],
+                         camera)
+
+
+def _modes_figure(path: str | os.PathLike[str], w: NDArray[np.float64],
+                  panels: Sequence[tuple[NDArray[np.float64], NDArray[np.float64],
+                                         NDArray[np.int64]]],
+                  camera: tuple[float, float]) -> Path:
+    """modes.png of the drawn ``panels`` ``(vertices, φ at the vertices, faces)``, one per
+    mode ``ω_i`` (:func:`plot_modes`)."""
     import matplotlib
 
     cols = min(w.size, 3)
@@ -196,8 +207,7 @@ def plot_modes(path: str | os.PathLike[str], surface: Surface, omegas: ArrayLike
     fig = _figure(width, height)
     cmap = matplotlib.colormaps[MODE_COLORMAP]
     cell_w, cell_h = MODE_PANEL_INCHES / width, MODE_PANEL_INCHES / height
-    for i in range(w.size):
-        y, phi, faces = mode_geometry(surface, phis[i], resolution)
+    for i, (y, phi, faces) in enumerate(panels):
         peak = float(np.abs(phi).max()) or 1.0
         rgba = np.asarray(cmap(0.5 + 0.5 * phi[faces].mean(axis=1) / peak))
         r, c = divmod(i, cols)
@@ -212,3 +222,37 @@ def plot_modes(path: str | os.PathLike[str], surface: Surface, omegas: ArrayLike
               colormap=MODE_COLORMAP, vmin=-1.0)
     return _save_png(fig, path, trim=True)
 
+
+def plot_body_modes(path: str | os.PathLike[str], patches: Sequence[Surface],
+                    omegas: ArrayLike, mode_nets: Sequence[ArrayLike], resolution: int = 24,
+                    orientation: Sequence[int] = (), camera: tuple[float, float] = CAMERA
+                    ) -> Path:
+    """modes.png of a body: every face in every panel, as :func:`plot_modes` draws one.
+
+    ``mode_nets[p]`` ``(K, n_u, n_v, 3)`` are the modes of patch ``p`` as control-net
+    displacements ``D_k``. Panel ``k`` is the body's welded mesh
+    (:func:`splinedeform.export.body.welded_body_points`, triangles wound along each
+    face's ``orientation``) at ``X(P_rest + 2 D_k)``, coloured by the mode's component
+    along the outward normal ``φ = (X(P_rest + D_k) − X(P_rest)) · n``, ``n`` the welded
+    rest mesh's vertex normals, on the scale ``φ / max |φ|``.
+    """
+    from ..export.body import welded_body_points
+    from ..export.weld import vertex_normals
+
+    w = np.asarray(omegas, dtype=float)
+    D = [np.asarray(d, dtype=float) for d in mode_nets]
+    if w.ndim != 1 or w.size == 0 or len(D) != len(patches) or \
+            any(d.shape != (w.size, *s.shape, 3) for s, d in zip(patches, D)):
+        raise InputError(f"omegas must be (k,) and the modes of each of the {len(patches)} "
+                         f"patches (k, n_u, n_v, 3); got {w.shape} and "
+                         f"{[d.shape for d in D]}")
+    if not (np.all(np.isfinite(w)) and all(np.all(np.isfinite(d)) for d in D)):
+        raise InputError("omegas and mode shapes must be finite")
+    rests = [s.control_points for s in patches]
+    X, faces, _, _ = welded_body_points(
+        patches, [np.concatenate([r[None], r[None] + d]) for r, d in zip(rests, D)],
+        resolution, orientation)
+    normal = vertex_normals(X[0], faces)
+    panels = [(X[0] + 2.0 * (X[k] - X[0]), np.einsum("ij,ij->i", X[k] - X[0], normal), faces)
+              for k in range(1, w.size + 1)]
+    return _modes_figure(path, w, panels, camera)

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 from ..export import check_frames, check_net, tessellate_frames, write_text
@@ -38,14 +38,17 @@ def vertex_checksum(vertices: ArrayLike) -> float:
 
 
 def viewer_data(surface: Surface, rest_net: ArrayLike, times: ArrayLike, nets: ArrayLike,
-                resolution: int = 32, title: str | None = None) -> dict[str, Any]:
+                resolution: int = 32, title: str | None = None,
+                modes: tuple[ArrayLike, ArrayLike] | None = None) -> dict[str, Any]:
     """The JSON document the viewer reads: meshes of every frame, control nets, colours.
 
     ``frames`` holds float32 vertex positions ``(F, N, 3)`` and ``nets`` the control
     nets ``(F, n_u, n_v, 3)`` as base64; ``rest`` the rest mesh for ``|d|``; ``title``
     (default: the surface's name) heads the page. The page opens at ``startFrame``, the
     frame of largest displacement ``argmax_f max |x_f - x_rest|`` over the tessellation
-    (the first such), as ``surfaces.png`` shows it.
+    (the first such), as ``surfaces.png`` shows it. ``modes = (ω, D)`` (a modes solve:
+    ``D (K, n_u, n_v, 3)`` the modes as net displacements) adds the menu of every mode
+    (:func:`mode_menu`).
     """
     t, P = check_frames(surface, times, nets)
     rest = check_net(surface, rest_net, "rest net")
@@ -53,7 +56,11 @@ def viewer_data(surface: Surface, rest_net: ArrayLike, times: ArrayLike, nets: A
     X0, _ = tessellate_frames(surface, rest, resolution)
     largest = np.linalg.norm(X - X0, axis=-1).max(axis=-1)
     vmax = float(largest.max())
-    return {"name": surface.name, "title": surface.name if title is None else str(title),
+    menu = {} if modes is None else {"modes": mode_menu(
+        modes[0], t, tessellate_frames(surface, _mode_nets(surface, modes[1]), resolution)[0],
+        np.asarray(modes[1], dtype=float).reshape(len(modes[1]), -1, 3), rest.reshape(-1, 3),
+        X0)}
+    return {**menu, "name": surface.name, "title": surface.name if title is None else str(title),
             "times": t.tolist(), "startFrame": int(np.argmax(largest)),
             "vertexCount": int(X.shape[1]),
             "frames": _b64(X, "<f4"), "rest": _b64(X0, "<f4"), "faces": _b64(faces, "<u4"),
@@ -61,6 +68,38 @@ def viewer_data(surface: Surface, rest_net: ArrayLike, times: ArrayLike, nets: A
             "periodic": [surface.basis_u.periodic, surface.basis_v.periodic],
             "nets": _b64(P, "<f4"), "vmax": vmax, "colormap": colormap_table(),
             "colormapName": COLORMAP}
+
+
+def _mode_nets(surface: Surface, mode_nets: ArrayLike) -> NDArray[np.float64]:
+    D = np.asarray(mode_nets, dtype=float)
+    if D.ndim != 4 or D.shape[0] == 0 or D.shape[1:] != (*surface.shape, 3):
+        raise InputError(f"mode nets must be an array (K, {surface.shape[0]}, "
+                         f"{surface.shape[1]}, 3) with K >= 1, got shape {D.shape}")
+    return D
+
+
+def mode_menu(omegas: ArrayLike, phases: ArrayLike, fields: ArrayLike, net_fields: ArrayLike,
+              net_rest: ArrayLike, rest: ArrayLike) -> dict[str, Any]:
+    """The viewer's menu of the modes of a modes solve.
+
+    Mode ``k`` is drawn at frame ``f`` as ``x_rest + sin(2π φ_f) d_k`` (the drawn points)
+    and ``P_rest + sin(2π φ_f) D_k`` (the control net), as the run's frames draw mode 1:
+    ``fields (K, N, 3)`` holds ``d_k`` at the mesh's points, ``net_fields (K, NN, 3)``
+    ``D_k`` at the net's points, ``net_rest (NN, 3)`` and ``rest (N, 3)`` the rest
+    positions, ``phases`` the frames' ``φ_f``. The page computes each mode's frames when
+    it is chosen (``setMode(k)``), so the file holds ``K`` fields instead of ``K F``
+    frames.
+    """
+    w = np.asarray(omegas, dtype=float)
+    d, D = np.asarray(fields, dtype=float), np.asarray(net_fields, dtype=float)
+    X0, P0 = np.asarray(rest, dtype=float), np.asarray(net_rest, dtype=float)
+    if w.ndim != 1 or d.shape != (w.size, *X0.shape) or D.shape != (w.size, *P0.shape) \
+            or not all(np.all(np.isfinite(a)) for a in (w, d, D)):
+        raise InputError(f"the viewer's modes need finite ω (K,) and fields (K, {len(X0)}, 3) "
+                         f"and (K, {len(P0)}, 3); got {w.shape}, {d.shape} and {D.shape}")
+    return {"omegas": w.tolist(),
+            "amplitude": np.sin(2.0 * np.pi * np.asarray(phases, dtype=float)).tolist(),
+            "fields": _b64(d, "<f4"), "netFields": _b64(D, "<f4"), "netRest": _b64(P0, "<f4")}
 
 
 def _vendor_text(name: str) -> str:
@@ -119,16 +158,19 @@ def script_json(data: Any) -> str:
 
 def write_viewer(path: str | os.PathLike[str], surface: Surface, rest_net: ArrayLike,
                  times: ArrayLike, nets: ArrayLike, resolution: int = 32,
-                 title: str | None = None) -> Path:
+                 title: str | None = None,
+                 modes: tuple[ArrayLike, ArrayLike] | None = None) -> Path:
     """Write ``viewer.html``: one offline page to orbit, zoom and play the motion.
 
     three.js (r187, MIT, vendored) is inlined; frames are float32 base64. The page
     exposes ``window.splinedeformViewer`` with ``setFrame(i)``, ``frameCount``,
     ``currentFrame``, ``play()``, ``pause()`` and ``vertexChecksum()`` (see
-    :func:`vertex_checksum`). ``title`` (e.g. the scenario's title) heads the page.
+    :func:`vertex_checksum`), and for ``modes`` (:func:`viewer_data`) ``modeCount``,
+    ``currentMode``, ``setMode(k)`` and ``faceMotion()`` (the largest drawn ``|x - x_rest|``
+    on each face). ``title`` (e.g. the scenario's title) heads the page.
     """
     target = Path(path)
     if target.suffix.lower() not in (".html", ".htm"):
         raise InputError(f"the viewer is an .html file, got {target.name!r}")
     return write_text(target, viewer_html(viewer_data(surface, rest_net, times, nets,
-                                                      resolution, title)))
+                                                      resolution, title, modes)))

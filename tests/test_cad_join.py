@@ -1,0 +1,120 @@
+"""A .3dm mixing Breps and loose surfaces: the loose ones joined where their edges meet.
+
+The file holds a Brep (rhino3dm's ``Brep.CreateFromSurface``, with its own edges) and a
+plain NURBS surface sharing one edge with it. The Brep's edges come from the file, the
+plain surface's from matching its sides (:mod:`splinedeform.cad_join`), and the report
+says which. Checked against the same two surfaces written as plain surfaces only (every
+interface from the geometry): the same interface, the same answer.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import splinedeform as sd
+
+r3 = pytest.importorskip("rhino3dm", reason="the 'cad' extra (rhino3dm) is not installed")
+
+CELLS = 4
+
+
+def square(x0: float) -> sd.Surface:
+    """``[x0, x0 + 1] × [0, 1]`` at ``z = 0``, bicubic on ``CELLS`` spans per direction."""
+    plane = sd.shapes.plane(size=(1.0, 1.0), cells=CELLS, degree=3, knots="open")
+    return plane.with_control_points(plane.control_points + [x0, 0.0, 0.0])
+
+
+def rhino_surface(surface: sd.Surface):
+    """The rhino3dm NURBS surface of ``surface`` (its knots without the end ones)."""
+    from splinedeform.cad import patch_from_surface
+
+    patch = patch_from_surface(surface)
+    cu, cv = patch.points.shape[:2]
+    srf = r3.NurbsSurface.Create(3, False, patch.degrees[0] + 1, patch.degrees[1] + 1, cu, cv)
+    for i, k in enumerate(np.asarray(patch.knots_u)[1:-1]):
+        srf.KnotsU[i] = float(k)
+    for i, k in enumerate(np.asarray(patch.knots_v)[1:-1]):
+        srf.KnotsV[i] = float(k)
+    for i, j in np.ndindex(cu, cv):
+        srf.Points[i, j] = r3.Point4d(*map(float, patch.points[i, j]), 1.0)
+    return srf
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    """``(mixed, plain)``: a Brep face and a loose surface; the two as plain surfaces."""
+    folder = tmp_path_factory.mktemp("join")
+    paths = []
+    for name, brep in (("mixed", True), ("plain", False)):
+        model = r3.File3dm()
+        left, right = rhino_surface(square(0.0)), rhino_surface(square(1.0))
+        if brep:
+            model.Objects.AddBrep(r3.Brep.CreateFromSurface(left))
+        else:
+            model.Objects.AddSurface(left)
+        model.Objects.AddSurface(right)
+        path = folder / f"{name}.3dm"
+        assert model.Write(str(path), 7)
+        paths.append(path)
+    return paths
+
+
+def test_the_loose_surface_is_joined_to_the_brep_face_by_geometry(files):
+    from splinedeform.cad_body import read_body
+
+    mixed, plain = files
+    surfaces, topology, info = read_body(mixed)
+    assert len(surfaces) == 2
+    (joined,) = topology.interfaces                      # the file has none between them
+    assert {(joined.a, joined.edge_a), (joined.b, joined.edge_b)} == {(0, "u1"), (1, "u0")}
+    assert joined.conforming and not joined.reversed
+    assert info["joined_by_geometry"] == [{"face_a": 0, "edge_a": "u1", "face_b": 1,
+                                           "edge_b": "u0"}]
+    # from the file: the Brep's 4 edges, each used once; the matching joins one of them
+    # with the loose surface's u0 and leaves its other 3 sides free: 1 shared, 6 boundary
+    assert topology.counts == {"shared": 1, "boundary": 6, "seam": 0, "non_manifold": 0,
+                               "off_sides": 0, "joined_by_geometry": 1}
+    # a file of plain surfaces only keeps its own path (no file edges, nothing to join)
+    assert read_body(plain)[2]["joined_by_geometry"] == []
+
+
+def test_the_mixed_body_deforms_as_the_plain_one(files):
+    from splinedeform.cad_body import read_body
+
+    answers = []
+    for path in files:
+        surfaces, topology, _ = read_body(path)
+        body = sd.Body(surfaces, topology.interfaces or None)
+        assert body.summary()["shared"] == 1 and body.summary()["boundary"] == 6
+        model = sd.BodyModel(body, sd.Material(w10=1.0, w01=1.0), boundary="clamped")
+        answers.append(model.static(sd.Uniform((0.0, 0.0, 1.0))).control_points())
+    (a0, a1), (b0, b1) = answers
+    # the same matrices and map: the same solve, to round-off of the displacement (0.1)
+    for x, y in ((a0, b0), (a1, b1)):
+        np.testing.assert_allclose(x, y, rtol=0, atol=1e-12)
+    # the shared edge stays closed: the merged control points are one
+    np.testing.assert_allclose(a0[-1], a1[0], rtol=0, atol=1e-14)
+    assert np.abs(a0[..., 2]).max() > 1e-2                 # and it did move
+
+
+def test_a_scenario_reports_the_edges_joined_by_geometry(files, tmp_path):
+    import shutil
+
+    from splinedeform.pipeline import run
+    from splinedeform.scenario import load_scenario
+
+    mixed = files[0]
+    shutil.copy(mixed, tmp_path / mixed.name)
+    path = tmp_path / "mixed.toml"
+    path.write_text(f'[surface]\nshape = "cad"\npath = "{mixed.name}"\n'
+                    '[material]\nw10 = 1.0\nw01 = 1.0\n[boundary]\nu0 = "clamped"\n'
+                    'u1 = "clamped"\nv0 = "clamped"\nv1 = "clamped"\n'
+                    '[[load]]\nkind = "uniform"\nforce = [0.0, 0.0, 1.0]\n'
+                    '[solve]\nkind = "static"\nframes = 2\n[output]\nformats = ["report"]\n')
+    run(load_scenario(path), tmp_path / "out")
+    body = json.loads((tmp_path / "out" / "report.json").read_text())["body"]
+    assert body["topology"]["joined_by_geometry"] == 1
+    assert body["topology"]["shared"] == 1 and body["interfaces"] == 1
