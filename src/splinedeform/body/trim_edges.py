@@ -34,7 +34,6 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from ..errors import InputError
-from ..material import Material
 from ..surface import Surface
 from ..trim.loops import PolygonLoop, TrimDomain
 from ..trim.model_matrices import loop_names
@@ -209,9 +208,9 @@ def find_edge_interfaces(patches: Sequence[Surface], boundary: Iterable[Edge],
     whole = {(p, loop_names(patches[p].trim)[k]) for p, k in shared_loops}
     curves = [c for p, s in enumerate(patches) for c in trim_edge_curves(p, s)
               if (p, c.name.split(".")[0]) not in whole]
-    if not curves:
-        return ()
     curves += [iso_curve(p, patches[p], e) for p, e in boundary]
+    if len({c.face for c in curves}) < 2:
+        return ()
     sides = [side(patches, c, c.part) for c in curves]
     fractions = np.linspace(0.0, 1.0, SAMPLES + 1)
     boxes = []
@@ -224,11 +223,16 @@ def find_edge_interfaces(patches: Sequence[Surface], boundary: Iterable[Edge],
     found = []
     for i, j in zip(*np.nonzero(np.triu(overlap, 1))):
         a, b = curves[i], curves[j]
-        if a.face == b.face or not (a.trimmed or b.trimmed):
+        if a.face == b.face:
             continue
         for part_a, part_b in common_parts(sides[i], sides[j], tol):
             found.append(TrimEdgeInterface(a.face, a.name, part_a, b.face, b.name, part_b))
     return tuple(found)
+
+
+def iso_stretches(parts: Sequence[TrimEdgeInterface]) -> list[TrimEdgeInterface]:
+    """The stretches shared by two iso-edges (T-junctions of untrimmed rectangles)."""
+    return [i for i in parts if i.edge_a in EDGES and i.edge_b in EDGES]
 
 
 def trim_edge_summary(patches: Sequence[Surface], whole: Sequence[Any],
@@ -246,18 +250,42 @@ def trim_edge_summary(patches: Sequence[Surface], whole: Sequence[Any],
             "stretches": len(parts) + len(whole)}
 
 
-def edge_penalty(patches: Sequence[Surface], interface: TrimEdgeInterface, material: Material,
-                 offsets: Sequence[int]) -> sp.csr_matrix:
-    """The penalties of one shared stretch (:func:`~splinedeform.physics.coupling_curves.
-    line_penalties` on the line of :func:`~splinedeform.physics.coupling_curves.curve_line`,
-    ``b``'s parameter guessed by the linear map of the stretch's ends); the trace space is
-    the iso-edge's running basis where one side is an iso-edge."""
-    from ..physics.coupling_curves import curve_line, line_penalties
+def stretch_line(patches: Sequence[Surface], interface: TrimEdgeInterface) -> tuple[Any, float]:
+    """Both faces' traces on one shared stretch and its element size
+    (:func:`~splinedeform.physics.coupling_curves.curve_line`, ``b``'s parameter guessed by
+    the linear map of the stretch's ends). The trace space is an iso-edge's running basis
+    where one side is an iso-edge, the finer one's (more knot-line crossings on the
+    stretch) where both are: a T-junction coupled as a non-conforming iso-edge interface."""
+    from ..physics.coupling_curves import curve_line
 
     a = side(patches, edge_curve(patches, interface.a, interface.edge_a), interface.part_a)
     b = side(patches, edge_curve(patches, interface.b, interface.edge_b), interface.part_b)
     (c0, c1), (s0, s1) = interface.part_a, interface.part_b
     start = lambda t: s0 + (np.asarray(t) - c0) * ((s1 - s0) / (c1 - c0))  # noqa: E731
     iso = [name in EDGES for name in (interface.edge_a, interface.edge_b)]
-    line, h = curve_line(a, b, str(interface), start, 1 if iso[1] else 0 if iso[0] else None)
-    return line_penalties(line, h, material, interface.a, interface.b, patches, offsets)
+    running = None if not any(iso) else 0 if not iso[1] else 1 if not iso[0] else \
+        int(len(b.breaks()) > len(a.breaks()))
+    return curve_line(a, b, str(interface), start, running)
+
+
+def edge_penalty(patches: Sequence[Surface], interface: TrimEdgeInterface, material: Any,
+                 offsets: Sequence[int]) -> sp.csr_matrix:
+    """The penalties of one shared stretch on the line of :func:`stretch_line`, factors
+    ``(α, β)`` from the material and the element size: for a plate
+    (:class:`~splinedeform.material.Material`)
+    :func:`~splinedeform.physics.coupling_curves.line_penalties` on its scalar control
+    values; for a Kirchhoff–Love shell (:class:`~splinedeform.physics.shell.ShellMaterial`)
+    ``½ α ∫ |Π (d_a − d_b)|² ds + ½ β ∫ (Π (θ_a − θ_b))² ds`` on its interleaved unknowns
+    (:func:`~splinedeform.physics.coupling.shell_line_penalty`), ``θ`` the rotation of
+    each side's conormal fibre about the tangent, so that a crease keeps its angle."""
+    from ..physics import coupling
+    from ..physics.coupling_curves import line_penalties
+    from ..physics.shell import ShellMaterial
+
+    line, h = stretch_line(patches, interface)
+    if not isinstance(material, ShellMaterial):
+        return line_penalties(line, h, material, interface.a, interface.b, patches, offsets)
+    alpha, beta = coupling.penalty_factors(material, h)
+    size = int(offsets[-1]) + patches[-1].shape[0] * patches[-1].shape[1]
+    off_a, off_b = int(offsets[interface.a]), int(offsets[interface.b])
+    return coupling.shell_line_penalty(line, (off_a, off_b, size), alpha, beta, line.space(0))
