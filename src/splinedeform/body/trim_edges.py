@@ -27,7 +27,7 @@ and the mesh.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Iterable, Sequence
+from typing import Any, Iterable, Mapping, Sequence
 
 import numpy as np
 import scipy.sparse as sp
@@ -250,12 +250,53 @@ def trim_edge_summary(patches: Sequence[Surface], whole: Sequence[Any],
             "stretches": len(parts) + len(whole)}
 
 
-def stretch_line(patches: Sequence[Surface], interface: TrimEdgeInterface) -> tuple[Any, float]:
-    """Both faces' traces on one shared stretch and its element size
+RUNS_WITH_POLYGON = {"v0": True, "u1": True, "v1": False, "u0": False}
+"""Whether an iso-edge's own parameter increases with the rectangle polygon's."""
+
+
+def _end_edge(edge: str, at_start: bool) -> str:
+    """The edge that an iso-edge meets at its start (``at_start``) or end in the
+    rectangle polygon's order (:func:`rectangle`)."""
+    from ..physics.coupling_model import ALONG
+
+    first, last = ALONG[edge]
+    return first if at_start == RUNS_WITH_POLYGON[edge] else last
+
+
+def stretch_ends(interface: TrimEdgeInterface, presets: Mapping[Edge, str]) -> tuple[str, str]:
+    """The conditions holding a stretch's two ends (in ``a``'s parameter order): at each
+    the strongest (:func:`~splinedeform.physics.coupling_model.held`) of the edges that
+    meet there, an iso-edge side contributing the edge next to it where the stretch
+    reaches that iso-edge's end (a trim edge side, or a stretch ending inside an edge: a
+    T-junction's vertex, contributes none)."""
+    from ..physics.coupling_model import held
+
+    found: list[list[str | None]] = [[], []]
+    for face, name, (p0, p1) in ((interface.a, interface.edge_a, interface.part_a),
+                                 (interface.b, interface.edge_b, interface.part_b)):
+        if name not in EDGES:
+            continue
+        k = ISO_SEGMENTS[name]
+        for end, p in enumerate((p0, p1)):
+            for corner, at_start in ((k, True), (k + 1, False)):
+                if abs(p - corner) <= 1e-9:
+                    found[end].append(presets.get((face, _end_edge(name, at_start))))
+    return held(None, *found[0]), held(None, *found[1])
+
+
+def stretch_line(patches: Sequence[Surface], interface: TrimEdgeInterface,
+                 presets: Mapping[Edge, str] | None = None
+                 ) -> tuple[Any, float, sp.csr_matrix]:
+    """Both faces' traces on one shared stretch, its element size and its trace space
     (:func:`~splinedeform.physics.coupling_curves.curve_line`, ``b``'s parameter guessed by
     the linear map of the stretch's ends). The trace space is an iso-edge's running basis
     where one side is an iso-edge, the finer one's (more knot-line crossings on the
-    stretch) where both are: a T-junction coupled as a non-conforming iso-edge interface."""
+    stretch) where both are: a T-junction coupled as a non-conforming iso-edge interface,
+    the functions at an end that the boundary holds (:func:`stretch_ends` on the edge
+    conditions ``presets``, keyed ``(face, edge)``) merged with their neighbours as there
+    (:data:`~splinedeform.physics.coupling.HELD`); a held end would otherwise be tied
+    twice and lock."""
+    from ..physics.coupling import HELD
     from ..physics.coupling_curves import curve_line
 
     a = side(patches, edge_curve(patches, interface.a, interface.edge_a), interface.part_a)
@@ -265,11 +306,20 @@ def stretch_line(patches: Sequence[Surface], interface: TrimEdgeInterface) -> tu
     iso = [name in EDGES for name in (interface.edge_a, interface.edge_b)]
     running = None if not any(iso) else 0 if not iso[1] else 1 if not iso[0] else \
         int(len(b.breaks()) > len(a.breaks()))
-    return curve_line(a, b, str(interface), start, running)
+    line, h = curve_line(a, b, str(interface), start, running)
+    if running is None:
+        return line, h, line.space(0)
+    ends = [HELD[e] for e in stretch_ends(interface, presets or {})]
+    name = (interface.edge_a, interface.edge_b)[running]
+    along_a = running == 0 or s1 > s0          # its polygon parameter runs with a's
+    if RUNS_WITH_POLYGON[name] != along_a:     # its running basis runs against a's
+        ends = ends[::-1]
+    return line, h, line.space(tuple(ends))
 
 
 def edge_penalty(patches: Sequence[Surface], interface: TrimEdgeInterface, material: Any,
-                 offsets: Sequence[int]) -> sp.csr_matrix:
+                 offsets: Sequence[int], presets: Mapping[Edge, str] | None = None
+                 ) -> sp.csr_matrix:
     """The penalties of one shared stretch on the line of :func:`stretch_line`, factors
     ``(α, β)`` from the material and the element size: for a plate
     (:class:`~splinedeform.material.Material`)
@@ -282,10 +332,11 @@ def edge_penalty(patches: Sequence[Surface], interface: TrimEdgeInterface, mater
     from ..physics.coupling_curves import line_penalties
     from ..physics.shell import ShellMaterial
 
-    line, h = stretch_line(patches, interface)
+    line, h, space = stretch_line(patches, interface, presets)
     if not isinstance(material, ShellMaterial):
-        return line_penalties(line, h, material, interface.a, interface.b, patches, offsets)
+        return line_penalties(line, h, material, interface.a, interface.b, patches, offsets,
+                              space)
     alpha, beta = coupling.penalty_factors(material, h)
     size = int(offsets[-1]) + patches[-1].shape[0] * patches[-1].shape[1]
     off_a, off_b = int(offsets[interface.a]), int(offsets[interface.b])
-    return coupling.shell_line_penalty(line, (off_a, off_b, size), alpha, beta, line.space(0))
+    return coupling.shell_line_penalty(line, (off_a, off_b, size), alpha, beta, space)

@@ -110,7 +110,8 @@ def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
     couplings += [c0_coupling(s, material, e, int(offsets[p]), size,
                               exact={(d, k) for q, d, k in ties.lines if q == p})
                   for p, (s, e) in enumerate(zip(patches, own))]
-    couplings += [edge_penalty(patches, i, material, offsets[:-1]) for i in body.edge_interfaces]
+    couplings += [edge_penalty(patches, i, material, offsets[:-1], presets)
+                  for i in body.edge_interfaces]
     for penalty in (c for c in couplings if c is not None):
         K = (K + penalty).tocsr()
     pairs = [np.zeros((0, 2), dtype=np.int64)]
