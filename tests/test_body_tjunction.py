@@ -23,6 +23,9 @@ import pytest
 
 import splinedeform as sd
 from splinedeform.body.interface import TrimEdgeInterface
+from splinedeform.cad import NurbsPatch
+from splinedeform.cad_faces import topology_line
+from splinedeform.cad_topology import body_topology
 from splinedeform.physics import coupling
 from splinedeform.physics.shell import ShellMaterial
 from splinedeform.physics.shell_model import AreaForce, ShellModel
@@ -123,3 +126,41 @@ def test_held_ends_are_merged_so_a_stiffer_penalty_does_not_lock(physics):
     stiffer, w_stiff = solve(physics, 8, 6, scale=10.0)
     assert abs(gap(stiffer) / gap(static) - 1) < 1e-2
     assert abs(w_stiff / w - 1) < 3e-5
+
+
+def sheet(corner, du, dv) -> NurbsPatch:
+    """The flat biquadratic file face ``corner + s du + t dv`` on ``[0, 1]²``."""
+    s = np.linspace(0.0, 1.0, 3)
+    P = (np.asarray(corner, float) + s[:, None, None] * np.asarray(du, float)
+         + s[None, :, None] * np.asarray(dv, float))
+    knots = np.array([0, 0, 0, 1, 1, 1.0])
+    return NurbsPatch((2, 2), knots, knots, P, np.ones((3, 3)))
+
+
+def file_edge(faces, a, b):
+    """An edge from ``a`` to ``b`` used by ``faces``, sampled as the readers sample it."""
+    t = (np.arange(9) + 0.5) / 9
+    return {"faces": faces, "points": np.asarray(a, float) + t[:, None] * np.subtract(b, a)}
+
+
+def test_a_file_s_t_junction_edges_are_listed_and_left_to_the_stretches():
+    # a Brep of the three-patch square: the left face's side x = 0.5 split into two
+    # edges, each also a side of one right face (as a sewn shell has it)
+    patches = [sheet([0, 0, 0], [0.5, 0, 0], [0, 1, 0]),
+               sheet([0.5, 0, 0], [0.5, 0, 0], [0, 0.5, 0]),
+               sheet([0.5, 0.5, 0], [0.5, 0, 0], [0, 0.5, 0])]
+    edges = [file_edge([0, 1], [0.5, 0, 0], [0.5, 0.5, 0]),
+             file_edge([0, 2], [0.5, 0.5, 0], [0.5, 1, 0]),
+             file_edge([1, 2], [0.5, 0.5, 0], [1, 0.5, 0])]
+    topology = body_topology(patches, edges, [0, 1, 2])
+    # counts are integers: compared to 0.5
+    assert abs(topology.counts["shared"] - 3) < 0.5
+    assert abs(topology.counts["partly_shared"] - 2) < 0.5
+    assert [(i.a, i.edge_a, i.b, i.edge_b) for i in topology.interfaces] == [
+        (1, "v1", 2, "v0")]
+    line = topology_line(topology.as_dict())
+    assert "3 shared" in line and "2 of them along part of a side" in line
+    # the body made with the file's interfaces finds and couples the two stretches
+    body = sd.Body(three_patches(4, 3), topology.interfaces)
+    assert abs(body.summary()["partly_shared"] - 2) < 0.5
+    assert abs(body.summary()["boundary"] - 7) < 0.5
