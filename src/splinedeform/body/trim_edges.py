@@ -213,21 +213,39 @@ def find_edge_interfaces(patches: Sequence[Surface], boundary: Iterable[Edge],
         return ()
     sides = [side(patches, c, c.part) for c in curves]
     fractions = np.linspace(0.0, 1.0, SAMPLES + 1)
-    boxes = []
+    boxes, polylines = [], []
     for c, s in zip(curves, sides):
         X = s.position(c.part[0] + fractions * (c.part[1] - c.part[0]))[0]
         margin = tol + 0.1 * float(np.linalg.norm(np.diff(X, axis=0), axis=1).max())
         boxes.append((X.min(axis=0) - margin, X.max(axis=0) + margin))
+        polylines.append(X)
     lower, upper = (np.array(x) for x in zip(*boxes))
     overlap = np.all((lower[:, None] <= upper[None]) & (lower[None] <= upper[:, None]), axis=-1)
     found = []
     for i, j in zip(*np.nonzero(np.triu(overlap, 1))):
         a, b = curves[i], curves[j]
-        if a.face == b.face:
+        if a.face == b.face or not (a.trimmed or b.trimmed or
+                                    _may_share(polylines[i], polylines[j], tol)):
             continue
         for part_a, part_b in common_parts(sides[i], sides[j], tol):
             found.append(TrimEdgeInterface(a.face, a.name, part_a, b.face, b.name, part_b))
     return tuple(found)
+
+
+def _may_share(a: Array, b: Array, tol: float) -> bool:
+    """Whether two edges sampled at :data:`SAMPLES` ``+ 1`` points may share a stretch:
+    an inner sample of one lies within ``tol`` plus a quarter of the other's longest chord
+    (more than the sag of a chord turning by 90°) of the other's chord polygon. Edges
+    that only touch at an end are so told apart without a projection; a stretch shorter
+    than a sixteenth of both edges is missed."""
+    for x, curve in ((a[1:-1], b), (b[1:-1], a)):
+        start, chord = curve[:-1], np.diff(curve, axis=0)
+        tau = np.clip(np.einsum("psk,sk->ps", x[:, None] - start, chord)
+                      / np.maximum(np.einsum("sk,sk->s", chord, chord), 1e-300), 0.0, 1.0)
+        gap = np.linalg.norm(x[:, None] - start - tau[..., None] * chord, axis=-1).min(axis=1)
+        if gap.min() <= tol + 0.25 * float(np.linalg.norm(chord, axis=1).max()):
+            return True
+    return False
 
 
 def iso_stretches(parts: Sequence[TrimEdgeInterface]) -> list[TrimEdgeInterface]:
