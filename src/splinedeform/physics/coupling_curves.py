@@ -319,12 +319,14 @@ def curve_penalty(patches: Sequence[Surface], interface: TrimInterface, material
 
 
 def line_penalties(line: Line, h: float, material: Material, a: int, b: int,
-                   patches: Sequence[Surface], offsets: Sequence[int]) -> sp.csr_matrix:
+                   patches: Sequence[Surface], offsets: Sequence[int],
+                   space: sp.csr_matrix | None = None) -> sp.csr_matrix:
     """The displacement penalty and, where the energy bends, the slope penalty of
-    :func:`curve_penalty` on ``line`` between faces ``a`` and ``b``, at element size ``h``."""
+    :func:`curve_penalty` on ``line`` between faces ``a`` and ``b``, at element size ``h``,
+    in the trace space ``space`` (default the line's, no end merged)."""
     alpha, beta = penalty_factors(material, h)
     size = int(offsets[-1]) + patches[-1].shape[0] * patches[-1].shape[1]
     layout = (int(offsets[a]), int(offsets[b]), size)
-    space = line.space(0)
+    space = line.space(0) if space is None else space
     K = line_penalty(line, "values", layout, alpha, space)
     return K if beta == 0 else (K + line_penalty(line, "slopes", layout, beta, space)).tocsr()

@@ -7,9 +7,10 @@ in each), interleaved (dof ``3k + c``). Per patch the shell's own matrices, so t
           M = \\operatorname{diag}(M_1, …, M_P),
 
 where ``K_coupling`` is the rotation penalty across every interface and C0 line that is
-not tied, and across a non-conforming interface also the displacement penalty
-(:mod:`.coupling_model`, factors from the material and the mesh). The constraint map
-``d = T d_free`` is ``T = T_b S``: ``T_b = diag(T_p)`` the edge conditions of each patch
+not tied, and across a non-conforming interface and along each stretch two iso-edges
+share (a T-junction, :func:`~splinedeform.body.trim_edges.edge_penalty`) also the
+displacement penalty (:mod:`.coupling_model`, factors from the material and the mesh).
+The constraint map ``d = T d_free`` is ``T = T_b S``: ``T_b = diag(T_p)`` the edge conditions of each patch
 (:func:`.shell_edges.constraint_matrix`: the body's kinds on boundary edges, free on
 interface edges), and ``S`` merges the columns of ``T_b`` that a conforming interface
 identifies. A merged pair of dofs ``(r_a, r_b)`` (the same component of the ``k``-th control
@@ -40,6 +41,7 @@ from ..body.constraints import boundary_presets, edge_rows
 from ..body.interface import EDGES
 from ..body.model import BodyReduction
 from ..body.model import _refuse as refuse
+from ..body.trim_edges import edge_penalty, iso_stretches
 from ..errors import InputError
 from ..surface import Surface
 from .coupling_model import c0_coupling, interface_coupling
@@ -108,6 +110,8 @@ def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
     couplings += [c0_coupling(s, material, e, int(offsets[p]), size,
                               exact={(d, k) for q, d, k in ties.lines if q == p})
                   for p, (s, e) in enumerate(zip(patches, own))]
+    couplings += [edge_penalty(patches, i, material, offsets[:-1], presets)
+                  for i in iso_stretches(body.edge_interfaces)]
     for penalty in (c for c in couplings if c is not None):
         K = (K + penalty).tocsr()
     pairs = [np.zeros((0, 2), dtype=np.int64)]
