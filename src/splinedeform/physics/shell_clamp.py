@@ -40,11 +40,14 @@ FLAT = 1e-10
 
 
 def is_flat(surface: Surface) -> bool:
-    """Whether the second fundamental form ``b_αβ = a_αβ·a_3`` vanishes on the metric grid."""
+    """Whether the second fundamental form ``b_αβ = a_αβ·a_3`` vanishes on the metric grid
+    (at its regular points: a pole has no normal)."""
     G = metric.grid(surface)
-    a3 = np.cross(G.a[0], G.a[1]) / G.sqrt_g[..., None]
-    b = np.abs(np.einsum("k...c,...c->k...", G.a2, a3))
-    scale = np.linalg.norm(G.a2, axis=-1) + np.sum(G.a[0] ** 2 + G.a[1] ** 2, -1)
+    regular = G.sqrt_g > 0
+    a3 = np.cross(G.a[0], G.a[1])[regular] / G.sqrt_g[regular][:, None]
+    b = np.abs(np.einsum("kpc,pc->kp", G.a2[:, regular], a3))
+    scale = (np.linalg.norm(G.a2[:, regular], axis=-1)
+             + np.sum(G.a[0][regular] ** 2 + G.a[1][regular] ** 2, -1))
     return bool(np.all(b <= FLAT * scale))
 
 

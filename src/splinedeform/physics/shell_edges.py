@@ -11,7 +11,8 @@ plate), so component ``c`` has ``T_c = T_u^c ⊗ T_v^c`` and ``T`` interleaves t
 - ``free``: none; ``pinned``: ``d = 0`` (``j = 0`` for x, y, z); ``clamped``: ``d = 0`` and
   ``∂d = 0`` (``j = 0, 1``), which holds the rotation of the normal about the edge, on a
   flat surface; on a curved one ``∂d = 0`` would hold the membrane strains ``ε_nn``,
-  ``ε_ns`` at the edge too, so there ``T`` holds ``d = 0`` only and the rotation
+  ``ε_ns`` at the edge too, so there (``weak_rotation``: the shell's formulation, a single
+  surface or a body's patches) ``T`` holds ``d = 0`` only and the rotation
   ``a_3·∂_n d = 0`` is Nitsche's (:mod:`.shell_clamp`);
 - ``diaphragm`` in the plane ``x_a = const`` containing the edge and the surface normal
   (Scordelis–Lo ends): rigid in that plane, ``d_b = 0`` for ``b ≠ a``; ``d_a`` free;

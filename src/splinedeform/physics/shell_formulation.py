@@ -108,6 +108,8 @@ class ShellFormulation:
                                                             system.edges)
             self.ties = system.ties
             points = np.concatenate([s.control_points.reshape(-1, 3) for s in self.patches])
+            if system.clamps:                      # a curved patch's clamped edges
+                motions = held(self.T)
         elif getattr(surface, "trim", None) is not None:     # loops held by Nitsche
             from ..trim.shell_trimmed import trimmed_shell
 
