@@ -29,26 +29,22 @@ from numpy.typing import NDArray
 
 from ..quadrature import gauss_points
 from ..surface import Surface
-from . import metric
 from .shell import ShellMaterial
 from .shell_rigid import RigidMotions
 
 Array = NDArray[np.float64]
-#: a surface whose curvature ``|a_αβ·a_3|`` stays below this fraction of ``|a_αβ|`` (or
-#: of ``|a_α|²``) at every quadrature point is flat
+#: control points within this fraction of the net's extent from one plane are coplanar
 FLAT = 1e-10
 
 
 def is_flat(surface: Surface) -> bool:
-    """Whether the second fundamental form ``b_αβ = a_αβ·a_3`` vanishes on the metric grid
-    (at its regular points: a pole has no normal)."""
-    G = metric.grid(surface)
-    regular = G.sqrt_g > 0
-    a3 = np.cross(G.a[0], G.a[1])[regular] / G.sqrt_g[regular][:, None]
-    b = np.abs(np.einsum("kpc,pc->kp", G.a2[:, regular], a3))
-    scale = (np.linalg.norm(G.a2[:, regular], axis=-1)
-             + np.sum(G.a[0][regular] ** 2 + G.a[1][regular] ** 2, -1))
-    return bool(np.all(b <= FLAT * scale))
+    """Whether the surface lies in a plane, ``b_αβ = a_αβ·a_3 = 0``: exactly when its control
+    points do (``n·x − c = Σ_k R_k (n·P_k − c)`` vanishes identically only with every
+    coefficient, the basis being linearly independent and a partition of unity on the
+    domain): the smallest singular value of the centred net against the largest."""
+    P = surface.control_points.reshape(-1, 3)
+    s = np.linalg.svd(P - P.mean(axis=0), compute_uv=False)
+    return bool(s[-1] <= FLAT * max(s[0], 1e-300))
 
 
 def weak_clamps(surface: Surface, edges: Mapping[str, str]) -> tuple[str, ...]:
