@@ -47,6 +47,7 @@ from ..surface import Surface
 from .coupling_model import c0_coupling, interface_coupling
 from .coupling_ties import Ties, smooth_ties, tie_components
 from .shell import ShellMaterial, matrices
+from .shell_clamp import clamp_rotation
 from .shell_edges import KINDS, check_edges, constraint_matrix
 from .shell_edges import _impose as impose
 
@@ -67,6 +68,9 @@ class ShellBodySystem:
         First control point of each patch (``len(patches) + 1`` values).
     ties : :class:`~.coupling_ties.Ties`
         The interfaces and C0 lines whose slopes ``T`` ties exactly.
+    clamps : bool
+        Whether a curved patch's clamped edge has its rotation held by Nitsche's terms
+        (:mod:`.shell_clamp`, in ``K``), which hold every rigid motion ``T`` leaves.
     """
 
     K: sp.csr_matrix
@@ -75,6 +79,7 @@ class ShellBodySystem:
     edges: dict[tuple[int, str], str]
     offsets: NDArray[np.int64]
     ties: Ties
+    clamps: bool = False
 
 
 def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
@@ -99,9 +104,12 @@ def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
     offsets = np.concatenate([[0], np.cumsum(sizes)])
     own = [check_edges(s, {e: presets.get((p, e), "free") for e in EDGES})
            for p, s in enumerate(patches)]
-    Tb = sp.block_diag([constraint_matrix(s, e) for s, e in zip(patches, own)], format="csr")
+    Tb = sp.block_diag([constraint_matrix(s, e, weak_rotation=True)
+                        for s, e in zip(patches, own)], format="csr")
     blocks = [matrices(s, material) for s in patches]
-    K = sp.block_diag([k for k, _ in blocks], format="csr")
+    clamps = [clamp_rotation(s, material, e) for s, e in zip(patches, own)]
+    K = sp.block_diag([k if c is None else k + c for (k, _), c in zip(blocks, clamps)],
+                      format="csr")
     M = sp.block_diag([m for _, m in blocks], format="csr")
     size = int(offsets[-1])
     ties = smooth_ties(patches, topology.interfaces, offsets)
@@ -129,7 +137,8 @@ def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
     if T.shape[1] == 0:
         raise InputError("no free displacement: the boundary holds every control point of "
                          f"the {len(patches)} patches")
-    return ShellBodySystem(K, M, T, presets, offsets, ties)
+    return ShellBodySystem(K, M, T, presets, offsets, ties,
+                           any(c is not None for c in clamps))
 
 
 def merge_columns(Tb: sp.csr_matrix, pairs: NDArray[np.int64]
