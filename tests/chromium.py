@@ -102,3 +102,17 @@ def sheet_page(browser: object, folder: Path, scenario: str, resolution: int) ->
         finally:
             page.close()
 
+
+
+def resolve_in_page(page, version: int) -> None:
+    """Press Re-solve and wait for basis ``version``; the page shows no error."""
+    page.click("#resolve")
+    page.wait_for_function(f"sculptState.version === {version} || sculptState.errors.length > 0",
+                           timeout=60000)
+    assert page.evaluate("sculptState.errors") == []
+
+
+def shoot(page, path: Path) -> None:
+    """A screenshot of ``page`` at ``path``, named on the output for a look."""
+    page.screenshot(path=str(path))
+    print(f"\nscreenshot: {path}")

@@ -68,7 +68,7 @@ def test_a_body_opens_with_every_face_on_the_page(served):
     client, session = served
     data = client.get("/api/basis").json()
     assert data["grid"] == [2 * R, R] and len(data["faces"]) == 2
-    assert data["body"] == {"faces": [0, 1], "units": "mm"}
+    assert data["body"]["faces"] == [0, 1] and data["body"]["units"] == "mm"
     assert [f["net"] for f in data["faces"]] == [[6, 6], [6, 6]]
     rest = decode(data["rest"]).reshape(2, R, R, 3)
     # float32 transport of coordinates in [0, 2]: 2**-23 relative

@@ -182,6 +182,9 @@ def topology_line(topology: dict[str, Any]) -> str:
     conforming = sum(i["conforming"] for i in topology["interfaces"])
     line = (f"edges: {topology['shared']} shared, {topology['boundary']} boundary, "
             f"{topology['seam']} seam(s), {topology['non_manifold']} non-manifold")
+    if topology.get("partly_shared"):
+        line += (f", {topology['partly_shared']} of them along part of a side "
+                 "(T-junctions, coupled as stretches)")
     if topology["off_sides"]:
         trims = topology.get("trim_edges") or {}
         line += (f", {topology['off_sides']} on trimming loops ({trims.get('shared', 0)} "

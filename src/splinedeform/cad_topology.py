@@ -35,6 +35,9 @@ from .knots import KnotVectorBasis
 
 #: knots along two edges within this distance (on ``[0, 1]``) are the same knot
 KNOT_TOL = 1e-9
+#: an edge running along less than this fraction of a face's side shares only part of it
+#: (a T-junction: the face's side is split among several edges, each another face's side)
+WHOLE_SIDE = 0.9
 #: the kinds of edges counted, in the order they are reported
 EDGE_KINDS = ("shared", "boundary", "seam", "non_manifold", "off_sides")
 
@@ -50,7 +53,10 @@ class Topology:
     counts : dict
         ``shared`` (two faces), ``boundary`` (one use), ``seam`` (one face twice),
         ``non_manifold`` (more than two uses), and ``off_sides``: edges with a use that
-        lies on no side of its face's rectangle (a trimmed face's loop), not coupled here.
+        lies on no side of its face's rectangle (a trimmed face's loop), not coupled here;
+        ``partly_shared`` where some are (also counted ``shared``): edges of two faces that
+        run along only part of a side of one (a T-junction), given no interface here, as
+        the body couples them along their stretch (:mod:`splinedeform.body.trim_edges`).
     trim_edges : dict
         Of the ``off_sides`` edges: ``shared`` (two faces use it: a body whose faces are
         simulated trimmed couples them along it, :mod:`splinedeform.body.trim_edges`) and
@@ -66,6 +72,14 @@ class Topology:
         return {**self.counts, "trim_edges": dict(self.trim_edges), "interfaces": [
             {"a": i.a, "edge_a": i.edge_a, "b": i.b, "edge_b": i.edge_b,
              "reversed": i.reversed, "conforming": i.conforming} for i in self.interfaces]}
+
+
+def coverage(s: NDArray[np.float64]) -> float:
+    """The fraction of a side an edge runs along, from the positions ``s`` on it of the
+    edge's points sampled at the middles of ``S`` equal parameter pieces: their range
+    widened by half a piece at each end, ``|s_{S-1} − s_0| · S / (S − 1)``."""
+    s = np.asarray(s, dtype=float)
+    return float(abs(s[-1] - s[0]) * s.size / max(s.size - 1, 1))
 
 
 def _size(patch: NurbsPatch) -> float:
@@ -166,6 +180,7 @@ def body_topology(patches: Sequence[NurbsPatch | None], edges: Sequence[dict[str
                 else "seam" if uses[0] == uses[1] else "shared")
         topology.counts[kind] += 1
         placed: list[tuple[int, str, bool]] = []
+        partial = False
         for f in uses:
             patch = patches[f]
             if patch is None:
@@ -178,12 +193,16 @@ def body_topology(patches: Sequence[NurbsPatch | None], edges: Sequence[dict[str
                 gap, s = place_on_side(curve, edge["points"])
                 if side not in taken and gap.max() <= tol:
                     placed.append((f, side, bool(s[-1] > s[0])))
+                    partial |= coverage(s) < WHOLE_SIDE
                     break
         if len(placed) < sum(patches[f] is not None for f in uses):
             topology.counts["off_sides"] += 1
             if kind in ("shared", "boundary"):
                 topology.trim_edges["shared" if kind == "shared" else "free"] += 1
         if len(placed) < 2:
+            continue
+        if partial and kind == "shared":       # a T-junction: coupled along its stretch
+            topology.counts["partly_shared"] = topology.counts.get("partly_shared", 0) + 1
             continue
         fa, side_a, forward_a = placed[0]
         for fb, side_b, forward_b in placed[1:]:

@@ -26,7 +26,7 @@ from ..surface import Surface
 from .interface import Interface, TrimEdgeInterface, TrimInterface
 from .topology import (KNOT_TOLERANCE, Topology, body_size, edge_basis, edges_of,
                        find_topology, normalised_knots)
-from .trim_edges import find_edge_interfaces, labelled, trim_edge_summary
+from .trim_edges import find_edge_interfaces, iso_stretches, labelled, trim_edge_summary
 from .trimmed import (checked_trim_interfaces, find_trim_interfaces, unmerged_at_trims,
                       without_trimmed_edges)
 
@@ -57,7 +57,9 @@ class Body:
     Trimmed faces (``surface.trim``) meet along their trim curves: pairs of loops tracing
     one curve are found geometrically (:mod:`.trimmed`), :attr:`trim_interfaces`; then
     the trim edges of the other loops with each other and with the boundary iso-edges of
-    other faces, in whole or in part (:mod:`.trim_edges`), :attr:`edge_interfaces`. An
+    other faces, in whole or in part (:mod:`.trim_edges`), :attr:`edge_interfaces`; and
+    boundary iso-edges of any faces with each other where they share only a stretch (a
+    T-junction: a face's edge along part of a neighbour's, trimmed or not). An
     iso-edge shared that way is no boundary edge, and an iso-edge interface of a trimmed
     face (a rectangle with holes) is coupled by penalties, not merged.
 
@@ -91,18 +93,16 @@ class Body:
             if trim_interfaces is not None
             else find_trim_interfaces(self.patches, self.topology.tol)
             if any(s.trim is not None for s in self.patches) else ())
-        self.edge_interfaces: tuple[TrimEdgeInterface, ...] = ()
-        if any(s.trim is not None for s in self.patches):
-            topology = unmerged_at_trims(self.patches, self.topology)
-            whole = {(i.a, i.loop_a) for i in self.trim_interfaces} | {
-                (i.b, i.loop_b) for i in self.trim_interfaces}
-            self.edge_interfaces = find_edge_interfaces(self.patches, topology.boundary,
-                                                        whole, topology.tol)
-            iso = {(i.a, i.edge_a) for i in self.edge_interfaces} | {
-                (i.b, i.edge_b) for i in self.edge_interfaces}
-            self.topology = replace(topology, boundary=tuple(
-                e for e in topology.boundary if e not in iso))
-            self.interfaces = self.topology.interfaces
+        topology = unmerged_at_trims(self.patches, self.topology)
+        whole = {(i.a, i.loop_a) for i in self.trim_interfaces} | {
+            (i.b, i.loop_b) for i in self.trim_interfaces}
+        self.edge_interfaces: tuple[TrimEdgeInterface, ...] = find_edge_interfaces(
+            self.patches, topology.boundary, whole, topology.tol)
+        iso = {(i.a, i.edge_a) for i in self.edge_interfaces} | {
+            (i.b, i.edge_b) for i in self.edge_interfaces}
+        self.topology = replace(topology, boundary=tuple(
+            e for e in topology.boundary if e not in iso))
+        self.interfaces = self.topology.interfaces
 
     @classmethod
     def from_surfaces(cls, surfaces: Sequence[Surface], tol: float | None = None) -> Body:
@@ -124,8 +124,12 @@ class Body:
 
     def summary(self) -> dict[str, int]:
         """Counts of shared edges, seams, boundary edges, non-manifold edges, poles and
-        non-conforming interfaces (:meth:`~.topology.Topology.summary`)."""
-        return self.topology.summary()
+        non-conforming interfaces (:meth:`~.topology.Topology.summary`), and where two
+        iso-edges share only a stretch (a T-junction, :mod:`.trim_edges`) their count,
+        ``partly_shared``."""
+        counts = self.topology.summary()
+        partly = iso_stretches(self.edge_interfaces)
+        return {**counts, "partly_shared": len(partly)} if partly else counts
 
     def trim_summary(self) -> dict[str, int]:
         """Counts of the trim edges of the body's trimmed faces: ``shared`` with another

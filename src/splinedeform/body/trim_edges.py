@@ -27,14 +27,13 @@ and the mesh.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Iterable, Sequence
+from typing import Any, Iterable, Mapping, Sequence
 
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from ..errors import InputError
-from ..material import Material
 from ..surface import Surface
 from ..trim.loops import PolygonLoop, TrimDomain
 from ..trim.model_matrices import loop_names
@@ -209,26 +208,49 @@ def find_edge_interfaces(patches: Sequence[Surface], boundary: Iterable[Edge],
     whole = {(p, loop_names(patches[p].trim)[k]) for p, k in shared_loops}
     curves = [c for p, s in enumerate(patches) for c in trim_edge_curves(p, s)
               if (p, c.name.split(".")[0]) not in whole]
-    if not curves:
-        return ()
     curves += [iso_curve(p, patches[p], e) for p, e in boundary]
+    if len({c.face for c in curves}) < 2:
+        return ()
     sides = [side(patches, c, c.part) for c in curves]
     fractions = np.linspace(0.0, 1.0, SAMPLES + 1)
-    boxes = []
+    boxes, polylines = [], []
     for c, s in zip(curves, sides):
         X = s.position(c.part[0] + fractions * (c.part[1] - c.part[0]))[0]
         margin = tol + 0.1 * float(np.linalg.norm(np.diff(X, axis=0), axis=1).max())
         boxes.append((X.min(axis=0) - margin, X.max(axis=0) + margin))
+        polylines.append(X)
     lower, upper = (np.array(x) for x in zip(*boxes))
     overlap = np.all((lower[:, None] <= upper[None]) & (lower[None] <= upper[:, None]), axis=-1)
     found = []
     for i, j in zip(*np.nonzero(np.triu(overlap, 1))):
         a, b = curves[i], curves[j]
-        if a.face == b.face or not (a.trimmed or b.trimmed):
+        if a.face == b.face or not (a.trimmed or b.trimmed or
+                                    _may_share(polylines[i], polylines[j], tol)):
             continue
         for part_a, part_b in common_parts(sides[i], sides[j], tol):
             found.append(TrimEdgeInterface(a.face, a.name, part_a, b.face, b.name, part_b))
     return tuple(found)
+
+
+def _may_share(a: Array, b: Array, tol: float) -> bool:
+    """Whether two edges sampled at :data:`SAMPLES` ``+ 1`` points may share a stretch:
+    an inner sample of one lies within ``tol`` plus a quarter of the other's longest chord
+    (more than the sag of a chord turning by 90°) of the other's chord polygon. Edges
+    that only touch at an end are so told apart without a projection; a stretch shorter
+    than a sixteenth of both edges is missed."""
+    for x, curve in ((a[1:-1], b), (b[1:-1], a)):
+        start, chord = curve[:-1], np.diff(curve, axis=0)
+        tau = np.clip(np.einsum("psk,sk->ps", x[:, None] - start, chord)
+                      / np.maximum(np.einsum("sk,sk->s", chord, chord), 1e-300), 0.0, 1.0)
+        gap = np.linalg.norm(x[:, None] - start - tau[..., None] * chord, axis=-1).min(axis=1)
+        if gap.min() <= tol + 0.25 * float(np.linalg.norm(chord, axis=1).max()):
+            return True
+    return False
+
+
+def iso_stretches(parts: Sequence[TrimEdgeInterface]) -> list[TrimEdgeInterface]:
+    """The stretches shared by two iso-edges (T-junctions of untrimmed rectangles)."""
+    return [i for i in parts if i.edge_a in EDGES and i.edge_b in EDGES]
 
 
 def trim_edge_summary(patches: Sequence[Surface], whole: Sequence[Any],
@@ -246,20 +268,93 @@ def trim_edge_summary(patches: Sequence[Surface], whole: Sequence[Any],
             "stretches": len(parts) + len(whole)}
 
 
-def edge_penalty(patches: Sequence[Surface], interface: TrimEdgeInterface, material: Material,
-                 offsets: Sequence[int], penalties: Any = None) -> sp.csr_matrix:
-    """The penalties of one shared stretch (:func:`~splinedeform.physics.coupling_curves.
-    line_penalties` on the line of :func:`~splinedeform.physics.coupling_curves.curve_line`,
-    ``b``'s parameter guessed by the linear map of the stretch's ends); the trace space is
-    the iso-edge's running basis where one side is an iso-edge. ``penalties`` as for
-    :func:`~splinedeform.physics.coupling_curves.curve_penalty`."""
-    from ..physics.coupling_curves import curve_line, line_penalties
+RUNS_WITH_POLYGON = {"v0": True, "u1": True, "v1": False, "u0": False}
+"""Whether an iso-edge's own parameter increases with the rectangle polygon's."""
+
+
+def _end_edge(edge: str, at_start: bool) -> str:
+    """The edge that an iso-edge meets at its start (``at_start``) or end in the
+    rectangle polygon's order (:func:`rectangle`)."""
+    from ..physics.coupling_model import ALONG
+
+    first, last = ALONG[edge]
+    return first if at_start == RUNS_WITH_POLYGON[edge] else last
+
+
+def stretch_ends(interface: TrimEdgeInterface, presets: Mapping[Edge, str]) -> tuple[str, str]:
+    """The conditions holding a stretch's two ends (in ``a``'s parameter order): at each
+    the strongest (:func:`~splinedeform.physics.coupling_model.held`) of the edges that
+    meet there, an iso-edge side contributing the edge next to it where the stretch
+    reaches that iso-edge's end (a trim edge side, or a stretch ending inside an edge: a
+    T-junction's vertex, contributes none)."""
+    from ..physics.coupling_model import held
+
+    found: list[list[str | None]] = [[], []]
+    for face, name, (p0, p1) in ((interface.a, interface.edge_a, interface.part_a),
+                                 (interface.b, interface.edge_b, interface.part_b)):
+        if name not in EDGES:
+            continue
+        k = ISO_SEGMENTS[name]
+        for end, p in enumerate((p0, p1)):
+            for corner, at_start in ((k, True), (k + 1, False)):
+                if abs(p - corner) <= 1e-9:
+                    found[end].append(presets.get((face, _end_edge(name, at_start))))
+    return held(None, *found[0]), held(None, *found[1])
+
+
+def stretch_line(patches: Sequence[Surface], interface: TrimEdgeInterface,
+                 presets: Mapping[Edge, str] | None = None
+                 ) -> tuple[Any, float, sp.csr_matrix]:
+    """Both faces' traces on one shared stretch, its element size and its trace space
+    (:func:`~splinedeform.physics.coupling_curves.curve_line`, ``b``'s parameter guessed by
+    the linear map of the stretch's ends). The trace space is an iso-edge's running basis
+    where one side is an iso-edge, the finer one's (more knot-line crossings on the
+    stretch) where both are: a T-junction coupled as a non-conforming iso-edge interface,
+    the functions at an end that the boundary holds (:func:`stretch_ends` on the edge
+    conditions ``presets``, keyed ``(face, edge)``) merged with their neighbours as there
+    (:data:`~splinedeform.physics.coupling.HELD`); a held end would otherwise be tied
+    twice and lock."""
+    from ..physics.coupling import HELD
+    from ..physics.coupling_curves import curve_line
 
     a = side(patches, edge_curve(patches, interface.a, interface.edge_a), interface.part_a)
     b = side(patches, edge_curve(patches, interface.b, interface.edge_b), interface.part_b)
     (c0, c1), (s0, s1) = interface.part_a, interface.part_b
     start = lambda t: s0 + (np.asarray(t) - c0) * ((s1 - s0) / (c1 - c0))  # noqa: E731
     iso = [name in EDGES for name in (interface.edge_a, interface.edge_b)]
-    line, h = curve_line(a, b, str(interface), start, 1 if iso[1] else 0 if iso[0] else None)
-    return (penalties or line_penalties)(line, h, material, interface.a, interface.b, patches,
-                                         offsets)
+    running = None if not any(iso) else 0 if not iso[1] else 1 if not iso[0] else \
+        int(len(b.breaks()) > len(a.breaks()))
+    line, h = curve_line(a, b, str(interface), start, running)
+    if running is None:
+        return line, h, line.space(0)
+    ends = [HELD[e] for e in stretch_ends(interface, presets or {})]
+    name = (interface.edge_a, interface.edge_b)[running]
+    along_a = running == 0 or s1 > s0          # its polygon parameter runs with a's
+    if RUNS_WITH_POLYGON[name] != along_a:     # its running basis runs against a's
+        ends = ends[::-1]
+    return line, h, line.space(tuple(ends))
+
+
+def edge_penalty(patches: Sequence[Surface], interface: TrimEdgeInterface, material: Any,
+                 offsets: Sequence[int], presets: Mapping[Edge, str] | None = None
+                 ) -> sp.csr_matrix:
+    """The penalties of one shared stretch on the line of :func:`stretch_line`, factors
+    ``(α, β)`` from the material and the element size: for a plate
+    (:class:`~splinedeform.material.Material`)
+    :func:`~splinedeform.physics.coupling_curves.line_penalties` on its scalar control
+    values; for a Kirchhoff–Love shell (:class:`~splinedeform.physics.shell.ShellMaterial`)
+    ``½ α ∫ |Π (d_a − d_b)|² ds + ½ β ∫ (Π (θ_a − θ_b))² ds`` on its interleaved unknowns
+    (:func:`~splinedeform.physics.coupling.shell_line_penalty`), ``θ`` the rotation of
+    each side's conormal fibre about the tangent, so that a crease keeps its angle."""
+    from ..physics import coupling
+    from ..physics.coupling_curves import line_penalties
+    from ..physics.shell import ShellMaterial
+
+    line, h, space = stretch_line(patches, interface, presets)
+    if not isinstance(material, ShellMaterial):
+        return line_penalties(line, h, material, interface.a, interface.b, patches, offsets,
+                              space)
+    alpha, beta = coupling.penalty_factors(material, h)
+    size = int(offsets[-1]) + patches[-1].shape[0] * patches[-1].shape[1]
+    off_a, off_b = int(offsets[interface.a]), int(offsets[interface.b])
+    return coupling.shell_line_penalty(line, (off_a, off_b, size), alpha, beta, space)

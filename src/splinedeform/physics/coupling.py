@@ -242,6 +242,18 @@ def _rotation_jump(line: Line, off_a: int, off_b: int, size: int) -> sp.csr_matr
             - _interleaved(b.slopes, np.cross(tangent, b.conormal), off_b, size))
 
 
+def shell_line_penalty(line: Line, layout: tuple[int, int, int], alpha: float, beta: float,
+                       space: sp.csr_matrix | None) -> sp.csr_matrix:
+    """``½ α ∫ |Π (d_a − d_b)|² ds + ½ β ∫ (Π (θ_a − θ_b))² ds`` on any coupling line (an
+    iso-edge's, a trim curve's, a shared stretch's), on the shell's interleaved unknowns:
+    :func:`shell_displacement_penalty` and :func:`shell_rotation_penalty` on ``line``,
+    ``layout`` as :func:`line_penalty`'s (in control points)."""
+    off_a, off_b, size = layout
+    values = line_penalty(line, "values", layout, alpha, space)
+    rotation = _penalty(_rotation_jump(line, off_a, off_b, size), line.weights, beta, space)
+    return (sp.kron(values, sp.identity(3), format="csr") + rotation).tocsr()
+
+
 def shell_c0_rotation_penalty(surface: Surface, direction: str, knot: float, beta: float,
                               offset: int = 0, size: int | None = None,
                               crosspoints: int | tuple[int, int] = 0

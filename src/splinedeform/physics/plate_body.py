@@ -159,7 +159,8 @@ def couplings(patches: Sequence[Surface], topology: Any, trims: Sequence[Any],
     terms = [interface_coupling(patches, topology.interfaces, material, constraints.edges,
                                 offsets[:-1], ties.interfaces)]
     terms += [curve_penalty(patches, i, material, offsets[:-1]) for i in trims]
-    terms += [edge_penalty(patches, i, material, offsets[:-1]) for i in stretches]
+    terms += [edge_penalty(patches, i, material, offsets[:-1], constraints.edges)
+              for i in stretches]
     terms += [c0_coupling(s, material, {e: constraints.edges.get((p, e), "free")
                                         for e in EDGES}, int(offsets[p]), size,
                           {(d, k) for q, d, k in ties.lines if q == p})

@@ -7,9 +7,10 @@ in each), interleaved (dof ``3k + c``). Per patch the shell's own matrices, so t
           M = \\operatorname{diag}(M_1, …, M_P),
 
 where ``K_coupling`` is the rotation penalty across every interface and C0 line that is
-not tied, and across a non-conforming interface also the displacement penalty
-(:mod:`.coupling_model`, factors from the material and the mesh). The constraint map
-``d = T d_free`` is ``T = T_b S``: ``T_b = diag(T_p)`` the edge conditions of each patch
+not tied, and across a non-conforming interface and along each stretch two iso-edges
+share (a T-junction, :func:`~splinedeform.body.trim_edges.edge_penalty`) also the
+displacement penalty (:mod:`.coupling_model`, factors from the material and the mesh).
+The constraint map ``d = T d_free`` is ``T = T_b S``: ``T_b = diag(T_p)`` the edge conditions of each patch
 (:func:`.shell_edges.constraint_matrix`: the body's kinds on boundary edges, free on
 interface edges), and ``S`` merges the columns of ``T_b`` that a conforming interface
 identifies. A merged pair of dofs ``(r_a, r_b)`` (the same component of the ``k``-th control
@@ -40,11 +41,13 @@ from ..body.constraints import boundary_presets, edge_rows
 from ..body.interface import EDGES
 from ..body.model import BodyReduction
 from ..body.model import _refuse as refuse
+from ..body.trim_edges import edge_penalty, iso_stretches
 from ..errors import InputError
 from ..surface import Surface
 from .coupling_model import c0_coupling, interface_coupling
 from .coupling_ties import Ties, smooth_ties, tie_components
 from .shell import ShellMaterial, matrices
+from .shell_clamp import clamp_rotation
 from .shell_edges import KINDS, check_edges, constraint_matrix
 from .shell_edges import _impose as impose
 
@@ -65,6 +68,9 @@ class ShellBodySystem:
         First control point of each patch (``len(patches) + 1`` values).
     ties : :class:`~.coupling_ties.Ties`
         The interfaces and C0 lines whose slopes ``T`` ties exactly.
+    clamps : bool
+        Whether a curved patch's clamped edge has its rotation held by Nitsche's terms
+        (:mod:`.shell_clamp`, in ``K``), which hold every rigid motion ``T`` leaves.
     motions : :class:`~.shell_rigid.RigidMotions` or None
         The free rigid motions where the system knows them (a body with trimmed faces,
         :mod:`.shell_body_trimmed`); None: those in ``range T``.
@@ -76,6 +82,7 @@ class ShellBodySystem:
     edges: dict[tuple[int, str], str]
     offsets: NDArray[np.int64]
     ties: Ties
+    clamps: bool = False
     motions: Any = None
 
 
@@ -106,11 +113,14 @@ def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
     offsets = np.concatenate([[0], np.cumsum(sizes)])
     own = [check_edges(s, {e: presets.get((p, e), "free") for e in EDGES})
            for p, s in enumerate(patches)]
-    Tb = sp.block_diag([constraint_matrix(s, e) for s, e in zip(patches, own)], format="csr")
+    Tb = sp.block_diag([constraint_matrix(s, e, weak_rotation=True)
+                        for s, e in zip(patches, own)], format="csr")
     given = given or {}
     blocks = [given[p] if p in given else matrices(s, material)
               for p, s in enumerate(patches)]
-    K = sp.block_diag([k for k, _ in blocks], format="csr")
+    clamps = [clamp_rotation(s, material, e) for s, e in zip(patches, own)]
+    K = sp.block_diag([k if c is None else k + c for (k, _), c in zip(blocks, clamps)],
+                      format="csr")
     M = sp.block_diag([m for _, m in blocks], format="csr")
     size = int(offsets[-1])
     ties = smooth_ties(patches, topology.interfaces, offsets)
@@ -119,6 +129,8 @@ def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
     couplings += [c0_coupling(s, material, e, int(offsets[p]), size,
                               exact={(d, k) for q, d, k in ties.lines if q == p})
                   for p, (s, e) in enumerate(zip(patches, own))]
+    couplings += [edge_penalty(patches, i, material, offsets[:-1], presets)
+                  for i in iso_stretches(body.edge_interfaces)]
     for penalty in (c for c in couplings if c is not None):
         K = (K + penalty).tocsr()
     pairs = [np.zeros((0, 2), dtype=np.int64)]
@@ -136,7 +148,8 @@ def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
     if T.shape[1] == 0:
         raise InputError("no free displacement: the boundary holds every control point of "
                          f"the {len(patches)} patches")
-    return ShellBodySystem(K, M, T, presets, offsets, ties)
+    return ShellBodySystem(K, M, T, presets, offsets, ties,
+                           any(c is not None for c in clamps))
 
 
 def merge_columns(Tb: sp.csr_matrix, pairs: NDArray[np.int64]

@@ -16,8 +16,10 @@ share (:mod:`splinedeform.body.trimmed`, :mod:`splinedeform.body.trim_edges`): o
 the displacement penalty ``½ α ∫_Γ |Π (d_a − d_b)|² ds`` on all three components and the
 rotation penalty ``½ β ∫_Γ (Π (θ_a − θ_b))² ds``, ``θ = ∂_n d · (τ × n)`` the rotation of
 a side's conormal fibre about the common tangent (:func:`~.coupling.shell_rotation_penalty`'s
-term, which keeps the angle between the faces, so a crease costs nothing when it turns
-rigidly). ``Π`` is the line's trace space (:func:`~.coupling_curves.curve_line`), and
+term, :func:`~.coupling.shell_line_penalty`, which keeps the angle between the faces, so
+a crease costs nothing when it turns rigidly; :func:`~.coupling_curves.curve_penalty`,
+:func:`~splinedeform.body.trim_edges.edge_penalty`). ``Π`` is the line's trace space
+(:func:`~.coupling_curves.curve_line`), and
 ``(α, β) = C (E t, E t³/12) / ((1 − ν²) h)`` from the material and the element size
 ``h`` along the curve (:func:`~.coupling.penalty_factors`).
 
@@ -28,7 +30,7 @@ that no Nitsche term holds (:func:`body_motions`).
 
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence
+from typing import Any, Mapping
 
 import numpy as np
 import scipy.sparse as sp
@@ -37,35 +39,16 @@ from scipy.sparse.csgraph import connected_components
 
 from ..body.body import Body
 from ..body.constraints import boundary_presets
-from ..body.trim_edges import edge_penalty
+from ..body.trim_edges import edge_penalty, iso_stretches
 from ..body.trimmed import edge_boundary, face_boundary, loop_presets
 from ..errors import InputError
-from ..surface import Surface
 from ..trim.shell_trimmed import trimmed_shell
-from .coupling import _penalty, _rotation_jump, line_penalty, penalty_factors
 from .coupling_curves import curve_penalty
-from .coupling_traces import Line
 from .shell import ShellMaterial
 from .shell_body import BODY_KINDS, ShellBodySystem, body_system
 from .shell_rigid import RigidMotions, free_rigid_motions
 
 Array = NDArray[np.float64]
-
-
-def shell_line_penalties(line: Line, h: float, material: ShellMaterial, a: int, b: int,
-                         patches: Sequence[Surface], offsets: Sequence[int]) -> sp.csr_matrix:
-    """The shell's penalties on a coupling line between faces ``a`` and ``b`` (module
-    docstring), ``(3N, 3N)`` on the interleaved unknowns: the scalar displacement penalty
-    of :func:`~.coupling.line_penalty` ``⊗ I₃`` and the rotation penalty on ``θ_a − θ_b``;
-    ``offsets`` are the faces' first control points (:func:`~.coupling_curves.line_penalties`'
-    arguments)."""
-    alpha, beta = penalty_factors(material, h)
-    size = int(offsets[-1]) + patches[-1].shape[0] * patches[-1].shape[1]
-    layout = (int(offsets[a]), int(offsets[b]), size)
-    space = line.space(0)
-    values = sp.kron(line_penalty(line, "values", layout, alpha, space), sp.identity(3))
-    rotation = _penalty(_rotation_jump(line, *layout), line.weights, beta, space)
-    return (values + rotation).tocsr()
 
 
 def trimmed_body_system(body: Body, material: ShellMaterial,
@@ -89,14 +72,15 @@ def trimmed_body_system(body: Body, material: ShellMaterial,
                          given={p: (s.stiffness, s.mass) for p, s in shells.items()})
     offsets = system.offsets
     K = system.K
+    edges = {**presets, **loops}
     for interface in body.trim_interfaces:
-        K = K + curve_penalty(patches, interface, material, offsets[:-1], shell_line_penalties)
-    for interface in body.edge_interfaces:
-        K = K + edge_penalty(patches, interface, material, offsets[:-1], shell_line_penalties)
+        K = K + curve_penalty(patches, interface, material, offsets[:-1])
+    iso = iso_stretches(body.edge_interfaces)           # coupled by the shell body already
+    for interface in (i for i in body.edge_interfaces if i not in iso):
+        K = K + edge_penalty(patches, interface, material, offsets[:-1], edges)
     T = with_face_maps(system.T, offsets, {p: s.T for p, s in shells.items()})
     held = {p for p, s in shells.items() if any(k != "free" for k in s.edges.values())}
-    edges = {**presets, **loops}
-    return ShellBodySystem(K.tocsr(), system.M, T, edges, offsets, system.ties,
+    return ShellBodySystem(K.tocsr(), system.M, T, edges, offsets, system.ties, system.clamps,
                            body_motions(body, T, offsets, held))
 
 

@@ -9,7 +9,11 @@ plate), so component ``c`` has ``T_c = T_u^c ⊗ T_v^c`` and ``T`` interleaves t
 (dof ``3k + c``). On an edge ``x = 0`` (``∂`` across it, ``j`` the derivative orders):
 
 - ``free``: none; ``pinned``: ``d = 0`` (``j = 0`` for x, y, z); ``clamped``: ``d = 0`` and
-  ``∂d = 0`` (``j = 0, 1``), which holds the rotation of the normal about the edge;
+  ``∂d = 0`` (``j = 0, 1``), which holds the rotation of the normal about the edge, on a
+  flat surface; on a curved one ``∂d = 0`` would hold the membrane strains ``ε_nn``,
+  ``ε_ns`` at the edge too, so there (``weak_rotation``: the shell's formulation, a single
+  surface or a body's patches) ``T`` holds ``d = 0`` only and the rotation
+  ``a_3·∂_n d = 0`` is Nitsche's (:mod:`.shell_clamp`);
 - ``diaphragm`` in the plane ``x_a = const`` containing the edge and the surface normal
   (Scordelis–Lo ends): rigid in that plane, ``d_b = 0`` for ``b ≠ a``; ``d_a`` free;
 - ``symmetry`` about the plane ``x_a = const``: ``d_a = 0`` and no slope across the plane,
@@ -37,6 +41,7 @@ from numpy.typing import NDArray
 from ..errors import InputError
 from ..surface import Basis, Surface
 from . import metric
+from .shell_clamp import weak_clamps
 from .shell_symmetry import slope_rows
 
 Array = NDArray[np.float64]
@@ -161,9 +166,13 @@ def _orders(kind: str, axis: int | None, c: int) -> tuple[int, ...]:
 
 
 def constraint_matrix(surface: Surface, boundary: Mapping[str, str],
-                      fixed: Array | None = None) -> sp.csr_matrix:
-    """``T`` with ``d = T d_free`` over the interleaved ``3n`` displacements (module doc)."""
+                      fixed: Array | None = None, weak_rotation: bool = False) -> sp.csr_matrix:
+    """``T`` with ``d = T d_free`` over the interleaved ``3n`` displacements (module doc);
+    with ``weak_rotation`` a curved surface's clamped edges are pinned, their rotation left
+    to :func:`.shell_clamp.clamp_rotation` (else the whole slope is held)."""
     edges = check_edges(surface, boundary)
+    weak = weak_clamps(surface, edges) if weak_rotation else ()
+    kinds = {**edges, **{e: "pinned" for e in weak}}
     n_u, n_v = surface.shape
     n = n_u * n_v
     is_fixed = np.zeros(3 * n, bool)
@@ -182,9 +191,9 @@ def constraint_matrix(surface: Surface, boundary: Mapping[str, str],
     blocks, dofs = [], []
     for c in range(3):
         T_u, keep_u = end_map(surface.basis_u,
-                              *(_orders(edges[e], axes[e], c) for e in ("u0", "u1")))
+                              *(_orders(kinds[e], axes[e], c) for e in ("u0", "u1")))
         T_v, keep_v = end_map(surface.basis_v,
-                              *(_orders(edges[e], axes[e], c) for e in ("v0", "v1")))
+                              *(_orders(kinds[e], axes[e], c) for e in ("v0", "v1")))
         blocks.append(sp.kron(T_u, T_v, format="csr"))
         dofs.append(3 * (keep_u[:, None] * n_v + keep_v[None, :]).ravel() + c)
     T = _interleave(blocks, np.concatenate(dofs), n)

@@ -38,6 +38,7 @@ from .coupling_model import c0_coupling
 from .coupling_ties import smooth_ties, tie_components
 from .shell import ShellMaterial, matrices
 from .shell_body import body_field, body_system
+from .shell_clamp import clamp_rotation, held
 from .shell_edges import check_edges, constraint_matrix
 from .shell_rigid import describe, free_rigid_motions
 from .shell_solution import ShellBodyReadout, ShellReadout
@@ -112,6 +113,8 @@ class ShellFormulation:
                                                             system.edges)
             self.ties = system.ties
             points = np.concatenate([s.control_points.reshape(-1, 3) for s in self.patches])
+            if system.clamps:                      # a curved patch's clamped edges
+                motions = held(self.T)
         elif getattr(surface, "trim", None) is not None:     # loops held by Nitsche
             from ..trim.shell_trimmed import trimmed_shell
 
@@ -135,9 +138,15 @@ class ShellFormulation:
                                 exact={(d, k) for _, d, k in self.ties.lines})
             if kinks is not None:                  # the crease kept across each C0 line
                 self.K_full = (self.K_full + kinks).tocsr()
+            rotation = clamp_rotation(surface, material, self.edges)
+            if rotation is not None:               # a curved shell's clamped edges
+                self.K_full = (self.K_full + rotation).tocsr()
             # the slopes tied exactly across each smooth C0 line
-            self.T = tie_components(constraint_matrix(surface, self.edges, fixed), self.ties.C)
+            self.T = tie_components(constraint_matrix(surface, self.edges, fixed, True),
+                                    self.ties.C)
             points = surface.control_points
+            if rotation is not None:               # a rigid motion at rest on a clamped
+                motions = held(self.T)             # edge turns about it: Nitsche holds it
         if motions is None:
             motions = free_rigid_motions(self.T, points)
         self.rigid_basis: Array = motions.reduced

@@ -116,10 +116,11 @@ class FaceEdges(_Table):
 
 class Boundary(_Table):
     u0: Preset = Field("free", description=(
-            "edge `u = 0`: pinned holds it (`d = 0`), clamped also holds its slope (`∂n d = 0`), "
-            "pole makes a collapsed edge (open knots) move as one point; shell only: diaphragm "
-            "is rigid in the edge's coordinate plane and free out of it, symmetry puts the edge "
-            "on a coordinate symmetry plane"))
+            "edge `u = 0`: pinned holds it (`d = 0`), clamped also holds its slope (`∂n d = 0`; "
+            "on a curved shell its rotation `a₃·∂n d = 0`), pole makes a collapsed edge (open "
+            "knots) move as one point; shell only: diaphragm is rigid in the edge's "
+            "coordinate plane and free out of it, symmetry puts the edge on a coordinate "
+            "symmetry plane"))
     u1: Preset = Field("free", description="edge `u = L_u` (presets as `u0`)")
     v0: Preset = Field("free", description="edge `v = 0` (presets as `u0`)")
     v1: Preset = Field("free", description="edge `v = L_v` (presets as `u0`)")

@@ -102,6 +102,9 @@ def scenario_to_toml(scenario: Scenario) -> str:
     loops = s.raw.get("boundary", {}).get("loops")      # a CAD face's, read when built
     if loops:
         boundary.append(("loops", dict(loops)))
+    faces = s.raw.get("boundary", {}).get("faces")      # a body's presets per edge
+    if faces:
+        boundary.append(("faces", dict(faces)))
     out += _toml_table("[boundary]", boundary)
     for load in s.loads:
         out += _toml_table("[[load]]", _load_items(load))

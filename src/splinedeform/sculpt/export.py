@@ -27,11 +27,25 @@ def payload(basis: SculptBasis) -> dict[str, Any]:
     ``[P ru, rv]``, ``u`` the patches' u samples one after the other and ``faces`` per patch
     its ``v`` samples, control net shape and periodic directions, so the page draws each
     patch as its own grid (no triangle joins two patches).
+
+    With trimmed patches (:mod:`.trimmed`) the trim crossings follow the grids and
+    ``trim`` holds the triangles to draw (int32 ``(F, 3)``), which samples lie inside the
+    trims (uint8) and each crossing's patch and ``(u, v)``.
     """
-    rest = np.concatenate([s.evaluate(*np.meshgrid(u, v, indexing="ij")).reshape(-1, 3)
-                           for s, (u, v) in zip(basis.patches, basis.samples)])
+    rest = [s.evaluate(*np.meshgrid(u, v, indexing="ij")).reshape(-1, 3)
+            for s, (u, v) in zip(basis.patches, basis.samples)]
+    trimmed, trim = basis.trimmed, None
+    if trimmed is not None:
+        for p, surface in enumerate(basis.patches):
+            at = trimmed.uv[trimmed.patch == p]
+            if len(at):
+                rest.append(np.asarray(surface.evaluate(at[:, 0], at[:, 1])).reshape(-1, 3))
+        trim = {"triangles": _b64(trimmed.triangles, "<i4"),
+                "inside": _b64(trimmed.inside, "u1"),
+                "crossings": {"face": trimmed.patch.tolist(), "u": trimmed.uv[:, 0].tolist(),
+                              "v": trimmed.uv[:, 1].tolist()}}
     ru, rv = basis.grid
-    return {"modes": int(basis.lam.size),
+    return {"modes": int(basis.lam.size), "trim": trim,
             "grid": [len(basis.samples) * ru, rv],
             "u": np.concatenate([u for u, _ in basis.samples]).tolist(),
             "v": basis.samples[0][1].tolist(),
@@ -39,7 +53,7 @@ def payload(basis: SculptBasis) -> dict[str, Any]:
                        "periodic": [bool(s.basis_u.periodic), bool(s.basis_v.periodic)]}
                       for s, (_, v) in zip(basis.patches, basis.samples)],
             "lam": _b64(basis.lam, "<f8"), "damping": _b64(basis.damping, "<f8"),
-            "phi": _b64(basis.phi_samples), "rest": _b64(rest)}
+            "phi": _b64(basis.phi_samples), "rest": _b64(np.concatenate(rest))}
 
 
 def decode(text: str, dtype: str = "<f4") -> np.ndarray:

@@ -91,7 +91,7 @@ def baked_net(basis: SculptBasis, q: NDArray[np.float64]) -> NDArray[np.float64]
 def baked_scenario(scenario: Scenario, basis: SculptBasis, nets: list[NDArray[np.float64]],
                    folder: Path, stem: str) -> tuple[Scenario, Path]:
     """``scenario`` on the surface of control nets ``nets`` (same bases), written to
-    ``folder/stem.json`` (one surface) or ``folder/stem.step`` (a body: every face in one
+    ``folder/stem.json`` (one surface, with its ``[surface.trim]`` if it has one) or ``folder/stem.step`` (a body: every face in one
     shell, in the body's unit, read back with ``faces = "all"``); the scenario reads it
     from ``folder`` (its directory then)."""
     from ..export import write_control_nets
@@ -100,8 +100,15 @@ def baked_scenario(scenario: Scenario, basis: SculptBasis, nets: list[NDArray[np
     if basis.is_body:
         return _baked_body(moved, basis, nets, folder / f"{stem}.step")
     surface = basis.model.surface
+    trim = scenario.raw.get("surface", {}).get("trim")
+    if surface.trim is not None and trim is None:
+        raise InputError("this face's trims come from its CAD file, and a baked net file "
+                         "does not hold them yet: bake is for an untrimmed face or a trim "
+                         "given by hand ([surface.trim])")
     path, = write_control_nets(folder, stem, surface, [0.0], nets[0][None], formats=("json",))
     table: dict[str, Any] = {"shape": "file", "path": path.name}
+    if trim is not None:                    # a trim given by hand: the baked net keeps it
+        table["trim"] = trim
     return with_overrides(moved, {"surface": table}, origin="sculpt bake"), path
 
 

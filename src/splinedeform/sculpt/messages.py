@@ -45,13 +45,24 @@ class MaterialMessage(_Message):
     w02: Weight = 0.0
 
 
+FaceNumber = Annotated[str, Field(pattern=r"^[0-9]{1,6}$")]
+"""A face of a body by its number in the file, as a JSON key."""
+SideName = Literal["u0", "u1", "v0", "v1"]
+MAX_FACES = 4096
+"""Most faces one message may name (the finest body the page draws has fewer)."""
+
+
 class BoundaryMessage(_Message):
-    """Boundary preset per edge: ``[boundary]`` of a scenario."""
+    """Boundary preset per edge: ``[boundary]`` of a scenario; a body's ``u0`` is the preset
+    of every boundary edge, ``faces`` (``boundary.faces``: ``{"3": {"v1": "clamped"}}``,
+    the file's face numbers) replaces it edge by edge."""
 
     u0: Edge = "free"
     u1: Edge = "free"
     v0: Edge = "free"
     v1: Edge = "free"
+    faces: Annotated[dict[FaceNumber, dict[SideName, Edge]],
+                     Field(max_length=MAX_FACES)] | None = None
 
 
 Parameter = Annotated[Real, Field(ge=-1e6, le=1e6)]

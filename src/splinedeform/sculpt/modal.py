@@ -21,6 +21,10 @@ patch, each on its own ``r × r`` grid, the grids one after the other: with the 
 
 and a push names its patch, ``φ_i = E_p(u, v) Φ_p``. Control points merged across an
 interface are one row of ``Φ``, so the faces' edges move together in every mode.
+
+A trimmed patch keeps its grid and adds the points where the grid crosses its trim loops,
+after every patch's grid (:mod:`.trimmed`): ``Φ_s`` gets their rows ``E_p(u_c, v_c) Φ_p``,
+the page draws the clipped mesh, and a push outside the trims is refused.
 """
 
 from __future__ import annotations
@@ -35,6 +39,7 @@ from numpy.typing import NDArray
 from ..errors import InputError
 from ..model import Model
 from ..surface import Surface
+from .trimmed import TrimmedSamples, outside_words, trimmed_samples
 
 Array = NDArray[np.float64]
 MAX_PAGE_SAMPLES = 400 * 400
@@ -72,6 +77,8 @@ class SculptBasis:
     phi_samples : (P ru rv, k) modes at the sample points, ``Φ_s = diag(E_p) T Φ``,
         patch after patch, row-major within a patch.
     units : the unit of the coordinates (a CAD file's), or None.
+    trimmed : the crossing points, triangles and inside mask of trimmed patches
+        (:mod:`.trimmed`), None when no patch is trimmed; their samples follow the grids.
     """
 
     model: Model
@@ -81,6 +88,7 @@ class SculptBasis:
     samples: tuple[tuple[Array, Array], ...]
     phi_samples: Array
     units: str | None = None
+    trimmed: TrimmedSamples | None = None
 
     @property
     def patches(self) -> tuple[Surface, ...]:
@@ -99,9 +107,10 @@ class SculptBasis:
 
     @property
     def sample_count(self) -> int:
-        """Sample points of every patch together."""
+        """Sample points of every patch together (grids, then trim crossings)."""
         ru, rv = self.grid
-        return len(self.samples) * ru * rv
+        extra = 0 if self.trimmed is None else len(self.trimmed.uv)
+        return len(self.samples) * ru * rv + extra
 
     @property
     def samples_u(self) -> Array:
@@ -119,8 +128,13 @@ class SculptBasis:
         return self.samples[0]
 
     def sample_point(self, index: int) -> tuple[int, float, float]:
-        """``(patch, u, v)`` of sample ``index`` (patch after patch, row-major)."""
+        """``(patch, u, v)`` of sample ``index`` (patch after patch, row-major, then the
+        trim crossings)."""
         ru, rv = self.grid
+        beyond = int(index) - len(self.samples) * ru * rv
+        if beyond >= 0 and self.trimmed is not None:
+            u_c, v_c = self.trimmed.uv[beyond]
+            return int(self.trimmed.patch[beyond]), float(u_c), float(v_c)
         patch, rest = divmod(int(index), ru * rv)
         u, v = self.samples[patch]
         return patch, float(u[rest // rv]), float(v[rest % rv])
@@ -139,17 +153,24 @@ class SculptBasis:
         return np.concatenate([s.control_points.reshape(-1, 3) for s in self.patches])
 
     def sample_matrix(self) -> sp.csr_matrix:
-        """``diag(E_1, …, E_P)``: the full net to the sample points, ``(P ru rv, N)``."""
-        return sample_evaluation(self.patches, self.samples)
+        """``diag(E_1, …, E_P)`` (and the trim crossings' rows): the full net to the sample
+        points, ``(sample_count, N)``."""
+        return sample_evaluation(self.patches, self.samples, self.trimmed)
 
     def rest_samples(self) -> Array:
-        """Rest positions of the sample points, ``(P ru rv, 3)``."""
+        """Rest positions of the sample points, ``(sample_count, 3)``."""
         return np.asarray(self.sample_matrix() @ self.rest_net())
 
     def participation(self, u: float, v: float, patch: int = 0) -> Array:
-        """Mode shapes at the grabbed point ``φ_i(u, v)`` of ``patch``, shape ``(k,)``."""
+        """Mode shapes at the grabbed point ``φ_i(u, v)`` of ``patch``, shape ``(k,)``;
+        :class:`~splinedeform.errors.InputError` outside a trimmed patch's trims."""
+        from ..trim.surface_trim import region_contains
+
         offsets = self.net_offsets()
-        E = self.patches[patch].evaluation_matrix(np.array([u]), np.array([v]))
+        surface = self.patches[patch]
+        if surface.trim is not None and not region_contains(surface, np.array([[u, v]]))[0]:
+            raise InputError(outside_words(surface, u, v))
+        E = surface.evaluation_matrix(np.array([u]), np.array([v]))
         return np.asarray(E @ self.phi_net[offsets[patch]:offsets[patch + 1]]).ravel()
 
     def step_response(self, tau: Array) -> Array:
@@ -177,14 +198,25 @@ class SculptBasis:
         return self.phi_samples @ self.modal(t, pushes)
 
 
-def sample_evaluation(patches: tuple[Surface, ...],
-                      samples: tuple[tuple[Array, Array], ...]) -> sp.csr_matrix:
-    """``diag(E_1, …, E_P)`` with ``E_p`` patch ``p``'s evaluation on its grid ``samples[p]``."""
+def sample_evaluation(patches: tuple[Surface, ...], samples: tuple[tuple[Array, Array], ...],
+                      trimmed: TrimmedSamples | None = None) -> sp.csr_matrix:
+    """``diag(E_1, …, E_P)`` with ``E_p`` patch ``p``'s evaluation on its grid ``samples[p]``,
+    then (``trimmed``) a row ``E_p(u_c, v_c)`` per trim crossing in patch ``p``'s columns."""
     blocks = []
     for surface, (u, v) in zip(patches, samples):
         uu, vv = np.meshgrid(u, v, indexing="ij")
         blocks.append(surface.evaluation_matrix(uu.ravel(), vv.ravel()))
-    return sp.block_diag(blocks, format="csr") if len(blocks) > 1 else sp.csr_matrix(blocks[0])
+    E = sp.block_diag(blocks, format="csr") if len(blocks) > 1 else sp.csr_matrix(blocks[0])
+    if trimmed is None or not len(trimmed.uv):
+        return E
+    rows = []
+    for p, surface in enumerate(patches):
+        at = trimmed.uv[trimmed.patch == p]
+        rows.append(sp.csr_matrix(surface.evaluation_matrix(at[:, 0], at[:, 1]))
+                    if len(at) else sp.csr_matrix((0, surface.shape[0] * surface.shape[1])))
+    # the crossings follow each other patch by patch (:func:`.trimmed.trimmed_samples`)
+    extra = sp.block_diag(rows, format="csr") if len(rows) > 1 else rows[0]
+    return sp.vstack([E, extra], format="csr")
 
 
 def sculpt_basis(model: Model, resolution: int = 32, modes: int | None = None,
@@ -209,5 +241,7 @@ def sculpt_basis(model: Model, resolution: int = 32, modes: int | None = None,
     phi_net = np.asarray(model.constraints.T @ phi)
     samples = tuple((np.asarray(u), np.asarray(v))
                     for u, v in (s.sample_parameters(resolution) for s in patches))
-    E = sample_evaluation(patches, samples)
-    return SculptBasis(model, lam, damping, phi_net, samples, np.asarray(E @ phi_net), units)
+    trimmed = trimmed_samples(patches, samples)
+    E = sample_evaluation(patches, samples, trimmed)
+    return SculptBasis(model, lam, damping, phi_net, samples, np.asarray(E @ phi_net), units,
+                       trimmed)

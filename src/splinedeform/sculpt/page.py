@@ -20,7 +20,7 @@ from ..viz.viewer import _vendor_text
 
 
 #: the parts of the page's script, in the order they are put together
-PARTS = ("state", "draw", "grab", "paint", "controls", "history", "files", "help")
+PARTS = ("state", "draw", "grab", "paint", "edges", "controls", "history", "files", "help")
 
 
 def sculpt_page(data: Mapping[str, Any], token: str = "") -> str:

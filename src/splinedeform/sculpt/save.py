@@ -20,6 +20,7 @@ from ..scenario.spec import Scenario
 from .grabs import chain_tables, grab_chains
 from .messages import PushMessage, SaveMessage
 from .modal import SculptBasis
+from .trimmed import outside_words
 
 MAX_PROBES = 8
 """Grabbed points written as probes of the saved scenario (the first ones)."""
@@ -34,10 +35,13 @@ def check_pushes(basis: SculptBasis, pushes: Sequence[PushMessage]) -> None:
 
 
 def check_index(basis: SculptBasis, index: int, what: str) -> None:
-    """``index`` names a sample point of ``basis``."""
+    """``index`` names a sample point of ``basis`` inside its trims."""
     count = basis.sample_count
     if not 0 <= index < count:
         raise InputError(f"{what} = {index} is not a sample point (0 .. {count - 1})")
+    if basis.trimmed is not None and not basis.trimmed.inside[index]:
+        patch, u, v = basis.sample_point(index)
+        raise InputError(f"{what} = {index}: {outside_words(basis.patches[patch], u, v)}")
 
 
 def face_numbers(basis: SculptBasis) -> list[int]:

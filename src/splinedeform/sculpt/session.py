@@ -25,6 +25,7 @@ import numpy as np
 from ..errors import InputError, ScenarioError
 from ..scenario import build, free_region_mask, scenario_to_toml, with_overrides
 from ..scenario.spec import Scenario
+from .body_edges import boundary_edges, faces_override
 from .carry import transfer
 from .correction import StaticCorrection, offline_data, static_correction
 from .export import _b64, payload
@@ -128,6 +129,11 @@ class Session:
             overrides: dict[str, Any] = {f"material.{k}": getattr(message.material, k)
                                          for k in MATERIAL_FIELDS}
             overrides.update({f"boundary.{e}": getattr(message.boundary, e) for e in EDGE_NAMES})
+            faces = faces_override(message.boundary.faces)
+            if faces is not None and not self.basis.is_body:
+                raise InputError("boundary.faces sets the edges of a body's faces; this is one "
+                                 "surface: set its edges u0, u1, v0 and v1")
+            overrides["boundary.faces"] = faces     # None: every boundary edge takes u0
             region = message.free_region
             box = None if region is None else {k: list(getattr(region, k)) for k in "uv"
                                                if getattr(region, k) is not None} or None
@@ -226,7 +232,8 @@ class Session:
     def payload(self) -> dict[str, Any]:
         """The modal data (see :func:`.export.payload`) plus the control net, the current
         material and boundary, and what the server offers; a body's adds ``body`` (its
-        faces' numbers and unit) and has one preset for every boundary edge, no free set."""
+        faces' numbers, unit and boundary edges with their presets, :mod:`.body_edges`) and
+        has no free set."""
         basis, model = self.basis, self.basis.model
         data = payload(basis)
         s = self.scenario
@@ -243,7 +250,8 @@ class Session:
         if basis.is_body:
             data.update(net_shape=[int(net_rest.shape[0]), 1], periodic=[False, False],
                         free_region=None, greville=[[], []], body={
-                            "faces": face_numbers(basis), "units": basis.units})
+                            "faces": face_numbers(basis), "units": basis.units,
+                            "edges": boundary_edges(s, model)})
             data["domain"] = [float(basis.patches[0].basis_u.length),
                               float(basis.patches[0].basis_v.length)]
             return data

@@ -4,7 +4,7 @@ The shape is the control net of the page's modal state ``q`` (``3 k`` numbers, m
 ``P + T Φ_net q`` (:func:`.history.baked_net`, the net a bake would make the rest shape),
 written by the project's own writers: :func:`splinedeform.cad.write_3dm` (a NURBS surface
 on the model's knot vectors, weights 1 or ``a_i b_j``), :func:`splinedeform.export.mesh.
-write_obj` (the surface sampled on the page's grid, vertex normals) and
+write_obj` (the surface sampled on the page's grid, clipped to its trims, vertex normals) and
 :func:`splinedeform.export.nets.write_control_nets` (the project's net file, which
 ``shape = "file"`` reads back). Each is written to a private temporary folder and its
 bytes returned; nothing is written beside the save.
@@ -56,6 +56,7 @@ def shape_file(basis: SculptBasis, q: NDArray[np.float64], fmt: str, title: str
 def _surface_file(basis: SculptBasis, net: NDArray[np.float64], fmt: str, folder: Path,
                   stem: str, title: str) -> Path:
     from ..cad import patch_from_surface, write_3dm
+    from ..export.frames import tessellate_frames
     from ..export.mesh import write_obj
     from ..export.nets import write_control_nets
 
@@ -64,7 +65,8 @@ def _surface_file(basis: SculptBasis, net: NDArray[np.float64], fmt: str, folder
     if fmt == "3dm":
         write_3dm(path, [patch_from_surface(surface, net)], names=[title], units=basis.units)
     elif fmt == "obj":
-        vertices, faces = surface.tessellate(basis.grid, control_points=net)
+        # a trimmed surface: the grid clipped to its trims, as the page draws it
+        vertices, faces = tessellate_frames(surface, net, basis.grid[0])
         write_obj(path, vertices, faces)
     else:
         write_control_nets(folder, stem, surface, [0.0], net[None], formats=("json",))

@@ -44,7 +44,7 @@
     hudBox.textContent = "t = " + t.toFixed(2) + (paused ? " (paused)" : "") +
       "   " + (mean > 0 ? (1000 / mean).toFixed(0) : "-") + " fps, " + work.toFixed(1) + " ms per frame" +
       "\n" + K + (data.complete ? " modes (all)" : " of " + data.n_free + " modes" +
-      (online || data.offline ? " + static correction" : "")) + ", " + (data.body ? faceList.length + " faces of " + faceRows : ru) + "×" + rv + " samples, max |d| = " + (dmax > 0 ? dmax.toPrecision(3) : "0") +
+      (online || data.offline ? " + static correction" : "")) + ", " + (data.body ? faceList.length + " faces of " + faceRows : ru) + "×" + rv + " samples" + (trimTriangles ? " clipped to the trims" : "") + ", max |d| = " + (dmax > 0 ? dmax.toPrecision(3) : "0") +
       (grab || extra.length ? "\n" + grabWords() : "");
   }
 
@@ -92,8 +92,8 @@
       input.addEventListener("input", () => { out.value = String(Number(Number(input.value).toPrecision(3))); });
       materialBox.appendChild(label);
     }
-    // a body: one preset for every boundary edge (an edge no other face meets); its faces
-    // move as one net, so no free region, painting or pin (one surface's)
+    // a body: one preset for every boundary edge (an edge no other face meets), then each
+    // edge on its own (edges.js); its faces move as one net, so no free region or pin
     for (const edge of data.body ? ["u0"] : EDGES) {
       const label = document.createElement("label");
       label.innerHTML = '<span class="name"></span><select></select>';
@@ -112,6 +112,8 @@
       select.value = data.boundary[edge];
       boundaryBox.appendChild(label);
     }
+    dropEdgeLines();
+    if (data.body) bodyEdgeForms(boundaryBox);     // each boundary edge on its own (edges.js)
     // free region: only control points whose Greville abscissae lie in the box move
     const region = data.free_region || {}, [lu, lv] = data.domain;
     const box = document.createElement("div");
@@ -162,6 +164,8 @@
     const material = {}, boundary = {};
     for (const key of WEIGHTS) material[key] = Number(document.getElementById("material-" + key).value);
     for (const edge of EDGES) boundary[edge] = document.getElementById("boundary-" + (data.body ? "u0" : edge)).value;
+    const faces = data.body ? bodyEdgeFaces() : null;
+    if (faces) boundary.faces = faces;
     const started = performance.now();
     const poll = setInterval(async () => {
       try {
@@ -316,7 +320,11 @@
     face(n) { return sampleAt(n).number; },
     get faceCount() { return faceList.length; },
     triangleCount() { return geometry.index.count / 3; },
-    nearestNet(n) { return nearestNetPoint(data.u[Math.floor(n / rv)], data.v[n % rv]); },
+    get sampleCount() { return N; },
+    get bodyEdges() { return data.body ? data.body.edges.map((e) => Object.assign({}, e)) : null; },
+    get edgeSegments() { return edgeLines ? edgeLines.geometry.attributes.position.count / 2 : 0; },
+    inside(n) { return !inside || Boolean(inside[n]); },
+    nearestNet(n) { const at = sampleAt(n); return nearestNetPoint(at.u, at.v); },
     get grabView() { return grabEnds && { point: grabEnds.point.slice(), pointer: grabEnds.pointer && grabEnds.pointer.slice(),
                                           marker: grabMarker.visible, spring: springLine.visible }; },
     get hud() { return hudBox.textContent; },

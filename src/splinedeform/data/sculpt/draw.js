@@ -20,7 +20,7 @@
   let radius = 1;
   function frameCamera() {
     const box = new THREE.Box3(), p = new THREE.Vector3();
-    for (let k = 0; k < rest.length; k += 3) box.expandByPoint(p.set(rest[k], rest[k + 1], rest[k + 2]));
+    for (let k = 0; k < rest.length; k += 3) if (!inside || inside[k / 3]) box.expandByPoint(p.set(rest[k], rest[k + 1], rest[k + 2]));
     const sphere = box.getBoundingSphere(new THREE.Sphere());
     radius = sphere.radius > 0 ? sphere.radius : 1;
     camera.near = radius / 100; camera.far = radius * 100;
@@ -69,9 +69,11 @@
     // mostly used by the triangles just before it, which the vertex cache of a software
     // renderer keeps; 16-bit indices when they suffice
     // (face by face: no triangle joins two faces of a body)
-    const faces = new (N <= 65536 ? Uint16Array : Uint32Array)(faceList.length * (faceRows - 1) * (rv - 1) * 6);
+    // (a trimmed face: the clipped mesh the server sends, welded along the trim loops)
+    const faces = new (N <= 65536 ? Uint16Array : Uint32Array)(trimTriangles ? trimTriangles.length : faceList.length * (faceRows - 1) * (rv - 1) * 6);
     let m = 0;
-    for (let lo = 0; lo < ru; lo += faceRows) {
+    if (trimTriangles) faces.set(trimTriangles);
+    else for (let lo = 0; lo < ru; lo += faceRows) {
       for (let j0 = 0; j0 + 1 < rv; j0 += 8) for (let i = lo; i + 1 < lo + faceRows; i++) {
         for (let j = j0; j < Math.min(j0 + 8, rv - 1); j++) {
           const a = i * rv + j, b = (i + 1) * rv + j;
@@ -282,6 +284,23 @@
       }
     }
   }
+  // normals of the clipped mesh of trimmed faces: the sum of the (area-weighted) normals
+  // of the triangles at each vertex, oriented like the triangles (x_u × x_v)
+  function meshNormals(pos, out) {
+    out.fill(0);
+    const tri = trimTriangles;
+    for (let m = 0; m < tri.length; m += 3) {
+      const a = 3 * tri[m], b = 3 * tri[m + 1], c = 3 * tri[m + 2];
+      const ux = pos[b] - pos[a], uy = pos[b + 1] - pos[a + 1], uz = pos[b + 2] - pos[a + 2];
+      const vx = pos[c] - pos[a], vy = pos[c + 1] - pos[a + 1], vz = pos[c + 2] - pos[a + 2];
+      const nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
+      for (const k of [a, b, c]) { out[k] += nx; out[k + 1] += ny; out[k + 2] += nz; }
+    }
+    for (let k = 0; k < out.length; k += 3) {
+      const len = Math.hypot(out[k], out[k + 1], out[k + 2]) || 1;
+      out[k] /= len; out[k + 1] /= len; out[k + 2] /= len;
+    }
+  }
   // x = x0 + d, |d|, grid normals, and the colour of each vertex lit on the CPU: the
   // colour c (plasma of |d| / max |d|, or plain) times the irradiance / π of a hemisphere
   // light (white sky +z, grey ground, 1.6) and a directional light from the camera (1.4),
@@ -294,12 +313,11 @@
       pos[k] = rest[k] + dx; pos[k + 1] = rest[k + 1] + dy; pos[k + 2] = rest[k + 2] + dz;
       const m = Math.sqrt(dx * dx + dy * dy + dz * dz);
       magnitude[n] = m;
-      if (m > top) top = m;
+      if (m > top && (!inside || inside[n])) top = m;     // what is drawn: inside the trims
     }
     vmax = Math.max(top, vmax * 0.995, 1e-6 * radius);
     dmax = top;
-    gridNormals(pos, normals);
-    poleNormals(pos, normals);
+    if (trimTriangles) meshNormals(pos, normals); else { gridNormals(pos, normals); poleNormals(pos, normals); }
     const cam = camera.position, lx = lightDir.x, ly = lightDir.y, lz = lightDir.z;
     const steps = cmap.length / 3 - 1, toIndex = steps / vmax, ground = 0.2462;
     let r = PLAIN[0], g = PLAIN[1], b = PLAIN[2];
@@ -324,6 +342,7 @@
       for (let k = 0; k < NN * 3; k++) np[k] = netRest[k] + netDisp[k];
       netPositions.needsUpdate = true;
     }
+    drawEdges(pos);
     showGrab();
     renderer.render(scene, camera);
   }

@@ -7,7 +7,21 @@
     const rect = renderer.domElement.getBoundingClientRect();
     return { x: rect.left + (p.x + 1) / 2 * rect.width, y: rect.top + (1 - p.y) / 2 * rect.height, z: p.z };
   }
+  // the sample under the pointer inside the trims; -1 for none. A trimmed face's grid points
+  // outside its trims are not drawn: the pointer over one (and over no drawn sample) is
+  // refused with a message, -2 (see splinedeform/sculpt/trimmed.py)
   function pick(clientX, clientY) {
+    const n = pickAny(clientX, clientY, true);
+    if (n >= 0 || !inside) return n;
+    const out = pickAny(clientX, clientY, false);
+    if (out < 0) return -1;
+    const at = sampleAt(out);
+    showMessage("refused: u = " + at.u.toPrecision(4) + ", v = " + at.v.toPrecision(4) +
+                (data.body ? " of face " + at.number : "") +
+                " lies outside the trims (the cut-away part is not in the model); grab the surface inside its trim loops");
+    return -2;
+  }
+  function pickAny(clientX, clientY, within) {
     camera.updateMatrixWorld();
     const e = camera.matrixWorldInverse.elements, P = camera.projectionMatrix.elements;
     const rect = renderer.domElement.getBoundingClientRect();
@@ -15,6 +29,7 @@
     const tolX = 14 / rect.width * 2, tolY = 14 / rect.height * 2;
     let best = -1, bestZ = Infinity, bestD = Infinity;
     for (let n = 0; n < N; n++) {
+      if (inside && Boolean(inside[n]) !== within) continue;
       const x = rest[3 * n] + disp[3 * n], y = rest[3 * n + 1] + disp[3 * n + 1], z = rest[3 * n + 2] + disp[3 * n + 2];
       const vx = e[0] * x + e[4] * y + e[8] * z + e[12], vy = e[1] * x + e[5] * y + e[9] * z + e[13];
       const vz = e[2] * x + e[6] * y + e[10] * z + e[14];
@@ -117,6 +132,7 @@
     if (event.button !== 0 || paintBox.checked) return;
     if (grab && !pinning && grab.pointerId === event.pointerId) return;
     const index = pick(event.clientX, event.clientY);
+    if (index === -2) { event.stopPropagation(); return; }   // outside the trims: refused
     if (index < 0) return;                       // background: OrbitControls rotates
     event.stopPropagation();
     if (pinning) { pin(index); return; }         // pin (a bake: it ends the grabs held), no grab

@@ -14,7 +14,7 @@
       "material-mass": "mass μ per unit parameter area: heavier rings slower (ω = √λ with λ of K φ = λ M φ)",
       "material-damping": "damping γ (mass-proportional, like air drag): every mode decays as e^{-γt/2μ}",
       "material-rayleigh": "rayleigh β (stiffness-proportional damping, like internal friction): mode i gets c_i = γ/μ + β λ_i, so fast, stiff modes die out first",
-      "boundary-u0": "edge u = 0: free (moves), pinned (held in place, may turn), clamped (held and no slope across it), pole (collapsed to a point)",
+      "boundary-u0": data.body ? "every boundary edge of the body (an edge no other face meets): free, pinned (held in place), clamped (held, no slope across it); each edge in the list below can then be set on its own, drawn on the surface green (free), orange (pinned) or black (clamped)" : "edge u = 0: free (moves), pinned (held in place, may turn), clamped (held and no slope across it), pole (collapsed to a point)",
       "boundary-u1": "edge u = 1: free, pinned (held in place), clamped (held, no slope across it), pole (collapsed to a point)",
       "boundary-v0": "edge v = 0: free, pinned (held in place), clamped (held, no slope across it), pole (collapsed to a point)",
       "boundary-v1": "edge v = 1: free, pinned (held in place), clamped (held, no slope across it), pole (collapsed to a point)",

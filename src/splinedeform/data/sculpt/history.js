@@ -119,7 +119,7 @@
   // pin the control point nearest (Greville points, parameter domain) to sample n
   function pin(n) {
     if (data.body) { showMessage("pinning a control point is for one surface; a body's faces move as one net"); return Promise.resolve(null); }
-    const cu = data.u[Math.floor(n / rv)], cv = data.v[n % rv];
+    const { u: cu, v: cv } = sampleAt(n);
     return bake(nearestNetPoint(cu, cv));
   }
   document.getElementById("bake").addEventListener("click", () => { bake(); });

@@ -78,8 +78,8 @@
     const k = pickNet(event.clientX, event.clientY), nv = gV.length;
     if (k >= 0) { brush(gU[Math.floor(k / nv)], gV[k % nv], event.shiftKey, k); return true; }
     const n = pick(event.clientX, event.clientY);
-    if (n < 0) return false;
-    const cu = data.u[Math.floor(n / rv)], cv = data.v[n % rv];
+    if (n < 0) return n === -2;                // outside the trims: refused, no rotation
+    const { u: cu, v: cv } = sampleAt(n);
     brush(cu, cv, event.shiftKey, nearestNetPoint(cu, cv));
     return true;
   }

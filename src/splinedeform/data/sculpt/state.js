@@ -43,8 +43,15 @@
   // the (ru, rv) grid for face p, and its control points the next nu·nv of the net; a single
   // surface is one face
   let faceList, faceRows;
+  // trimmed faces (splinedeform/sculpt/trimmed.py): the points where the grid crosses the
+  // trim loops follow the grids (samples ru·rv …); trimTriangles are the clipped mesh drawn,
+  // inside[n] whether sample n lies in its face's trims (only those are grabbed)
+  let trimTriangles = null, inside = null;
   function unpack(d) {
-    K = d.modes; [ru, rv] = d.grid; N = ru * rv;
+    K = d.modes; [ru, rv] = d.grid;
+    N = ru * rv + (d.trim ? d.trim.crossings.u.length : 0);
+    trimTriangles = d.trim ? decode(d.trim.triangles, Int32Array) : null;
+    inside = d.trim ? decode(d.trim.inside, Uint8Array) : null;
     faceList = d.faces || [{ v: d.v, net: d.net_shape, periodic: d.periodic }];
     faceRows = ru / faceList.length;
     lam = decode(d.lam, Float64Array); damp = decode(d.damping, Float64Array);
@@ -59,11 +66,16 @@
   unpack(data);
   // sample n: its face p (the file's face number of a body), and (u, v) on that face
   function sampleAt(n) {
+    if (n >= ru * rv) {
+      const c = data.trim.crossings, k = n - ru * rv, p = c.face[k];
+      return { face: p, number: data.body ? data.body.faces[p] : p, u: c.u[k], v: c.v[k] };
+    }
     const p = Math.floor(n / (faceRows * rv));
     return { face: p, number: data.body ? data.body.faces[p] : p, u: data.u[Math.floor(n / rv)], v: faceList[p].v[n % rv] };
   }
   // what fixes the page's geometry: the sample grid and each face's net
-  const layoutOf = (d) => JSON.stringify([d.grid, (d.faces || []).map((face) => face.net), d.net_shape, d.periodic]);
+  const layoutOf = (d) => JSON.stringify([d.grid, (d.faces || []).map((face) => face.net), d.net_shape, d.periodic,
+                                          d.trim ? [d.trim.triangles, d.trim.inside] : null]);
 
   // -- modal state: (q, q', f) per mode and coordinate at the last event tEvent --------------
   // q(τ) = f/λ + e^{-στ}(a C + (b + σ a) S), q'(τ) = e^{-στ}(b C - (λ a + σ b) S),

@@ -1,0 +1,98 @@
+"""The rotation of a curved shell's clamped edges, held by Nitsche's terms.
+
+Clamping holds ``d = 0`` on the edge (hence ``∂_s d = 0`` along it) and the rotation of
+the normal about the edge, ``a_3·∂_n d = 0``; the in-plane slope across the edge is free:
+``a_n·∂_n d`` and ``a_s·∂_n d`` are the membrane strains ``ε_nn`` and ``2ε_ns`` there,
+which the exact solution of a curved shell does not make zero. Holding the whole slope
+``∂_n d = 0`` (the second row of control points at rest, :mod:`.shell_edges`) would hold
+them too: an over-constraint that converges only slowly on a curved shell. On a flat
+one membrane and bending decouple under normal loads, and the whole slope stays held
+there (the plate's clamping, exact).
+
+So on a curved surface a clamped edge is pinned in ``T`` (``d = 0``) and the rotation is
+held by the clamped Nitsche terms of the trimmed shell
+(:func:`splinedeform.trim.energy_forms.nitsche_matrix` with the shell's
+:func:`~splinedeform.trim.shell_trimmed.shell_form`) on ``p + 2`` Gauss points per cell of
+the edge. With ``d = v = 0`` on the edge the boundary form reduces to
+``b(v, d) = ∮ (g(v)·n)(a_3·∂_n d) ds``, ``g ∥ a_3`` (the moment), and the penalty to
+``γ_1 ∮ (a_3·∂_n d)(a_3·∂_n v) ds``, ``γ_1 = β w_b/h``: the terms of ``d`` itself vanish
+in ``range T``.
+"""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import NDArray
+
+from ..quadrature import gauss_points
+from ..surface import Surface
+from .shell import ShellMaterial
+from .shell_rigid import RigidMotions
+
+Array = NDArray[np.float64]
+#: control points within this fraction of the net's extent from one plane are coplanar
+FLAT = 1e-10
+
+
+def is_flat(surface: Surface) -> bool:
+    """Whether the surface lies in a plane, ``b_αβ = a_αβ·a_3 = 0``: exactly when its control
+    points do (``n·x − c = Σ_k R_k (n·P_k − c)`` vanishes identically only with every
+    coefficient, the basis being linearly independent and a partition of unity on the
+    domain): the smallest singular value of the centred net against the largest."""
+    P = surface.control_points.reshape(-1, 3)
+    s = np.linalg.svd(P - P.mean(axis=0), compute_uv=False)
+    return bool(s[-1] <= FLAT * max(s[0], 1e-300))
+
+
+def weak_clamps(surface: Surface, edges: Mapping[str, str]) -> tuple[str, ...]:
+    """The clamped edges whose rotation Nitsche's terms hold: all of a curved surface's."""
+    clamped = tuple(e for e, kind in edges.items() if kind == "clamped")
+    return clamped if clamped and not is_flat(surface) else ()
+
+
+def edge_quadrature(surface: Surface, edge: str) -> tuple[Array, Array, Array, Array, Array]:
+    """Gauss points ``p (P, 2)`` of an edge, their parameter arc weights ``ds``, outward
+    parameter normals ``n``, tangents ``s`` and knot-cell sizes ``h`` (the smaller side of
+    the edge's cell)."""
+    along = surface.basis_v if edge[0] == "u" else surface.basis_u
+    across = surface.basis_u if edge[0] == "u" else surface.basis_v
+    q = max(surface.basis_u.degree, surface.basis_v.degree) + 2
+    x, w = gauss_points(along, q)
+    cells_along = np.repeat(w.reshape(-1, q).sum(axis=1), q)
+    cells_across = gauss_points(across, q)[1].reshape(-1, q).sum(axis=1)
+    end = edge[1] == "1"
+    h = np.minimum(cells_along, cells_across[-1 if end else 0])
+    fixed = np.full_like(x, across.length if end else 0.0)
+    sign = 1.0 if end else -1.0
+    if edge[0] == "u":
+        p, n, s = np.stack([fixed, x], 1), [sign, 0.0], [0.0, sign]
+    else:
+        p, n, s = np.stack([x, fixed], 1), [0.0, sign], [-sign, 0.0]
+    return (p, w, np.broadcast_to(n, p.shape).copy(), np.broadcast_to(s, p.shape).copy(), h)
+
+
+def clamp_rotation(surface: Surface, material: ShellMaterial, edges: Mapping[str, str]
+                   ) -> sp.csr_matrix | None:
+    """Nitsche's terms holding the rotation of the :func:`weak_clamps` edges, ``(3N, 3N)``
+    interleaved; ``None`` where there are none."""
+    weak = weak_clamps(surface, edges)
+    if not weak:
+        return None
+    from ..trim.energy_forms import nitsche_matrix
+    from ..trim.model_matrices import nitsche_penalty
+    from ..trim.shell_trimmed import shell_form
+
+    parts = [edge_quadrature(surface, e) for e in weak]
+    p, ds, n, s, h = (np.concatenate(k) for k in zip(*parts))
+    degree = max(surface.basis_u.degree, surface.basis_v.degree)
+    return nitsche_matrix(surface, shell_form(material), p, ds, n, s,
+                          np.ones(len(p), bool), h, nitsche_penalty(degree))
+
+
+def held(T: sp.spmatrix) -> RigidMotions:
+    """No free rigid motion: one in ``range T`` is at rest on a clamped edge, so at most a
+    rotation about that edge's line, whose rotation ``a_3·∂_n d`` the penalty holds."""
+    return RigidMotions(np.zeros((T.shape[1], 0)), np.zeros((6, 0)))
