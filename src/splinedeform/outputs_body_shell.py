@@ -100,22 +100,21 @@ def body_mode_maxima(model: Any, shapes: Sequence[Array], resolution: int
 def render_body_stresses(path: Path, model: Any, rests: Sequence[Array],
                          nets: Sequence[Array], title: str, resolution: int) -> Path:
     """``stresses.png`` of a shell body in the state ``nets`` (one net per patch): every
-    face on its output grid, coloured by von Mises top and bottom on one scale
+    face on its output mesh (a trimmed face's clipped to its region), coloured by von Mises top and bottom on one scale
     (:func:`splinedeform.viz.stresses.stress_figure`)."""
-    from .surface import grid_faces
+    from .export.frames import tessellate_frames
+    from .export.shell_fields import output_parameters
     from .viz.figures import _save_png
     from .viz.stresses import stress_figure
 
     points, triangles, layers, offset = [], [], {"top": [], "bottom": []}, 0
     for face, rest, net in zip(face_shells(model), rests, nets):
-        surface = face.surface
-        u, v = surface.sample_parameters(int(resolution))
-        U, V = np.meshgrid(u, v, indexing="ij")
+        U, V = output_parameters(face.surface, resolution)    # a trimmed face: its region
         s = face.stresses(np.asarray(net, dtype=float) - rest, U, V, at_poles="nan")
-        points.append(surface.with_control_points(np.asarray(net, dtype=float))
-                      .evaluate(U, V).reshape(-1, 3))
-        triangles.append(grid_faces(u.size, v.size) + offset)
-        offset += u.size * v.size
+        X, F = tessellate_frames(face.surface, np.asarray(net, dtype=float), resolution)
+        points.append(X)
+        triangles.append(F + offset)
+        offset += len(X)
         for layer in layers:
             layers[layer].append(s.von_mises[layer].ravel())
     fields = {f"{layer} face": np.concatenate(v) for layer, v in layers.items()}

@@ -25,18 +25,32 @@ def is_shell(model: Any) -> bool:
 CHUNK_POINTS = 200_000
 
 
+def output_parameters(surface: Any, resolution: int) -> tuple[Array, Array]:
+    """``(U, V)`` of the output mesh's points, in its order: the grid
+    ``surface.sample_parameters(resolution)`` ``(r_u, r_v)``, or on a trimmed surface the
+    points of that grid clipped to its trim loops ``(N, 1)``
+    (:func:`splinedeform.trim.tessellate.surface_grid`, as the meshes are)."""
+    u, v = surface.sample_parameters(int(resolution))
+    if getattr(surface, "trim", None) is not None:
+        from ..trim.tessellate import surface_grid
+
+        points = surface_grid(surface, u, v)[0]
+        return points[:, :1], points[:, 1:]
+    return tuple(np.meshgrid(u, v, indexing="ij"))  # type: ignore[return-value]
+
+
 def grid_stresses(model: Any, rest: Array, nets: Array, resolution: int) -> Any:
     """:class:`~splinedeform.physics.shell_stress.ShellStresses` of frames ``(F, n_u, n_v, 3)``
-    on the output grid, fields ``(F, r_u, r_v, ...)``."""
-    u, v = model.surface.sample_parameters(int(resolution))
-    U, V = np.meshgrid(u, v, indexing="ij")
+    on the output mesh's points (:func:`output_parameters`), fields ``(F, r_u, r_v, ...)``
+    (``(F, N, 1, ...)`` on a trimmed surface)."""
+    U, V = output_parameters(model.surface, resolution)
     return model.stresses(np.asarray(nets) - rest, U, V, at_poles="nan")
 
 
 def frame_chunks(model: Any, rest: Array, nets: Array, resolution: int) -> Any:
     """``(first frame, ShellStresses of a chunk of frames)`` over all frames, in order."""
-    u, v = model.surface.sample_parameters(int(resolution))
-    step = max(1, CHUNK_POINTS // (u.size * v.size))
+    U, _ = output_parameters(model.surface, resolution)
+    step = max(1, CHUNK_POINTS // U.size)
     for f in range(0, len(nets), step):
         yield f, grid_stresses(model, rest, nets[f:f + step], resolution)
 

@@ -45,8 +45,9 @@ from ..trim.cells import Grid, _circle_pieces
 from ..trim.loops import CircleLoop, PolygonLoop
 from ..trim.spline_loop import SplineLoop
 from ..trim.values import tensor_values
-from .coupling import line_penalty, penalty_factors
+from .coupling import line_penalty, penalty_factors, shell_line_penalty
 from .coupling_parts import kinks, running_space, stretch_space
+from .shell import ShellMaterial
 from .coupling_traces import (EXTRA_POINTS, Line, Trace, check_meet, gauss, trace_of,
                               union)
 
@@ -300,14 +301,18 @@ def loop_of(surface: Surface, index: int) -> Any:
     return loops[index]
 
 
-def curve_penalty(patches: Sequence[Surface], interface: TrimInterface, material: Material,
+def curve_penalty(patches: Sequence[Surface], interface: TrimInterface, material: Any,
                   offsets: Sequence[int]) -> sp.csr_matrix:
     """The coupling of two faces along a trim curve, every factor from the material and the
     mesh: ``½ α ∫_Γ |Π (d_a − d_b)|² ds`` and, where the energy bends,
     ``½ β ∫_Γ (Π (∂_{n_a} d_a + ∂_{n_b} d_b))² ds``, ``(α, β)`` of
     :func:`~.coupling.penalty_factors` at the element size of :func:`curve_line`;
     the same matrices as an iso-edge's (:func:`~.coupling.line_penalty`), on the faces'
-    concatenated control points (``offsets`` their first rows)."""
+    concatenated control points (``offsets`` their first rows). For a Kirchhoff–Love shell
+    (:class:`~splinedeform.physics.shell.ShellMaterial`) the displacement penalty on all
+    three components and the rotation penalty ``½ β ∫_Γ (Π (θ_a − θ_b))² ds`` on its
+    interleaved unknowns (:func:`~.coupling.shell_line_penalty`: ``θ`` the rotation of
+    each face's conormal fibre about the tangent, so that a crease keeps its angle)."""
     for index in (interface.a, interface.b):
         if not 0 <= index < len(patches):
             raise InputError(f"{interface} names face {index}, but the body has "
@@ -315,7 +320,12 @@ def curve_penalty(patches: Sequence[Surface], interface: TrimInterface, material
     sides = [CurveSide.of_loop(patches[p], loop_of(patches[p], k))
              for p, k in ((interface.a, interface.loop_a), (interface.b, interface.loop_b))]
     line, h = curve_line(sides[0], sides[1], str(interface))
-    return line_penalties(line, h, material, interface.a, interface.b, patches, offsets)
+    if not isinstance(material, ShellMaterial):
+        return line_penalties(line, h, material, interface.a, interface.b, patches, offsets)
+    alpha, beta = penalty_factors(material, h)
+    size = int(offsets[-1]) + patches[-1].shape[0] * patches[-1].shape[1]
+    layout = (int(offsets[interface.a]), int(offsets[interface.b]), size)
+    return shell_line_penalty(line, layout, alpha, beta, line.space(0))
 
 
 def line_penalties(line: Line, h: float, material: Material, a: int, b: int,

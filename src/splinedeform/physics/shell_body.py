@@ -29,7 +29,7 @@ penalty there: the rotation is continuous exactly.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Mapping, Sequence
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 import scipy.sparse as sp
@@ -71,6 +71,9 @@ class ShellBodySystem:
     clamps : bool
         Whether a curved patch's clamped edge has its rotation held by Nitsche's terms
         (:mod:`.shell_clamp`, in ``K``), which hold every rigid motion ``T`` leaves.
+    motions : :class:`~.shell_rigid.RigidMotions` or None
+        The free rigid motions where the system knows them (a body with trimmed faces,
+        :mod:`.shell_body_trimmed`); None: those in ``range T``.
     """
 
     K: sp.csr_matrix
@@ -80,10 +83,13 @@ class ShellBodySystem:
     offsets: NDArray[np.int64]
     ties: Ties
     clamps: bool = False
+    motions: Any = None
 
 
 def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
-                boundary: str | Mapping[tuple[int, str], str] = "free") -> ShellBodySystem:
+                boundary: str | Mapping[tuple[int, str], str] = "free",
+                given: Mapping[int, tuple[sp.spmatrix, sp.spmatrix]] | None = None
+                ) -> ShellBodySystem:
     """Assemble the shell body of the module docstring.
 
     Parameters
@@ -93,6 +99,9 @@ def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
     boundary : str or mapping
         One kind of :data:`BODY_KINDS` for every boundary edge, or ``{(patch, edge): kind}``
         (missing boundary edges are free).
+    given : mapping, optional
+        ``{patch: (K_p, M_p)}``: the matrices of those patches, taken instead of
+        :func:`.shell.matrices` (a trimmed face's, :mod:`.shell_body_trimmed`).
     """
     if not isinstance(body, Body):
         body = Body(body)
@@ -106,7 +115,9 @@ def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
            for p, s in enumerate(patches)]
     Tb = sp.block_diag([constraint_matrix(s, e, weak_rotation=True)
                         for s, e in zip(patches, own)], format="csr")
-    blocks = [matrices(s, material) for s in patches]
+    given = given or {}
+    blocks = [given[p] if p in given else matrices(s, material)
+              for p, s in enumerate(patches)]
     clamps = [clamp_rotation(s, material, e) for s, e in zip(patches, own)]
     K = sp.block_diag([k if c is None else k + c for (k, _), c in zip(blocks, clamps)],
                       format="csr")

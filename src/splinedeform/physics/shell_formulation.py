@@ -100,8 +100,13 @@ class ShellFormulation:
             if fixed is not None:
                 raise InputError("a shell body is held by its boundary edges; fixed "
                                  "components are for a single surface")
-            system = body_system(surface, material, "free" if boundary is None else boundary)
             self.body = surface if isinstance(surface, Body) else Body(surface)
+            if any(s.trim is not None for s in self.body.patches):   # :mod:`.shell_body_trimmed`
+                from .shell_body_trimmed import trimmed_body_system as build
+            else:
+                build = body_system
+            system = build(self.body, material, "free" if boundary is None else boundary)
+            motions = system.motions
             self.patches: tuple[Surface, ...] | None = self.body.patches
             self.surface, self.offsets = None, system.offsets
             self.K_full, self.M_full, self.T, self.edges = (system.K, system.M, system.T,

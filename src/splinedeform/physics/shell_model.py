@@ -74,11 +74,14 @@ class ShellModel(Model):
         One patch, or a body of patches deformed as one shell (:mod:`.shell_body`:
         conforming interfaces merged, their slopes tied where the rest shape is smooth
         across them, the others and every crease coupled by penalties); general NURBS
-        weights (``net_weights``) included.
+        weights (``net_weights``) included. Trimmed faces of a body are taken on their
+        regions, coupled along the trim curves and trim edges they share
+        (:mod:`.shell_body_trimmed`).
     material : ShellMaterial
     boundary : mapping edge -> kind, optional
         See the module docstring; missing edges are free. For a body one kind for every
-        boundary edge, or ``{(patch, edge): kind}``.
+        boundary edge, or ``{(patch, edge): kind}`` (a trimmed face's loops and trim edges
+        keyed ``(face, "outer")``, ``(face, "hole1.0")`` …).
     fixed : bool array ``(n_u, n_v, 3)`` or ``(n_u, n_v)``, optional
         Individual displacement components (or whole control points) that do not move
         (a single surface only).

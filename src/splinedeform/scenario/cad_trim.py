@@ -4,9 +4,9 @@ Face ``face`` of a ``.3dm``, STEP or IGES file is read as its whole underlying s
 its loops (:func:`splinedeform.cad_trims.read_trims`) are attached after ``elevate`` and
 ``refine`` (the loops live in parameter space, refinement does not move them), so the
 model and every output use the trimmed region only. ``surface.trimmed`` switches this:
-by default the trim is taken where the trimmed model can hold the surface (any physics
-for one face, the plate's for a face of a body; clamped knots with simple interior
-knots, not periodic;
+by default the trim is taken where the trimmed model can hold the surface (any physics,
+for one face and for a face of a body; clamped knots with simple interior knots, not
+periodic;
 :func:`~splinedeform.trim.surface_trim.trim_grid`) and the whole face
 is used otherwise, with one warning line naming the face and the reason; ``trimmed =
 true`` refuses such a face, ``trimmed = false`` takes the whole face without a word.
@@ -58,11 +58,11 @@ def _face_number(spec: Any) -> int:
 
 def why_untrimmable(scenario: Any, surface: Any, body: bool = False) -> str | None:
     """Why the trimmed model cannot hold ``surface`` in this scenario; None when it can
-    (one face takes every physics; a face of a body, the plate's ``parametric`` and
-    ``intrinsic``)."""
-    if body and scenario.material.physics == "shell":
-        return ("the shell is not trimmed in a body of faces yet (a trimmed face of a body "
-                "takes physics \"parametric\" or \"intrinsic\")")
+    (every physics; a face of a body under the shell, unless its NURBS weights are not a
+    product, which :mod:`splinedeform.trim.shell_trimmed` refuses on one face)."""
+    if body and scenario.material.physics == "shell" and surface.net_weights is not None:
+        return ("the trimmed shell does not take NURBS weights that are not a product "
+                "w_kl = a_k b_l yet")
     return None
 
 
