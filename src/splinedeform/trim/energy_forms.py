@@ -236,23 +236,23 @@ def nitsche_matrix(surface: Any, form: Form, p: Array, ds: Array, n: Array, s: A
     local = local_values(surface, p, orders)
     vals = np.stack([local.values[o] for o in SLOTS])                           # (5, P, m)
     nu, nv = (n[:, k][:, None, None, None] for k in (0, 1))
-    gu = _sigma(A, 2, vals) * nu + 0.5 * _sigma(A, 3, vals) * nv
-    gv = _sigma(A, 4, vals) * nv + 0.5 * _sigma(A, 3, vals) * nu
-    vu, vv = local.values[1, 0], local.values[0, 1]
-    su, sv = s[:, 0][:, None], s[:, 1][:, None]
+    w = ds[:, None, None, None]
+    gu = (_sigma(A, 2, vals) * nu + 0.5 * _sigma(A, 3, vals) * nv) * w        # ds g_u, ds g_v
+    gv = (_sigma(A, 4, vals) * nv + 0.5 * _sigma(A, 3, vals) * nu) * w
+    su, sv = (s[:, k][:, None, None, None] for k in (0, 1))
+    gs = gu * su + gv * sv               # pinned: (g·s)(∂_s v) = v_u s_u (g·s) + v_v s_v (g·s)
     cl = clamped[:, None, None, None]
-    gs = gu * su[..., None, None] + gv * sv[..., None, None]
-    vs = vu * su + vv * sv
-    b = np.where(cl[:, None], _outer(vu, gu) + _outer(vv, gv), _outer(vs, gs))
+    vu, vv = local.values[1, 0], local.values[0, 1]
+    b = _outer(vu, np.where(cl, gu, su * gs)) + _outer(vv, np.where(cl, gv, sv * gs))
     _, _, w_b = penalty_scales(A)
     gamma1 = beta * w_b / h * ds * clamped
     rho = form.rotation(geo, n)                                          # (P, M, C, 2)
     r = (np.einsum("qmc,qk->qmkc", rho[..., 0], vu) + np.einsum("qmc,qk->qmkc", rho[..., 1], vv))
-    pen = gamma1[:, None, None, None, None] * np.einsum("qmlc,qmkd->qlckd", r, r)
+    pen = np.einsum("qmlc,qmkd->qlckd", gamma1[:, None, None, None] * r, r)
     if full:
         b0, pen0 = _value_terms(form, geo, x, A, local, n, ds, h, beta)
         b, pen = b + b0, pen + pen0
-    blocks = -(b + np.transpose(b, (0, 3, 4, 1, 2))) * ds[:, None, None, None, None] + pen
+    blocks = pen - b - np.transpose(b, (0, 3, 4, 1, 2))
     return _scatter(local.cols, blocks, C, size)
 
 
@@ -268,8 +268,8 @@ def _outer(test: Array, g: Array) -> Array:
 
 def _value_terms(form: Form, geo: Geometry, x: dict, A: Array, local: Local, n: Array,
                  ds: Array, h: Array, beta: float) -> tuple[Array, Array]:
-    """The terms of the value ``v_0`` (:func:`nitsche_matrix`): the blocks of ``g_0(d)·v_0``
-    and the penalty ``γ_0 ds v_0 v_0``, ``γ_0 = β (Γ_b/h³ + Γ_t/h)``."""
+    """The terms of the value ``v_0`` (:func:`nitsche_matrix`): the blocks of
+    ``ds g_0(d)·v_0`` and the penalty ``γ_0 ds v_0 v_0``, ``γ_0 = β (Γ_b/h³ + Γ_t/h)``."""
     dAu, dAv = coefficient_derivatives(form, geo, x, STEP * h)
     vals = np.stack([local.values[o] for o in SLOTS])
     shifted = [np.stack([local.values[a + da, b + db] for a, b in SLOTS])
@@ -285,4 +285,5 @@ def _value_terms(form: Form, geo: Geometry, x: dict, A: Array, local: Local, n: 
     v0 = local.values[0, 0]
     tension, bending, _ = penalty_scales(A)
     gamma0 = beta * (bending / h[:, None, None] ** 3 + tension / h[:, None, None])
-    return _outer(v0, g0), np.einsum("q,ql,qk,qcd->qlckd", ds, v0, v0, gamma0)
+    return (_outer(v0, g0 * ds[:, None, None, None]),
+            np.einsum("q,ql,qk,qcd->qlckd", ds, v0, v0, gamma0))
