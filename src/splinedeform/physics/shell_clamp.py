@@ -16,7 +16,8 @@ held by the clamped Nitsche terms of the trimmed shell
 the edge. With ``d = v = 0`` on the edge the boundary form reduces to
 ``b(v, d) = ∮ (g(v)·n)(a_3·∂_n d) ds``, ``g ∥ a_3`` (the moment), and the penalty to
 ``γ_1 ∮ (a_3·∂_n d)(a_3·∂_n v) ds``, ``γ_1 = β w_b/h``: the terms of ``d`` itself vanish
-in ``range T``.
+in ``range T`` and are not assembled (nor the third derivatives and coefficient
+derivatives they need).
 """
 
 from __future__ import annotations
@@ -74,10 +75,13 @@ def edge_quadrature(surface: Surface, edge: str) -> tuple[Array, Array, Array, A
     return (p, w, np.broadcast_to(n, p.shape).copy(), np.broadcast_to(s, p.shape).copy(), h)
 
 
-def clamp_rotation(surface: Surface, material: ShellMaterial, edges: Mapping[str, str]
-                   ) -> sp.csr_matrix | None:
+def clamp_rotation(surface: Surface, material: ShellMaterial, edges: Mapping[str, str],
+                   displacement_held: bool = True) -> sp.csr_matrix | None:
     """Nitsche's terms holding the rotation of the :func:`weak_clamps` edges, ``(3N, 3N)``
-    interleaved; ``None`` where there are none."""
+    interleaved; ``None`` where there are none. ``T`` holds ``d = 0`` on these edges, so
+    by default the terms of ``d`` itself, which vanish in ``range T``, are left out
+    (``displacement_held`` of :func:`~splinedeform.trim.energy_forms.nitsche_matrix`);
+    ``False`` assembles them too."""
     weak = weak_clamps(surface, edges)
     if not weak:
         return None
@@ -89,7 +93,7 @@ def clamp_rotation(surface: Surface, material: ShellMaterial, edges: Mapping[str
     p, ds, n, s, h = (np.concatenate(k) for k in zip(*parts))
     degree = max(surface.basis_u.degree, surface.basis_v.degree)
     return nitsche_matrix(surface, shell_form(material), p, ds, n, s,
-                          np.ones(len(p), bool), h, nitsche_penalty(degree))
+                          np.ones(len(p), bool), h, nitsche_penalty(degree), displacement_held)
 
 
 def held(T: sp.spmatrix) -> RigidMotions:

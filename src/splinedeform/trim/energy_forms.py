@@ -212,51 +212,78 @@ def penalty_scales(A: Array) -> tuple[Array, Array, Array]:
 
 
 def nitsche_matrix(surface: Any, form: Form, p: Array, ds: Array, n: Array, s: Array,
-                   clamped: NDArray[np.bool_], h: Array, beta: float) -> sp.csr_matrix:
+                   clamped: NDArray[np.bool_], h: Array, beta: float,
+                   displacement_held: bool = False) -> sp.csr_matrix:
     """Nitsche's terms (module docstring) at the held loop points ``p (P, 2)`` with weights
     ``ds``, outward normals ``n``, tangents ``s``; ``clamped`` per point (else pinned),
-    ``h`` the knot cell at each point."""
+    ``h`` the knot cell at each point.
+
+    With ``displacement_held`` the loop's ``d = 0`` is held exactly by a constraint map
+    ``T``: every term with the value ``v_0`` (of the test or trial function) as a factor,
+    ``−∮ g_0(d)·v_0 + g_0(v)·d_0`` and ``γ_0 ∮ d·v``, vanishes in ``Tᵀ K T`` and is left
+    out, with the third derivatives and ``∂_γ A`` that ``g_0`` needs; what remains is
+    ``−∮ g_u(d) v_u + g_v(d) v_v + (d ↔ v) + γ_1 ∮ Σ_m ρ_m(d) ρ_m(v)`` (clamped) or
+    ``−∮ (g·s)(∂_s v) + (d ↔ v)`` (pinned).
+    """
     C = form.components
     size = surface.control_points.shape[0] * surface.control_points.shape[1]
     if not len(p):
         return sp.csr_matrix((C * size,) * 2)
-    geo, x = surface_geometry(surface, p, third=True)
+    full = not displacement_held
+    geo, x = surface_geometry(surface, p, third=full)
     A = coefficients(form, geo)
-    dAu, dAv = coefficient_derivatives(form, geo, x, STEP * h)
-    orders = [(0, 0)] + list(SLOTS) + [(3, 0), (2, 1), (1, 2), (0, 3)]
+    orders = [(0, 0)] + list(SLOTS) + ([(3, 0), (2, 1), (1, 2), (0, 3)] if full else [])
     local = local_values(surface, p, orders)
     vals = np.stack([local.values[o] for o in SLOTS])                           # (5, P, m)
+    nu, nv = (n[:, k][:, None, None, None] for k in (0, 1))
+    w = ds[:, None, None, None]
+    gu = (_sigma(A, 2, vals) * nu + 0.5 * _sigma(A, 3, vals) * nv) * w        # ds g_u, ds g_v
+    gv = (_sigma(A, 4, vals) * nv + 0.5 * _sigma(A, 3, vals) * nu) * w
+    su, sv = (s[:, k][:, None, None, None] for k in (0, 1))
+    gs = gu * su + gv * sv               # pinned: (g·s)(∂_s v) = v_u s_u (g·s) + v_v s_v (g·s)
+    cl = clamped[:, None, None, None]
+    vu, vv = local.values[1, 0], local.values[0, 1]
+    b = _outer(vu, np.where(cl, gu, su * gs)) + _outer(vv, np.where(cl, gv, sv * gs))
+    _, _, w_b = penalty_scales(A)
+    gamma1 = beta * w_b / h * ds * clamped
+    rho = form.rotation(geo, n)                                          # (P, M, C, 2)
+    r = (np.einsum("qmc,qk->qmkc", rho[..., 0], vu) + np.einsum("qmc,qk->qmkc", rho[..., 1], vv))
+    pen = np.einsum("qmlc,qmkd->qlckd", gamma1[:, None, None, None] * r, r)
+    if full:
+        b0, pen0 = _value_terms(form, geo, x, A, local, n, ds, h, beta)
+        b, pen = b + b0, pen + pen0
+    blocks = pen - b - np.transpose(b, (0, 3, 4, 1, 2))
+    return _scatter(local.cols, blocks, C, size)
+
+
+def _sigma(coef: Array, t: int, basis: Array) -> Array:
+    """The rows of ``σ_t = Σ_s coef_ts D^s`` on ``basis (5, P, m)``, ``(P, C, m, C)``."""
+    return np.einsum("qscd,sqk->qckd", coef[:, t], basis)
+
+
+def _outer(test: Array, g: Array) -> Array:
+    """``test (P, m) ⊗ g (P, C, m, C)`` as point blocks ``(P, m, C, m, C)``."""
+    return np.einsum("ql,qckd->qlckd", test, g)
+
+
+def _value_terms(form: Form, geo: Geometry, x: dict, A: Array, local: Local, n: Array,
+                 ds: Array, h: Array, beta: float) -> tuple[Array, Array]:
+    """The terms of the value ``v_0`` (:func:`nitsche_matrix`): the blocks of
+    ``ds g_0(d)·v_0`` and the penalty ``γ_0 ds v_0 v_0``, ``γ_0 = β (Γ_b/h³ + Γ_t/h)``."""
+    dAu, dAv = coefficient_derivatives(form, geo, x, STEP * h)
+    vals = np.stack([local.values[o] for o in SLOTS])
     shifted = [np.stack([local.values[a + da, b + db] for a, b in SLOTS])
                for da, db in ((1, 0), (0, 1))]
 
-    def sigma(coef: Array, t: int, basis: Array) -> Array:        # (P, C, m, C): σ_t rows
-        return np.einsum("qscd,sqk->qckd", coef[:, t], basis)
-
     def d_sigma(t: int, axis: int) -> Array:
-        coef = (dAu, dAv)[axis]
-        return sigma(coef, t, vals) + sigma(A, t, shifted[axis])
+        return _sigma((dAu, dAv)[axis], t, vals) + _sigma(A, t, shifted[axis])
 
     nu, nv = (n[:, k][:, None, None, None] for k in (0, 1))
-    g0 = (sigma(A, 0, vals) * nu + sigma(A, 1, vals) * nv
+    g0 = (_sigma(A, 0, vals) * nu + _sigma(A, 1, vals) * nv
           - (d_sigma(2, 0) * nu + 0.5 * (d_sigma(3, 0) * nv + d_sigma(3, 1) * nu)
              + d_sigma(4, 1) * nv))
-    gu = sigma(A, 2, vals) * nu + 0.5 * sigma(A, 3, vals) * nv
-    gv = sigma(A, 4, vals) * nv + 0.5 * sigma(A, 3, vals) * nu
-    v0, vu, vv = local.values[0, 0], local.values[1, 0], local.values[0, 1]
-    su, sv = s[:, 0][:, None], s[:, 1][:, None]
-    cl = clamped[:, None, None, None]
-    gs = gu * su[..., None, None] + gv * sv[..., None, None]
-    vs = vu * su + vv * sv
-    def outer(test: Array, g: Array) -> Array:                    # (P, m, C, m, C)
-        return np.einsum("ql,qckd->qlckd", test, g)
-
-    b = outer(v0, g0) + np.where(cl[:, None], outer(vu, gu) + outer(vv, gv), outer(vs, gs))
-    tension, bending, w_b = penalty_scales(A)
+    v0 = local.values[0, 0]
+    tension, bending, _ = penalty_scales(A)
     gamma0 = beta * (bending / h[:, None, None] ** 3 + tension / h[:, None, None])
-    gamma1 = beta * w_b / h * ds * clamped
-    pen = np.einsum("q,ql,qk,qcd->qlckd", ds, v0, v0, gamma0)
-    rho = form.rotation(geo, n)                                          # (P, M, C, 2)
-    r = (np.einsum("qmc,qk->qmkc", rho[..., 0], vu) + np.einsum("qmc,qk->qmkc", rho[..., 1], vv))
-    pen = pen + gamma1[:, None, None, None, None] * np.einsum("qmlc,qmkd->qlckd", r, r)
-    blocks = -(b + np.transpose(b, (0, 3, 4, 1, 2))) * ds[:, None, None, None, None] + pen
-    return _scatter(local.cols, blocks, C, size)
+    return (_outer(v0, g0 * ds[:, None, None, None]),
+            np.einsum("q,ql,qk,qcd->qlckd", ds, v0, v0, gamma0))
