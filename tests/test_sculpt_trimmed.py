@@ -61,7 +61,9 @@ def test_the_page_gets_the_exports_clipped_mesh(served):
     g = np.linspace(0, 1, R)
     uu, vv = np.meshgrid(g, g, indexing="ij")
     within = np.hypot(uu - 0.5, vv - 0.5).ravel() < 0.4
-    assert np.array_equal(inside[:R * R].astype(bool), within)      # booleans: exact
+    # inside/outside flags as 0/1: integers, compared to half a unit
+    flags = inside[:R * R].astype(bool).astype(float)
+    assert np.abs(flags - within.astype(float)).max() <= 0.5
 
 
 def test_a_push_at_the_centre_moves_the_trimmed_model(served):
@@ -177,7 +179,9 @@ def test_a_bake_keeps_the_trim(served):
     after = session.basis
     assert session.scenario.surface.shape == "file" and after.model.surface.trim is not None
     assert after.model.n_free == before.model.n_free
-    assert np.array_equal(after.trimmed.triangles, before.trimmed.triangles)   # integers
+    # the triangles' vertex indices: integers, compared to half a unit
+    assert after.trimmed.triangles.shape == before.trimmed.triangles.shape
+    assert np.abs(after.trimmed.triangles - before.trimmed.triangles).max() <= 0.5
     # the baked rest shape is the shape of q: rest + Φ_s q, to round-off of the net (1e-12)
     shape = before.rest_samples() + before.phi_samples @ q
     assert np.abs(after.rest_samples() - shape).max() <= 1e-12

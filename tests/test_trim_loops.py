@@ -24,7 +24,11 @@ def test_point_in_domain_and_signed_distance_against_closed_forms():
     r = np.hypot(p[:, 0] - 0.5, p[:, 1] - 0.5)
     box = np.maximum(np.abs(p[:, 0] - 0.5), np.abs(p[:, 1] - 0.5))
     expected = (box < 0.4) & (r > 0.2)
-    assert np.array_equal(d.contains(p), expected)
+    # inside/outside as 0/1, compared to half a unit away from the loops: a point within
+    # 1e-12 of a loop (round-off of coordinates of size 1) may fall either way
+    clear = (np.abs(box - 0.4) > 1e-12) & (np.abs(r - 0.2) > 1e-12)
+    got = d.contains(p).astype(float)
+    assert clear.sum() > 1990 and np.abs(got - expected)[clear].max() <= 0.5
     # inside the convex square the distance to it is 0.4 - box, to the circle r - 0.2
     # (closed forms); 1e-14 is round-off of coordinates of size 1
     sd = d.signed_distance(p)
