@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 import splinedeform as sd
-from splinedeform.body.model import BodyReduction
+from splinedeform.physics.plate_body import BodyReduction
 from splinedeform.quadrature import gauss_points
 from splinedeform.refine import refine_surface
 

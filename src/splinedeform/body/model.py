@@ -18,13 +18,12 @@ from numpy.typing import NDArray
 
 from ..model import Model, check_options
 from ..material import Material
-from ..physics.plate_body import BodyReduction, body_system, known_fields, rigid_count
-from ..physics.plate_body import refuse as _refuse
+from ..physics.plate_body import body_system, known_fields, rigid_count
 from ..solvers.rigid import UnresolvedSpectrum, null_space
 from ..surface import Surface
 from .body import Body
 
-__all__ = ["BodyModel", "BodyReduction", "_refuse"]
+__all__ = ["BodyModel"]
 
 Array = NDArray[np.float64]
 

@@ -39,8 +39,7 @@ from scipy.sparse.csgraph import connected_components
 from ..body.body import Body
 from ..body.constraints import boundary_presets, edge_rows
 from ..body.interface import EDGES
-from ..body.model import BodyReduction
-from ..body.model import _refuse as refuse
+from .plate_body import BodyReduction, refuse
 from ..body.trim_edges import edge_penalty, iso_stretches
 from ..errors import InputError
 from ..surface import Surface
@@ -194,7 +193,7 @@ def merge_columns(Tb: sp.csr_matrix, pairs: NDArray[np.int64]
 def body_field(patches: Sequence[Surface], term: object, t: float = 0.0,
                signs: tuple[int, ...] = ()) -> Array:
     """One load term's force on every patch, patch after patch, interleaved ``(3N,)``
-    (:class:`~splinedeform.body.model.BodyReduction`: :class:`~splinedeform.body.OnPatch`
+    (:class:`~splinedeform.physics.plate_body.BodyReduction`: :class:`~splinedeform.body.OnPatch`
     terms act on their patch only, a pressure along ``signs[p] x_u × x_v``)."""
     return np.asarray(BodyReduction(None, patches, None, tuple(signs)).field(term, t)).ravel()
 
