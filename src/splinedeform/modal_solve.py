@@ -46,6 +46,9 @@ DEFAULT_TIMES = 201
 """Without ``times=`` the modes are chosen for this many evenly spaced times on ``[0, t_end]``
 and, after each load jump, the time half their spacing later (:func:`default_times`)."""
 _POINTWISE: weakref.WeakKeyDictionary[Any, float] = weakref.WeakKeyDictionary()
+ONE_OFF_TIMES = 16
+"""Up to this many times given at the call, on a model with no Krylov space yet, the modes
+are computed from a space started from the load (:func:`_automatic_modes`)."""
 
 
 def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
@@ -86,7 +89,9 @@ def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
             report = {}                  # all modes: the auto eigen-solution resolves them
     if report and report["modes"] < model.n_free:
         modes, eigensolver = report["modes"], "sparse"
-    basis = model.modal_basis(eigensolver, modes, omega_max, check_spectrum)
+    basis = report.pop("basis", None)
+    if basis is None:
+        basis = model.modal_basis(eigensolver, modes, omega_max, check_spectrum)
     start = time.perf_counter()
     M, _, K = model.matrices()
     lam = basis.lam
@@ -189,13 +194,21 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
     physics = model.formulation
     M, _, K = model.matrices()
     krylov = _KRYLOV.get(model)
-    if krylov is None:
+    # a few times asked at the call on a model with no space yet: a space started from the
+    # load (fewer solves), for this call alone; else the model's random-start space, kept
+    # for further load cases
+    one_off = krylov is None and times is not None and at.size <= ONE_OFF_TIMES
+    if krylov is None and not one_off:
         krylov = _KRYLOV[model] = BlockLanczos(K, M)
     gamma, beta, c_inf = physics.damping_rate, physics.rayleigh, pointwise_factor(model)
     out_of_reach = model.n_free > modal_basis.DENSE_MAX    # all modes cannot be had
     basis, correction, report = mode_select.automatic_basis(
         K, M, spatial[0], gamma, beta, at, tolerance, krylov=krylov, pointwise=c_inf,
-        best_effort=out_of_reach)
+        best_effort=out_of_reach, load_started=one_off)
+    krylov = report.pop("krylov")
+    if one_off and not report.get("load_started"):
+        _KRYLOV[model] = krylov               # the search went on in a random-start space
+        one_off = False
     report["of_static"] = tolerance
     if basis is not None and not of_static:
         grid = np.union1d(np.linspace(0.0, t_end, DEFAULT_TIMES), at)
@@ -205,8 +218,12 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
             basis, correction, report = (None, None, {"tolerance": tolerance}) if below <= 0 \
                 else mode_select.automatic_basis(K, M, spatial[0], gamma, beta, at, below,
                                                  krylov=krylov, pointwise=c_inf,
-                                                 best_effort=out_of_reach)
+                                                 best_effort=out_of_reach,
+                                                 load_started=one_off)
             report.update(tolerance=tolerance, of_static=below)
+            if one_off and not report.get("load_started", True):
+                _KRYLOV[model] = report["krylov"]       # went on in a random-start space
+            report.pop("krylov", None)
             if basis is not None:
                 report["bound"] *= tolerance / below
     if report.get("met") is False:
@@ -220,7 +237,10 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
     if basis is None:
         report["modes"] = model.n_free
     else:
-        model._bases[("sparse", report["modes"], None)] = basis
+        if report.pop("load_started", False):
+            report["basis"] = basis          # the load's modes only: not the model's
+        else:
+            model._bases[("sparse", report["modes"], None)] = basis
         report["correction"] = correction
         report["times"] = at
     return report

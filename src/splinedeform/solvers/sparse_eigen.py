@@ -142,15 +142,21 @@ class BlockLanczos:
         (never narrowed) when a later call asks for more.
     tol : accepted relative residual of a Ritz pair.
     seed : of the random starting block.
+    start : a starting block ``W₀ = K⁻¹F`` instead of a random one (a load's static
+        response: the space of *load-dependent* Ritz vectors). Its block width is the rank
+        of ``F`` and stays fixed. The space then holds only the modes the load excites, so
+        it may serve that load alone: a mode with ``φᵀF = 0`` is never found, and another
+        load may need it.
     """
 
     def __init__(self, K: sp.spmatrix, M: sp.spmatrix, lu: Any | None = None,
-                 block: int | None = None, tol: float = TOLERANCE, seed: int = 0):
+                 block: int | None = None, tol: float = TOLERANCE, seed: int = 0,
+                 start: Array | None = None):
         self.K, self.M = K, M
         self.n = K.shape[0]
         self.lu = factorise(K) if lu is None else lu
         self.tol = tol
-        self.fixed = block is not None
+        self.fixed = block is not None or start is not None
         self.wide = getattr(self.lu, "method", "") == "block"   # level-3 solves: wider blocks
         self.b = min(block or block_size(1, self.wide), self.n)
         self.rng = np.random.default_rng(seed)
@@ -160,10 +166,17 @@ class BlockLanczos:
         self.p = self.lo = 0
         self.solves = 0
         self.next: tuple[Array, Array, Array] | None = None    # (Q, MQ, B) of the next block
-        X = self.rng.standard_normal((self.n, self.b))
-        W = self.lu.solve(M @ X)
-        self.solves += self.b
+        if start is None:
+            X = self.rng.standard_normal((self.n, self.b))
+            W = self.lu.solve(M @ X)
+            self.solves += self.b
+        else:
+            W = np.asarray(start, dtype=float).reshape(self.n, -1)
         Q, MQ, _ = _m_orthonormal(W, M @ W)
+        if start is not None:
+            if Q.shape[1] == 0:
+                raise ValueError("the starting block of a load-started Krylov space is zero")
+            self.b = Q.shape[1]
         self._append(Q, MQ)
 
     def _reserve(self, size: int) -> None:
