@@ -66,6 +66,9 @@ GRID = 3500
 DECADES = 14.0
 START = 16
 """Modes computed first; the selection may keep fewer."""
+FEW_TIMES = 16
+"""Up to this many times, a count that meets the tolerance with the static correction is
+kept without looking for fewer modes with the transient one."""
 LOAD_STARTED_MODES = 48
 """A space started from the load serves up to this many modes (its blocks are one vector
 per load direction); a search for more goes on in a random-start space."""
@@ -278,9 +281,11 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
         report.update(computed=k, solves=modes.solves)
         last = (k, modes, lam, coef, norms, relative)
         weight = factor / max(scale, 1e-300)
-        dynamic = transient_count(int(fits[0]) - 1 if fits.size else k, lam, norms,
-                                   jump_times, gamma, beta, times, weight, tolerance,
-                                   weight * bound)
+        # where the static bound meets the tolerance at a few times, fewer modes with the
+        # transient correction would save little of their evaluation and cost its solves
+        dynamic = None if fits.size and times.size <= FEW_TIMES else transient_count(
+            int(fits[0]) - 1 if fits.size else k, lam, norms, jump_times, gamma, beta, times,
+            weight, tolerance, weight * bound)
         if fits.size or dynamic is not None:
             m, bound_m = dynamic if dynamic is not None else (int(fits[0]), relative[fits[0]])
             parts = statics - np.array([modes.combine(c[:m]) for c in coef])
