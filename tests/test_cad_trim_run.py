@@ -246,7 +246,12 @@ def test_a_face_the_trimmed_model_cannot_take(trimmed_plane, monkeypatch):
     from splinedeform.errors import ScenarioError
     from splinedeform.scenario import cad_trim
 
-    monkeypatch.setattr(cad_trim, "why_untrimmable", lambda *a, **k: "a reason")
+    from splinedeform.errors import InputError
+
+    def refused(surface):
+        raise InputError("a reason")
+
+    monkeypatch.setattr(cad_trim, "equal_cell_form", refused)
     built, said = _built(trimmed_plane)
     whole = [s for s in said if "whole underlying surface" in s]
     assert len(whole) == 1 and "face 0" in whole[0] and "a reason" in whole[0]

@@ -105,13 +105,6 @@ def test_refusals_name_the_problem():
         ShellModel(disc, MATERIAL, {"outer": "clamped"}, fixed=np.zeros(plane.shape, bool))
     with pytest.raises(sd.InputError, match="hole7"):
         ShellModel(disc, MATERIAL, {"hole7": "clamped"})
-    from dataclasses import replace
-
-    opened = sd.shapes.plane(cells=(6, 6), degree=3, knots="open")
-    weighted = replace(opened, net_weights=1 + 0.1 * opened.control_points[..., 0])
-    with pytest.raises(sd.InputError, match="not a product"):
-        ShellModel(weighted.with_trim(TrimDomain(CircleLoop((0.5, 0.5), A))), MATERIAL,
-                   {"outer": "clamped"})
     quadratic = sd.shapes.plane(cells=(6, 6), degree=2, knots="uniform")
     with pytest.raises(sd.InputError, match="degree >= 3"):
         ShellModel(quadratic.with_trim(TrimDomain(CircleLoop((0.5, 0.5), A))), MATERIAL,

@@ -4,12 +4,12 @@ Face ``face`` of a ``.3dm``, STEP or IGES file is read as its whole underlying s
 its loops (:func:`splinedeform.cad_trims.read_trims`) are attached after ``elevate`` and
 ``refine`` (the loops live in parameter space, refinement does not move them), so the
 model and every output use the trimmed region only. ``surface.trimmed`` switches this:
-by default the trim is taken where the trimmed model can hold the surface (any physics,
-for one face and for a face of a body; clamped knots with simple interior knots, not
-periodic;
-:func:`~splinedeform.trim.surface_trim.trim_grid`) and the whole face
-is used otherwise, with one warning line naming the face and the reason; ``trimmed =
-true`` refuses such a face, ``trimmed = false`` takes the whole face without a word.
+by default the trim is taken where the trimmed model can hold the surface (any physics
+and any NURBS weights, for one face and for a face of a body; clamped knots with simple
+interior knots, not periodic; :func:`~splinedeform.trim.surface_trim.trim_grid`) and the
+whole face is used otherwise, with one warning line naming the face and the reason;
+``trimmed = true`` refuses such a face, ``trimmed = false`` takes the whole face without a
+word.
 """
 
 from __future__ import annotations
@@ -56,16 +56,6 @@ def _face_number(spec: Any) -> int:
     return int(chosen[0])
 
 
-def why_untrimmable(scenario: Any, surface: Any, body: bool = False) -> str | None:
-    """Why the trimmed model cannot hold ``surface`` in this scenario; None when it can
-    (every physics; a face of a body under the shell, unless its NURBS weights are not a
-    product, which :mod:`splinedeform.trim.shell_trimmed` refuses on one face)."""
-    if body and scenario.material.physics == "shell" and surface.net_weights is not None:
-        return ("the trimmed shell does not take NURBS weights that are not a product "
-                "w_kl = a_k b_l yet")
-    return None
-
-
 def with_face_trim(scenario: Any, surface: Any, caught: list[warnings.WarningMessage]) -> Any:
     """``surface`` (face ``surface.face`` of ``surface.path``, refined) with the face's trim
     loops attached, or whole (module docstring); the reader's warnings ``caught`` shown
@@ -81,7 +71,7 @@ def with_face_trim(scenario: Any, surface: Any, caught: list[warnings.WarningMes
     from ..cad_trims import read_trims
 
     face, path = _face_number(spec), spec.path
-    source = f"{path} face {face}"
+    source, reason = f"{path} face {face}", None
     try:
         domain = read_trims(path, face)
     except InputError as exc:                               # loops that cannot be read
@@ -90,7 +80,6 @@ def with_face_trim(scenario: Any, surface: Any, caught: list[warnings.WarningMes
         if domain is None or (not domain.holes and whole_rectangle(surface, domain.outer)):
             _shown(caught, drop_whole=False)
             return surface                                  # not trimmed: nothing to attach
-        reason = why_untrimmable(scenario, surface)
     trimmed = None
     if reason is None:
         try:
@@ -163,7 +152,7 @@ def with_body_trims(scenario: Any, body: Any, caught: list[warnings.WarningMessa
     patches, kept_whole = list(body.patches), []
     trimmed_faces: set[int] = set()
     for p, (face, surface) in enumerate(zip(body.faces, body.patches)):
-        source = f"{path} face {face}"
+        source, reason = f"{path} face {face}", None
         try:
             domain = read_trims(path, face)
         except InputError as exc:
@@ -171,7 +160,6 @@ def with_body_trims(scenario: Any, body: Any, caught: list[warnings.WarningMessa
         else:
             if domain is None or (not domain.holes and whole_rectangle(surface, domain.outer)):
                 continue
-            reason = why_untrimmable(scenario, surface, body=True)
         if reason is None:
             try:
                 patches[p] = equal_cell_form(surface).with_trim(domain)

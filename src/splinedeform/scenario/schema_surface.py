@@ -199,9 +199,8 @@ class FromCad(_Refined):
             "simulate a trimmed face on the region inside its trim loops (loops `outer`, "
             "`hole1`, …; an outer loop that is the parameter rectangle keeps the `[boundary]` "
             "edges; `[boundary.loops]` holds the loops): `true` refuses a face the trimmed "
-            "model cannot take (periodic, repeated interior knots; under physics `shell` a "
-            "face of a body with NURBS weights that are not a product), `false` takes the "
-            "whole underlying surface"),
+            "model cannot take (periodic, repeated interior knots), `false` takes the whole "
+            "underlying surface"),
         json_schema_extra={"doc_default": "the trim where the model can take it, else the "
                                           "whole surface with one warning"})
     faces: Optional[Union[Literal["all"], Annotated[list[FaceNumber], Field(min_length=1)],

@@ -10,6 +10,18 @@ with Höllig's extension ``E``: each component is a scalar spline field, and the
 reproduces polynomials component by component, so the displacement stays a B-spline
 surface and every output works on it.
 
+**NURBS weights.** The shape functions are the surface's basis: polynomial, rational with
+product weights ``w_kl = a_k b_l`` or with general weights
+(:attr:`~splinedeform.Surface.net_weights`), ``R_kl = w_kl b_k b_l / W``, whose derivatives
+up to the third order (Nitsche's terms) come from the quotient rule at every trimmed point
+(:func:`~.values.surface_values`, :func:`splinedeform.rational.basis_derivatives`); the
+geometry ``x = Σ R_kl p_kl`` and its derivatives from the same rows, so the strains are
+the untrimmed shell's (:mod:`splinedeform.physics.shell`). A rational field is extended
+through its numerator's coefficients (``E = diag(1/w) E_b diag(w_I)``,
+:func:`~.web.web_basis`): the fields ``P / W`` with ``P`` a polynomial of the B-splines'
+degree are reproduced, the rigid motions among them where ``W`` and ``W x`` are such
+polynomials (a rational Bézier patch, refined or not).
+
 **Held loops by Nitsche's method, not by Höllig's weight function.** A weight ``w``
 vanishing on the loop makes the displacement ``w Σ c_k b_k``, no longer in the surface's
 own spline space (no control net, mesh or CAD export could hold it), and a weight that is
@@ -106,10 +118,6 @@ def trimmed_shell(surface: Any, material: ShellMaterial,
                   boundary: str | Mapping[str, str] | None, fixed: Any = None) -> TrimmedShell:
     """The shell of a trimmed surface (module docstring); ``boundary`` names its loops
     (``{"outer": "clamped", "hole1": "free"}``, or one preset for every loop)."""
-    if surface.net_weights is not None:
-        raise InputError(f"the trimmed Kirchhoff–Love shell does not take NURBS weights that "
-                         f"are not a product w_kl = a_k b_l yet (surface {surface.name!r}); "
-                         "the untrimmed shell and the trimmed plate do")
     degrees = surface_degrees(surface)
     if min(degrees) < 2:
         raise InputError("the Kirchhoff–Love shell needs degree >= 2 in u and v (curvatures)")
