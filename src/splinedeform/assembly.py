@@ -76,9 +76,10 @@ class ReducedFactors:
     """The reduced 1-D Gram matrices ``T_uᵀ G_a^u T_u`` (``u``) and ``T_vᵀ G_b^v T_v``
     (``v``) of one geometry, and the compressed layouts of their sums
     (:class:`KroneckerLayout`) by the orders ``(a, b)`` they sum: what models of several
-    materials on that geometry share."""
+    materials on that geometry share. The factors are CSC (the layouts' format), their
+    arrays read-only (the ``reduced`` cache's)."""
 
-    def __init__(self, u: list[sp.csr_matrix], v: list[sp.csr_matrix]) -> None:
+    def __init__(self, u: list[sp.csc_matrix], v: list[sp.csc_matrix]) -> None:
         self.u, self.v = u, v
         self._layouts: dict[tuple[tuple[int, int], ...], KroneckerLayout] = {}
 
@@ -101,15 +102,15 @@ def reduced_factors(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], constr
     return ReducedFactors(_reduced(gram_u, T_u), _reduced(gram_v, T_v))
 
 
-def _reduced(grams: Sequence[sp.spmatrix], T: sp.spmatrix) -> list[sp.csr_matrix]:
+def _reduced(grams: Sequence[sp.spmatrix], T: sp.spmatrix) -> list[sp.csc_matrix]:
     """``[T_1dᵀ G_a T_1d]`` of one direction, from the ``reduced`` cache
     (:mod:`splinedeform.construction_cache`; keyed by the matrices' bytes, read-only)."""
     key = tuple(content(A) for A in (T, *grams))
 
-    def make() -> tuple[sp.csr_matrix, ...]:
+    def make() -> tuple[sp.csc_matrix, ...]:
         out = []
         for G in grams:
-            R = (T.T @ G @ T).tocsr()
+            R = (T.T @ G @ T).tocsc()
             R.sum_duplicates()
             read_only(R.data, R.indices, R.indptr)
             out.append(R)

@@ -153,6 +153,19 @@ def end_constraints(basis: BSplineBasis, end: int, preset: str) -> sp.csr_matrix
     return sp.vstack([basis.matrix(x, j) for j in range(order)]).tocsr()
 
 
+def _end_rows(basis: BSplineBasis, end: int, preset: str) -> NDArray[np.float64]:
+    """The rows of :func:`end_constraints` as a dense ``(r, size)`` array (one evaluation
+    of the basis and its derivatives at the end)."""
+    order = {"free": 0, "pole": 0, "pinned": 1, "clamped": 2}[preset]
+    C = np.zeros((order, basis.size))
+    if order:
+        index, values = basis.nonzero_derivatives(
+            np.array([0.0 if end == 0 else basis.length]), order - 1)
+        for j in range(order):
+            np.add.at(C[j], index[0], values[j, 0])
+    return C
+
+
 _MAPS = BoundedCache("constraint_map", 256, 64 * 2**20,
                      lambda m: m[0].data.nbytes + m[0].indices.nbytes + m[0].indptr.nbytes
                      + m[1].nbytes)
@@ -180,7 +193,7 @@ def _constraint_map(basis: BSplineBasis, start: str, end: str
     size = basis.size
     eliminated: dict[int, NDArray[np.float64]] = {}   # coefficient -> row over all columns
     for which, preset in ((0, start), (1, end)):
-        C = end_constraints(basis, which, preset).toarray()
+        C = _end_rows(basis, which, preset)
         if C.shape[0] == 0:
             continue
         support = np.flatnonzero(np.any(C != 0, axis=0))
