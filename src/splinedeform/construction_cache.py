@@ -27,6 +27,7 @@ time a construction from scratch); :func:`cache_info` tells their sizes.
 
 from __future__ import annotations
 
+import threading
 from collections import OrderedDict
 from typing import Any, Callable, Hashable
 
@@ -40,6 +41,8 @@ class BoundedCache:
 
     ``nbytes(value)`` measures a value; a value larger than ``max_bytes`` is computed but
     not kept. Registered under ``name`` for :func:`clear_caches` and :func:`cache_info`.
+    Safe to share between threads (a lock around the map; two threads missing the same key
+    both compute it, the first result is kept).
     """
 
     def __init__(self, name: str, entries: int, max_bytes: int,
@@ -48,28 +51,33 @@ class BoundedCache:
         self._data: OrderedDict[Hashable, tuple[Any, int]] = OrderedDict()
         self.bytes = 0
         self.hits = self.misses = 0
+        self._lock = threading.Lock()
         _CACHES[name] = self
 
     def get(self, key: Hashable, make: Callable[[], Any]) -> Any:
         """The value kept under ``key``, else ``make()`` (kept when it fits)."""
-        found = self._data.get(key)
-        if found is not None:
-            self._data.move_to_end(key)
-            self.hits += 1
-            return found[0]
-        self.misses += 1
-        value = make()
+        with self._lock:
+            found = self._data.get(key)
+            if found is not None:
+                self._data.move_to_end(key)
+                self.hits += 1
+                return found[0]
+            self.misses += 1
+        value = make()                      # outside the lock: it may use other caches
         size = int(self.nbytes(value))
         if size <= self.max_bytes:
-            self._data[key] = (value, size)
-            self.bytes += size
-            while len(self._data) > self.entries or self.bytes > self.max_bytes:
-                self.bytes -= self._data.popitem(last=False)[1][1]
+            with self._lock:
+                if key not in self._data:
+                    self._data[key] = (value, size)
+                    self.bytes += size
+                while len(self._data) > self.entries or self.bytes > self.max_bytes:
+                    self.bytes -= self._data.popitem(last=False)[1][1]
         return value
 
     def clear(self) -> None:
-        self._data.clear()
-        self.bytes = self.hits = self.misses = 0
+        with self._lock:
+            self._data.clear()
+            self.bytes = self.hits = self.misses = 0
 
     def __len__(self) -> int:
         return len(self._data)
