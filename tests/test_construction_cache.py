@@ -139,3 +139,42 @@ def test_reduced_matrices_equal_the_reduction_of_dense_kronecker_sums(name):
                                        atol=1e-12 * np.abs(expected[key]).max())
         model.gram_u[0].data[:] = 0.0
     assert cache_info()["reduced"]["hits"] >= 2
+
+
+def test_principal_submatrices_equal_scipys_selection():
+    """``A[keep][:, keep]`` for matrices on one pattern: a selection moves entries without
+    arithmetic (compared to 1e-15 of the largest, which any rounding would exceed)."""
+    from splinedeform.kronecker import principal_submatrices
+
+    rng = np.random.default_rng(5)
+    A = sp.random(30, 30, 0.2, random_state=rng, format="csc")
+    A = (A + A.T).tocsc()
+    A.sum_duplicates()
+    B = A.copy()
+    B.data = rng.standard_normal(B.nnz)
+    keep = np.flatnonzero(rng.random(30) < 0.6)
+    for got, full in zip(principal_submatrices([A, B], keep), (A, B)):
+        expected = full.toarray()[np.ix_(keep, keep)]
+        assert got.format == "csc" and got.has_canonical_format
+        got.check_format(full_check=True)
+        np.testing.assert_allclose(got.toarray(), expected, rtol=0,
+                                   atol=1e-15 * np.abs(expected).max())
+
+
+@pytest.mark.parametrize("knots, boundary", [("open", "free"), ("uniform", "clamped")])
+def test_a_free_region_that_is_no_rectangle_takes_the_submatrices_of_the_rectangle(
+        knots, boundary):
+    """Fixed points off a rectangle: ``K_r``, ``M_r``, ``C_r`` equal ``Tᵀ K T`` etc. of
+    the whole net's matrices (a few roundings of sums of O(max) terms: 1e-12)."""
+    surface = sd.shapes.plane(cells=(7, 6), knots=knots)
+    fixed = np.zeros(surface.shape, dtype=bool)
+    fixed[3, 4] = fixed[5, 1] = True
+    model = sd.Model(surface, PLATE, boundary=boundary, fixed=fixed)
+    assert model.constraints.T_u is None and model.constraints.masked is not None
+    T = model.T
+    K, M = model.K_full, model.M_full
+    C = (PLATE.damping / PLATE.mass) * M + PLATE.rayleigh * K
+    for got, full in zip(model.matrices(), (M, C, K)):
+        expected = (T.T @ full @ T).toarray()
+        np.testing.assert_allclose(got.toarray(), expected, rtol=0,
+                                   atol=1e-12 * np.abs(expected).max())

@@ -28,14 +28,16 @@ import scipy.sparse as sp
 
 from .construction_cache import BoundedCache, read_only
 from .errors import InputError
-from .kronecker import KroneckerLayout, compressed, content, kronecker_sum, kronecker_sums
+from .kronecker import (KroneckerLayout, compressed, content, kronecker_sum, kronecker_sums,
+                        principal_submatrices)
 from .material import Material
 from .physics import intrinsic, rational_plate
 from .quadrature import gram_set
 from .surface import Surface
 
 __all__ = ["KroneckerLayout", "kronecker_sum", "kronecker_sums", "full_matrices",
-           "reduced_matrices", "reduced_factors", "gram_matrices", "patch_matrices"]
+           "reduced_matrices", "masked_matrices", "reduced_factors", "gram_matrices",
+           "patch_matrices"]
 
 _REDUCED = BoundedCache("reduced", 64, 64 * 2**20,
                         lambda factors: sum(G.data.nbytes + G.indices.nbytes
@@ -152,6 +154,27 @@ def reduced_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix],
     with np.errstate(over="ignore", invalid="ignore"):      # scales are checked later
         C = compressed(sp.csc_matrix, viscous * M.data + material.rayleigh * K.data,
                        K.indices, K.indptr, shape)           # the same layout as K and M
+    return K, M, C
+
+
+def masked_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix],
+                    material: Material, lumped: bool, constraints: Any
+                    ) -> tuple[sp.csc_matrix, sp.csc_matrix, sp.csc_matrix] | None:
+    """``(K_r, M_r, C_r)`` of fixed points that leave no rectangle free, in CSC.
+
+    ``T = (T_u ⊗ T_v)[:, c]`` (:attr:`~splinedeform.boundary.Constraints.masked`), so
+    ``Tᵀ A T = ((T_u ⊗ T_v)ᵀ A (T_u ⊗ T_v))[c][:, c]``: the principal submatrices ``c`` of
+    the matrices :func:`reduced_matrices` makes from the factors of ``T_u`` and ``T_v``.
+    ``None`` without such a map, or for a lumped mass (its ``Tᵀ M T`` is made as it is).
+    """
+    masked = getattr(constraints, "masked", None)
+    if masked is None or lumped:
+        return None
+    T_u, T_v, columns = masked
+    factors = ReducedFactors(_reduced(gram_u, T_u), _reduced(gram_v, T_v))
+    reduced = reduced_matrices(gram_u, gram_v, material, False, constraints, factors)
+    assert reduced is not None                  # the factors are given
+    K, M, C = principal_submatrices(reduced, columns)
     return K, M, C
 
 

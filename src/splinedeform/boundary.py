@@ -241,6 +241,10 @@ class Constraints:
         Flat index of the control point each free coordinate stands for.
     edges : dict
         The edge presets.
+    masked : ``(T_u, T_v, columns)`` or ``None``
+        Where fixed points leave a free region that is no rectangle: ``T = (T_u ⊗
+        T_v)[:, columns]``, so ``Tᵀ A T`` is the principal submatrix ``columns`` of
+        ``(T_u ⊗ T_v)ᵀ A (T_u ⊗ T_v)`` (:func:`splinedeform.assembly.masked_matrices`).
     """
 
     T: sp.csr_matrix
@@ -249,6 +253,7 @@ class Constraints:
     free_index: NDArray[np.int64]
     edges: dict[str, str]
     has_fixed_points: bool
+    masked: tuple[sp.csr_matrix, sp.csr_matrix, NDArray[np.int64]] | None = None
 
     @property
     def n_free(self) -> int:
@@ -301,9 +306,10 @@ def build_constraints(basis_u: BSplineBasis, basis_v: BSplineBasis,
         T = kron(T_u, T_v)
         free_index = (keep_u[rows_u][:, None] * n_v + keep_v[rows_v][None, :]).ravel()
         return Constraints(T, T_u, T_v, free_index, edges, bool(mask.any()))
-    T = kron(T_u, T_v)[:, moving.ravel()]
-    return Constraints(T.tocsr(), None, None, free_index[moving.ravel()], edges,
-                       bool(mask.any()))
+    columns = np.flatnonzero(moving.ravel())
+    T = kron(T_u, T_v)[:, columns]
+    return Constraints(T.tocsr(), None, None, free_index[columns], edges, bool(mask.any()),
+                       (T_u, T_v, columns))
 
 
 def _check_mask(fixed: NDArray[np.bool_], basis_u: BSplineBasis, basis_v: BSplineBasis

@@ -190,3 +190,28 @@ def kronecker_sums(sums: Sequence[Sequence[tuple[float, sp.spmatrix, sp.spmatrix
 def kron(A: sp.spmatrix, B: sp.spmatrix, format: str = "csr") -> sp.spmatrix:
     """``A ⊗ B`` in CSR (or CSC) form, on the stored entries of both."""
     return kronecker_sum([(1.0, A, B)], format=format)
+
+
+def principal_submatrices(matrices: Sequence[sp.spmatrix], keep: np.ndarray
+                          ) -> list[sp.spmatrix]:
+    """``A[keep][:, keep]`` of square compressed matrices sharing one canonical pattern
+    (``keep`` sorted), selected together: the lines ``keep``, then in them the entries whose
+    other index is kept, renumbered (the order stays sorted)."""
+    A = matrices[0]
+    n = A.shape[0]
+    dtype = index_dtype(A.nnz, n + 1)
+    new = np.full(n, -1, dtype=np.int64)
+    new[keep] = np.arange(keep.size)
+    counts = np.diff(A.indptr)[keep]
+    start = np.repeat(A.indptr[keep].astype(np.int64) - np.cumsum(counts) + counts, counts)
+    positions = np.arange(start.size) + start             # the entries of the kept lines
+    other = new[A.indices[positions]]
+    stored = other >= 0
+    positions, other = positions[stored], other[stored].astype(dtype)
+    line = np.repeat(np.arange(keep.size), counts)[stored]
+    indptr = np.zeros(keep.size + 1, dtype=dtype)
+    np.cumsum(np.bincount(line, minlength=keep.size), out=indptr[1:])
+    cls = type(A)
+    return [compressed(cls, B.data[positions], other, indptr, (keep.size, keep.size))
+            for B in matrices]
+
