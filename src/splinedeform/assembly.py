@@ -152,8 +152,9 @@ def reduced_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix],
     stiff_terms = [(w, i) for i, (w, _, _) in enumerate(stiff, start=1)]
     K, M = layout.sums([stiff_terms, [(material.mass, 0)]], shape)
     with np.errstate(over="ignore", invalid="ignore"):      # scales are checked later
-        C = compressed(sp.csc_matrix, viscous * M.data + material.rayleigh * K.data,
-                       K.indices, K.indptr, shape)           # the same layout as K and M
+        damping = np.multiply(M.data, viscous)
+        damping += material.rayleigh * K.data
+        C = compressed(sp.csc_matrix, damping, K.indices, K.indptr, shape)  # K's, M's layout
     return K, M, C
 
 
@@ -239,5 +240,6 @@ def patch_matrices(surface: Surface, material: Material, physics: str, lumped: b
 
 
 def _largest(A: sp.spmatrix) -> float:
-    """``max |A_ij|`` (0 for an empty matrix; NaN propagates)."""
-    return float(np.abs(A.data).max()) if A.nnz else 0.0
+    """``max |A_ij| = max(max A_ij, -min A_ij)`` (0 for an empty matrix; NaN propagates;
+    no array of the absolute values is made)."""
+    return float(max(A.data.max(), -A.data.min())) if A.nnz else 0.0
