@@ -61,7 +61,8 @@ class _Pattern:
         (la, ca), (lb, cb) = other_a.shape, other_b.shape
         stored = (other_a >= 0)[:, None, :, None] & (other_b >= 0)[None, :, None, :]
         nnz = int(counts_a.sum()) * int(counts_b.sum())
-        dtype = index_dtype(nnz, la * lb + 1, la * ca * lb * cb)
+        dtype = index_dtype(nnz, la * lb + 1, la * ca * lb * cb,
+                            (int(other_a.max(initial=0)) + 1) * width_b)
         self.indptr = np.zeros(la * lb + 1, dtype=dtype)
         np.cumsum(np.outer(counts_a, counts_b).ravel(), out=self.indptr[1:])
         self.indices = ((other_a * width_b).astype(dtype)[:, None, :, None]
