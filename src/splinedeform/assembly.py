@@ -28,8 +28,7 @@ import scipy.sparse as sp
 
 from .construction_cache import BoundedCache, read_only
 from .errors import InputError
-from .kronecker import (KroneckerLayout, compressed, content, kronecker_sum, kronecker_sums,
-                        principal_submatrices)
+from .kronecker import KroneckerLayout, compressed, content, kronecker_sum, kronecker_sums
 from .material import Material
 from .physics import intrinsic, rational_plate
 from .quadrature import gram_set
@@ -123,7 +122,7 @@ def _reduced(grams: Sequence[sp.spmatrix], T: sp.spmatrix) -> list[sp.csc_matrix
 
 def reduced_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix],
                      material: Material, lumped: bool, constraints: Any,
-                     factors: ReducedFactors | None = None
+                     factors: ReducedFactors | None = None, keep: np.ndarray | None = None
                      ) -> tuple[sp.csc_matrix, sp.csc_matrix, sp.csc_matrix] | None:
     """``(K_r, M_r, C_r) = (Tᵀ K T, Tᵀ M T, Tᵀ C T)`` from the reduced 1-D factors, in CSC.
 
@@ -133,7 +132,9 @@ def reduced_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix],
     compressed layout: ``K_r`` and ``M_r`` two sums of Kronecker products of the same 1-D
     factors, ``C_r`` their combination entry by entry.
     ``factors``: those of :func:`reduced_factors` when already at hand (models of one
-    geometry and several materials share them and their layouts).
+    geometry and several materials share them and their layouts). ``keep`` (consistent
+    mass only): the principal submatrices ``[keep][:, keep]`` only, on the restricted
+    layout (:meth:`~splinedeform.kronecker.KroneckerLayout.restricted`).
     """
     if factors is None:
         factors = reduced_factors(gram_u, gram_v, constraints)
@@ -149,6 +150,9 @@ def reduced_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix],
     stiff = [(w, a, b) for w, a, b in _weighted_orders(material) if w]
     # the orders summed: the mass's (0, 0) first, then the stiffness's
     layout = factors.layout([(0, 0)] + [(a, b) for _, a, b in stiff])
+    if keep is not None:
+        layout = layout.restricted(keep)
+        shape = (keep.size, keep.size)
     stiff_terms = [(w, i) for i, (w, _, _) in enumerate(stiff, start=1)]
     K, M = layout.sums([stiff_terms, [(material.mass, 0)]], shape)
     with np.errstate(over="ignore", invalid="ignore"):      # scales are checked later
@@ -165,7 +169,8 @@ def masked_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix],
 
     ``T = (T_u ⊗ T_v)[:, c]`` (:attr:`~splinedeform.boundary.Constraints.masked`), so
     ``Tᵀ A T = ((T_u ⊗ T_v)ᵀ A (T_u ⊗ T_v))[c][:, c]``: the principal submatrices ``c`` of
-    the matrices :func:`reduced_matrices` makes from the factors of ``T_u`` and ``T_v``.
+    the matrices :func:`reduced_matrices` makes from the factors of ``T_u`` and ``T_v``,
+    summed on the restricted layout only.
     ``None`` without such a map, or for a lumped mass (its ``Tᵀ M T`` is made as it is).
     """
     masked = getattr(constraints, "masked", None)
@@ -173,10 +178,7 @@ def masked_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix],
         return None
     T_u, T_v, columns = masked
     factors = ReducedFactors(_reduced(gram_u, T_u), _reduced(gram_v, T_v))
-    reduced = reduced_matrices(gram_u, gram_v, material, False, constraints, factors)
-    assert reduced is not None                  # the factors are given
-    K, M, C = principal_submatrices(reduced, columns)
-    return K, M, C
+    return reduced_matrices(gram_u, gram_v, material, False, constraints, factors, columns)
 
 
 def full_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], material: Material,

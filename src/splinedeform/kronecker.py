@@ -15,6 +15,7 @@ it takes without checks of their contents or copies.
 
 from __future__ import annotations
 
+import copy
 from typing import Sequence
 
 import numpy as np
@@ -75,6 +76,17 @@ class _Pattern:
         self.nbytes = self.indptr.nbytes + self.indices.nbytes + self.positions.nbytes
 
 
+class _Restricted:
+    """A :class:`_Pattern` restricted to the principal submatrix ``keep`` of a layout."""
+
+    def __init__(self, layout: "KroneckerLayout", keep: np.ndarray) -> None:
+        entries, self.indices, self.indptr = _principal(layout.indptr, layout.indices,
+                                                        layout.full_shape[0], keep)
+        self.positions = layout.positions[entries]
+        read_only(self.indptr, self.indices, self.positions)
+        self.nbytes = self.indptr.nbytes + self.indices.nbytes + self.positions.nbytes
+
+
 class KroneckerLayout:
     """The compressed layout of sums ``Σ_t w_t A_t ⊗ B_t`` over fixed factor pairs
     (module docstring): the cached pattern of the two union patterns and the factors'
@@ -96,11 +108,26 @@ class KroneckerLayout:
                other_b.tobytes())
         pattern = _PATTERNS.get(key, lambda: _Pattern(other_a, other_b, width_b, counts_a,
                                                       counts_b))
+        self._key = key
         self.indptr, self.indices, self.positions = (pattern.indptr, pattern.indices,
                                                      pattern.positions)
         self.full_shape = (shape_a[0] * shape_b[0], shape_a[1] * shape_b[1])
         read_only(self.values_a, self.values_b)
         self.nbytes = pattern.nbytes + self.values_a.nbytes + self.values_b.nbytes
+
+    def restricted(self, keep: np.ndarray) -> KroneckerLayout:
+        """The layout of the principal submatrices ``[keep][:, keep]`` of its sums (square
+        sums, ``keep`` sorted): the pattern's entries of the kept lines and other indices,
+        renumbered, from the ``layout`` cache."""
+        keep = np.asarray(keep, dtype=np.int64)
+        key = (self._key, "restricted", keep.tobytes())
+        pattern = _PATTERNS.get(key, lambda: _Restricted(self, keep))
+        new = copy.copy(self)
+        new.indptr, new.indices, new.positions = (pattern.indptr, pattern.indices,
+                                                  pattern.positions)
+        new.full_shape, new._key = (keep.size, keep.size), key
+        new.nbytes = pattern.nbytes + self.values_a.nbytes + self.values_b.nbytes
+        return new
 
     @classmethod
     def of(cls, pairs: Sequence[tuple[sp.spmatrix, sp.spmatrix]], format: str = "csr"
@@ -196,23 +223,28 @@ def kron(A: sp.spmatrix, B: sp.spmatrix, format: str = "csr") -> sp.spmatrix:
 def principal_submatrices(matrices: Sequence[sp.spmatrix], keep: np.ndarray
                           ) -> list[sp.spmatrix]:
     """``A[keep][:, keep]`` of square compressed matrices sharing one canonical pattern
-    (``keep`` sorted), selected together: the lines ``keep``, then in them the entries whose
-    other index is kept, renumbered (the order stays sorted)."""
+    (``keep`` sorted), selected together (:func:`_principal`)."""
     A = matrices[0]
-    n = A.shape[0]
-    dtype = index_dtype(A.nnz, n + 1)
-    new = np.full(n, -1, dtype=np.int64)
-    new[keep] = np.arange(keep.size)
-    counts = np.diff(A.indptr)[keep]
-    start = np.repeat(A.indptr[keep].astype(np.int64) - np.cumsum(counts) + counts, counts)
-    positions = np.arange(start.size) + start             # the entries of the kept lines
-    other = new[A.indices[positions]]
-    stored = other >= 0
-    positions, other = positions[stored], other[stored].astype(dtype)
-    line = np.repeat(np.arange(keep.size), counts)[stored]
-    indptr = np.zeros(keep.size + 1, dtype=dtype)
-    np.cumsum(np.bincount(line, minlength=keep.size), out=indptr[1:])
-    cls = type(A)
-    return [compressed(cls, B.data[positions], other, indptr, (keep.size, keep.size))
+    entries, indices, indptr = _principal(A.indptr, A.indices, A.shape[0],
+                                          np.asarray(keep, dtype=np.int64))
+    return [compressed(type(A), B.data[entries], indices, indptr, (keep.size, keep.size))
             for B in matrices]
 
+
+def _principal(indptr: np.ndarray, indices: np.ndarray, n: int, keep: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The principal submatrix ``keep`` (sorted) of a canonical ``n × n`` pattern: the
+    stored entries of the kept lines whose other index is kept, their other indices
+    renumbered (still sorted) and the new ``indptr``."""
+    dtype = index_dtype(indices.size, n + 1)
+    new = np.full(n, -1, dtype=np.int64)
+    new[keep] = np.arange(keep.size)
+    counts = np.diff(indptr)[keep]
+    start = np.repeat(indptr[keep].astype(np.int64) - np.cumsum(counts) + counts, counts)
+    entries = np.arange(start.size) + start               # the entries of the kept lines
+    other = new[indices[entries]]
+    stored = other >= 0
+    line = np.repeat(np.arange(keep.size), counts)[stored]
+    out_indptr = np.zeros(keep.size + 1, dtype=dtype)
+    np.cumsum(np.bincount(line, minlength=keep.size), out=out_indptr[1:])
+    return entries[stored], other[stored].astype(dtype), out_indptr
