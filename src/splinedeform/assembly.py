@@ -9,7 +9,14 @@ with exact 1-D Gram matrices ``G_a`` (:func:`splinedeform.quadrature.gram_matrix
 Constraints of tensor-product form ``T = T_u ⊗ T_v`` reduce each factor apart,
 ``Tᵀ (A ⊗ B) T = (T_uᵀ A T_u) ⊗ (T_vᵀ B T_v)``, so the reduced matrices are assembled
 from 1-D matrices without forming ``Tᵀ K T``. Every sum of Kronecker products is built
-directly in compressed form on the union of the terms' patterns (:func:`kronecker_sum`).
+directly in compressed form on the union of the terms' patterns
+(:mod:`splinedeform.kronecker`, :func:`kronecker_sum`).
+
+What depends on the geometry alone is cached (:mod:`splinedeform.construction_cache`): the
+1-D Gram matrices, the 1-D constraint maps, the reduced 1-D factors ``T_uᵀ G_a^u T_u``
+(the ``reduced`` cache here, keyed by the bytes of ``T_1d`` and the ``G_a``) and the
+Kronecker layouts, so that a model built again on the same net assembles only the weighted
+sums. ``splinedeform.construction_cache.clear_caches()`` empties them.
 """
 
 from __future__ import annotations
@@ -19,11 +26,21 @@ from typing import Any, Sequence
 import numpy as np
 import scipy.sparse as sp
 
+from .construction_cache import BoundedCache, read_only
 from .errors import InputError
+from .kronecker import KroneckerLayout, compressed, content, kronecker_sum, kronecker_sums
 from .material import Material
 from .physics import intrinsic, rational_plate
-from .quadrature import gram_matrix
+from .quadrature import gram_set
 from .surface import Surface
+
+__all__ = ["KroneckerLayout", "kronecker_sum", "kronecker_sums", "full_matrices",
+           "reduced_matrices", "masked_matrices", "reduced_factors", "gram_matrices",
+           "patch_matrices"]
+
+_REDUCED = BoundedCache("reduced", 64, 64 * 2**20,
+                        lambda factors: sum(G.data.nbytes + G.indices.nbytes
+                                            + G.indptr.nbytes for G in factors))
 
 
 def stiffness_terms(gram_u: Sequence[sp.spmatrix], gram_v: Sequence[sp.spmatrix],
@@ -60,9 +77,10 @@ class ReducedFactors:
     """The reduced 1-D Gram matrices ``T_uᵀ G_a^u T_u`` (``u``) and ``T_vᵀ G_b^v T_v``
     (``v``) of one geometry, and the compressed layouts of their sums
     (:class:`KroneckerLayout`) by the orders ``(a, b)`` they sum: what models of several
-    materials on that geometry share."""
+    materials on that geometry share. The factors are CSC (the layouts' format), their
+    arrays read-only (the ``reduced`` cache's)."""
 
-    def __init__(self, u: list[sp.csr_matrix], v: list[sp.csr_matrix]) -> None:
+    def __init__(self, u: list[sp.csc_matrix], v: list[sp.csc_matrix]) -> None:
         self.u, self.v = u, v
         self._layouts: dict[tuple[tuple[int, int], ...], KroneckerLayout] = {}
 
@@ -70,8 +88,8 @@ class ReducedFactors:
         """The CSC layout of sums of ``u[a] ⊗ v[b]`` over ``orders``, made once."""
         key = tuple(orders)
         if key not in self._layouts:
-            self._layouts[key] = KroneckerLayout([(self.u[a], self.v[b]) for a, b in key],
-                                                 "csc")
+            self._layouts[key] = KroneckerLayout.of([(self.u[a], self.v[b]) for a, b in key],
+                                                    "csc")
         return self._layouts[key]
 
 
@@ -82,22 +100,41 @@ def reduced_factors(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], constr
     T_u, T_v = constraints.T_u, constraints.T_v
     if T_u is None or T_v is None:
         return None
-    return ReducedFactors([(T_u.T @ G @ T_u).tocsr() for G in gram_u],
-                          [(T_v.T @ G @ T_v).tocsr() for G in gram_v])
+    return ReducedFactors(_reduced(gram_u, T_u), _reduced(gram_v, T_v))
+
+
+def _reduced(grams: Sequence[sp.spmatrix], T: sp.spmatrix) -> list[sp.csc_matrix]:
+    """``[T_1dᵀ G_a T_1d]`` of one direction, from the ``reduced`` cache
+    (:mod:`splinedeform.construction_cache`; keyed by the matrices' bytes, read-only)."""
+    key = tuple(content(A) for A in (T, *grams))
+
+    def make() -> tuple[sp.csc_matrix, ...]:
+        out = []
+        for G in grams:
+            R = (T.T @ G @ T).tocsc()
+            R.sum_duplicates()
+            read_only(R.data, R.indices, R.indptr)
+            out.append(R)
+        return tuple(out)
+
+    return list(_REDUCED.get(key, make))
 
 
 def reduced_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix],
                      material: Material, lumped: bool, constraints: Any,
-                     factors: ReducedFactors | None = None
+                     factors: ReducedFactors | None = None, keep: np.ndarray | None = None
                      ) -> tuple[sp.csc_matrix, sp.csc_matrix, sp.csc_matrix] | None:
     """``(K_r, M_r, C_r) = (Tᵀ K T, Tᵀ M T, Tᵀ C T)`` from the reduced 1-D factors, in CSC.
 
     ``C = (γ/μ) M + β K`` (viscous and Rayleigh damping). ``None`` unless the constraints
     are of tensor-product form (``T_u``, ``T_v`` known). A lumped (diagonal) mass is
     reduced as it is, ``Tᵀ M T``. The consistent ``K_r``, ``M_r`` and ``C_r`` share one
-    compressed layout: three sums of Kronecker products of the same 1-D factors.
+    compressed layout: ``K_r`` and ``M_r`` two sums of Kronecker products of the same 1-D
+    factors, ``C_r`` their combination entry by entry.
     ``factors``: those of :func:`reduced_factors` when already at hand (models of one
-    geometry and several materials share them and their layouts).
+    geometry and several materials share them and their layouts). ``keep`` (consistent
+    mass only): the principal submatrices ``[keep][:, keep]`` only, on the restricted
+    layout (:meth:`~splinedeform.kronecker.KroneckerLayout.restricted`).
     """
     if factors is None:
         factors = reduced_factors(gram_u, gram_v, constraints)
@@ -113,11 +150,35 @@ def reduced_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix],
     stiff = [(w, a, b) for w, a, b in _weighted_orders(material) if w]
     # the orders summed: the mass's (0, 0) first, then the stiffness's
     layout = factors.layout([(0, 0)] + [(a, b) for _, a, b in stiff])
+    if keep is not None:
+        layout = layout.restricted(keep)
+        shape = (keep.size, keep.size)
     stiff_terms = [(w, i) for i, (w, _, _) in enumerate(stiff, start=1)]
-    K, M, C = layout.sums([stiff_terms, [(material.mass, 0)],
-                           [(viscous * material.mass, 0)] +
-                           [(material.rayleigh * w, i) for w, i in stiff_terms]], shape)
+    K, M = layout.sums([stiff_terms, [(material.mass, 0)]], shape)
+    with np.errstate(over="ignore", invalid="ignore"):      # scales are checked later
+        damping = np.multiply(M.data, viscous)
+        damping += material.rayleigh * K.data
+        C = compressed(sp.csc_matrix, damping, K.indices, K.indptr, shape)  # K's, M's layout
     return K, M, C
+
+
+def masked_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix],
+                    material: Material, lumped: bool, constraints: Any
+                    ) -> tuple[sp.csc_matrix, sp.csc_matrix, sp.csc_matrix] | None:
+    """``(K_r, M_r, C_r)`` of fixed points that leave no rectangle free, in CSC.
+
+    ``T = (T_u ⊗ T_v)[:, c]`` (:attr:`~splinedeform.boundary.Constraints.masked`), so
+    ``Tᵀ A T = ((T_u ⊗ T_v)ᵀ A (T_u ⊗ T_v))[c][:, c]``: the principal submatrices ``c`` of
+    the matrices :func:`reduced_matrices` makes from the factors of ``T_u`` and ``T_v``,
+    summed on the restricted layout only.
+    ``None`` without such a map, or for a lumped mass (its ``Tᵀ M T`` is made as it is).
+    """
+    masked = getattr(constraints, "masked", None)
+    if masked is None or lumped:
+        return None
+    T_u, T_v, columns = masked
+    factors = ReducedFactors(_reduced(gram_u, T_u), _reduced(gram_v, T_v))
+    return reduced_matrices(gram_u, gram_v, material, False, constraints, factors, columns)
 
 
 def full_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], material: Material,
@@ -129,91 +190,6 @@ def full_matrices(gram_u: list[sp.spmatrix], gram_v: list[sp.spmatrix], material
     K, M = kronecker_sums([stiffness_terms(gram_u, gram_v, material),
                            [(material.mass, gram_u[0], gram_v[0])]], shape)
     return K, M
-
-
-def kronecker_sum(terms: Sequence[tuple[float, sp.spmatrix, sp.spmatrix]],
-                  shape: tuple[int, int] | None = None, format: str = "csr") -> sp.spmatrix:
-    """``Σ_t w_t A_t ⊗ B_t`` assembled directly in CSR (or CSC) form (:func:`kronecker_sums`)."""
-    return kronecker_sums([terms], shape, format)[0]
-
-
-def kronecker_sums(sums: Sequence[Sequence[tuple[float, sp.spmatrix, sp.spmatrix]]],
-                   shape: tuple[int, int] | None = None, format: str = "csr"
-                   ) -> list[sp.spmatrix]:
-    """Several sums ``Σ_t w_t A_t ⊗ B_t`` on one shared compressed layout
-    (:class:`KroneckerLayout` of all their terms' factors)."""
-    cls = sp.csr_matrix if format == "csr" else sp.csc_matrix
-    if not any(sums):
-        return [cls(shape) for _ in sums]
-    pairs = [(A, B) for terms in sums for _, A, B in terms]
-    layout = KroneckerLayout(pairs, format)
-    index, out = 0, []
-    for terms in sums:
-        out.append([(w, index + i) for i, (w, _, _) in enumerate(terms)])
-        index += len(terms)
-    return layout.sums(out, shape)
-
-
-class KroneckerLayout:
-    """The compressed layout of sums ``Σ_t w_t A_t ⊗ B_t`` over fixed factor pairs.
-
-    On the union patterns of all the ``A_t`` and of all the ``B_t``, each stored as a
-    padded table ``(line, slot)`` of its compressed lines (rows for CSR, columns for
-    CSC), the value of a sum at the entry pair ``((i, e), (k, f))`` is
-    ``Σ_t w_t A_t[i, e] B_t[k, f]``: one matrix product ``Aᵀ W B`` of the stacked tables
-    (``W = diag w``). Line ``(i, k)`` of ``P_A ⊗ P_B`` (``i n_B + k``) holds the entries
-    of line ``i`` of ``P_A`` times those of line ``k`` of ``P_B``, ``e``-major, which is
-    also the order of their other indices ``j m_B + l``: the product read in the order
-    ``(i, k, e, f)``, less the padding, is the compressed data. The layout and the
-    factors' tables are computed once; a sum of other weights is one product.
-    """
-
-    def __init__(self, pairs: Sequence[tuple[sp.spmatrix, sp.spmatrix]],
-                 format: str = "csr") -> None:
-        self.cls = sp.csr_matrix if format == "csr" else sp.csc_matrix
-        pairs = [(self.cls(A), self.cls(B)) for A, B in pairs]
-        PA = _union_pattern([A for A, _ in pairs])
-        PB = _union_pattern([B for _, B in pairs])
-        other_a, _ = _table(PA, PA.indices)
-        other_b, _ = _table(PB, PB.indices)
-        stored = (other_a >= 0)[:, None, :, None] & (other_b >= 0)[None, :, None, :]
-        self.indptr = np.zeros(stored.shape[0] * stored.shape[1] + 1, dtype=np.int64)
-        np.cumsum(np.outer(np.diff(PA.indptr), np.diff(PB.indptr)).ravel(),
-                  out=self.indptr[1:])
-        width_b = PB.shape[1] if format == "csr" else PB.shape[0]
-        self.indices = (other_a[:, None, :, None] * width_b
-                        + other_b[None, :, None, :])[stored]
-        la, ca = other_a.shape
-        lb, cb = other_b.shape
-        # where each stored (i, k, e, f) sits in the product's (i e, k f) layout
-        i, k, e, f = np.nonzero(stored)
-        self.positions = ((i * ca + e) * lb + k) * cb + f
-        self.full_shape = (PA.shape[0] * PB.shape[0], PA.shape[1] * PB.shape[1])
-        self.values_a = np.stack([_table(PA, _values_on(A, PA))[0] for A, _ in pairs])
-        self.values_b = np.stack([_table(PB, _values_on(B, PB))[0] for _, B in pairs])
-
-    def sums(self, sums: Sequence[Sequence[tuple[float, int]]],
-             shape: tuple[int, int] | None = None) -> list[sp.spmatrix]:
-        """``Σ_t w_t A_t ⊗ B_t`` for each list of ``(w_t, t)`` (``t``: a pair's index), on
-        one copy of the layout's index arrays (theirs, not the layout's, to keep)."""
-        indices, indptr = self.indices.copy(), self.indptr.copy()
-        out = []
-        for terms in sums:
-            if terms:
-                weights = np.array([w for w, _ in terms], dtype=float)
-                index = [t for _, t in terms]
-                values_a, values_b = self.values_a[index], self.values_b[index]
-                with np.errstate(over="ignore", invalid="ignore"):  # scales are checked later
-                    product = ((values_a * weights[:, None, None]).reshape(len(terms), -1).T
-                               @ values_b.reshape(len(terms), -1))          # (i e, k f)
-                data = np.take(product.ravel(), self.positions)
-            else:
-                data = np.zeros(indices.size)
-            matrix = self.cls((data, indices, indptr),
-                              shape=self.full_shape if shape is None else shape)
-            matrix.has_sorted_indices = True
-            out.append(matrix)
-        return out
 
 
 def check_bending(surface: Surface, material: Material) -> None:
@@ -232,9 +208,8 @@ def check_bending(surface: Surface, material: Material) -> None:
 
 def gram_matrices(surface: Surface) -> tuple[list[sp.csr_matrix], list[sp.csr_matrix]]:
     """The 1-D Gram matrices ``G_a = ∫ N^(a) N^(a)ᵀ`` of both directions, ``a ≤ min(2, n)``."""
-    top = lambda b: min(2, b.degree)  # noqa: E731
-    return ([gram_matrix(surface.basis_u, a) for a in range(top(surface.basis_u) + 1)],
-            [gram_matrix(surface.basis_v, a) for a in range(top(surface.basis_v) + 1)])
+    return (gram_set(surface.basis_u, range(min(2, surface.basis_u.degree) + 1)),
+            gram_set(surface.basis_v, range(min(2, surface.basis_v.degree) + 1)))
 
 
 def patch_matrices(surface: Surface, material: Material, physics: str, lumped: bool
@@ -266,43 +241,7 @@ def patch_matrices(surface: Surface, material: Material, physics: str, lumped: b
     return gram_u, gram_v, K, M
 
 
-def _table(pattern: sp.spmatrix, entries: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``entries`` (one per stored position of ``pattern``) as a table ``(line, slot)``.
-
-    Padding slots hold ``-1`` for integer entries and ``0`` for values; returns the table
-    and the slot of each stored position.
-    """
-    counts = np.diff(pattern.indptr)
-    line = np.repeat(np.arange(counts.size), counts)
-    slot = np.arange(pattern.nnz) - pattern.indptr[line]
-    fill = -1 if entries.dtype.kind in "iu" else 0.0
-    table = np.full((counts.size, int(counts.max()) if counts.size else 0), fill,
-                    dtype=np.int64 if fill == -1 else float)
-    table[line, slot] = entries
-    return table, slot
-
-
-def _union_pattern(matrices: Sequence[sp.spmatrix]) -> sp.spmatrix:
-    """Sorted compressed pattern of the entries stored in any of ``matrices`` (same format)."""
-    pattern = matrices[0].copy()
-    pattern.data = np.ones_like(pattern.data)
-    for A in matrices[1:]:
-        other = A.copy()
-        other.data = np.ones_like(other.data)
-        pattern = pattern + other
-    pattern.sum_duplicates()
-    pattern.sort_indices()
-    return pattern
-
-
-def _values_on(A: sp.spmatrix, pattern: sp.spmatrix) -> np.ndarray:
-    """Entries of ``A`` at the stored positions of ``pattern`` (zero where ``A`` stores none)."""
-    lines = np.repeat(np.arange(pattern.indptr.size - 1), np.diff(pattern.indptr))
-    if sp.isspmatrix_csr(pattern):
-        return np.asarray(A[lines, pattern.indices]).ravel()
-    return np.asarray(A[pattern.indices, lines]).ravel()
-
-
 def _largest(A: sp.spmatrix) -> float:
-    """``max |A_ij|`` (0 for an empty matrix; NaN propagates)."""
-    return float(np.abs(A.data).max()) if A.nnz else 0.0
+    """``max |A_ij| = max(max A_ij, -min A_ij)`` (0 for an empty matrix; NaN propagates;
+    no array of the absolute values is made)."""
+    return float(max(A.data.max(), -A.data.min())) if A.nnz else 0.0

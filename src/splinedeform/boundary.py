@@ -11,6 +11,11 @@ solved for as many of its outermost coefficients (pivoted), giving a sparse ``T_
 whose columns are the kept coefficients. Per-edge conditions give ``T = T_u ⊗ T_v``.
 A mask of fixed control points removes further columns (the paper's reduced set of moving
 control points); when the free region is a rectangle of the net the Kronecker form survives.
+
+The 1-D maps of a basis and two end presets are kept in the bounded ``constraint_map``
+cache of :mod:`splinedeform.construction_cache` (read-only there, each caller gets a copy;
+:func:`~splinedeform.construction_cache.clear_caches` empties it); ``T_u ⊗ T_v`` is built
+directly in CSR form (:func:`splinedeform.kronecker.kron`).
 """
 
 from __future__ import annotations
@@ -24,7 +29,9 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from .basis import BSplineBasis
+from .construction_cache import BoundedCache, basis_key, read_only
 from .errors import InputError
+from .kronecker import kron
 
 PRESETS = ("free", "pinned", "clamped", "pole")
 EDGES = ("u0", "u1", "v0", "v1")
@@ -146,20 +153,47 @@ def end_constraints(basis: BSplineBasis, end: int, preset: str) -> sp.csr_matrix
     return sp.vstack([basis.matrix(x, j) for j in range(order)]).tocsr()
 
 
+def _end_rows(basis: BSplineBasis, end: int, preset: str) -> NDArray[np.float64]:
+    """The rows of :func:`end_constraints` as a dense ``(r, size)`` array (one evaluation
+    of the basis and its derivatives at the end)."""
+    order = {"free": 0, "pole": 0, "pinned": 1, "clamped": 2}[preset]
+    C = np.zeros((order, basis.size))
+    if order:
+        index, values = basis.nonzero_derivatives(
+            np.array([0.0 if end == 0 else basis.length]), order - 1)
+        for j in range(order):
+            np.add.at(C[j], index[0], values[j, 0])
+    return C
+
+
+_MAPS = BoundedCache("constraint_map", 256, 64 * 2**20,
+                     lambda m: m[0].data.nbytes + m[0].indices.nbytes + m[0].indptr.nbytes
+                     + m[1].nbytes)
+
+
 def constraint_map(basis: BSplineBasis, start: str, end: str
                    ) -> tuple[sp.csr_matrix, NDArray[np.int64]]:
     """1-D constraint map ``T`` (size × kept) and the indices of the kept coefficients.
 
     The constrained coefficients of each end are eliminated: with the end's rows split into
-    the eliminated columns ``E`` and the rest ``R``, ``c_E = -C_E^{-1} C_R c_R``.
+    the eliminated columns ``E`` and the rest ``R``, ``c_E = -C_E^{-1} C_R c_R``. Copies of
+    the cached map of ``(basis, start, end)`` (module docstring).
     """
     if basis.periodic and (start, end) != ("free", "free"):
         raise InputError(f"a periodic direction has no edges; its boundary presets must be "
                          f"'free', got {start!r} and {end!r}")
+    T, kept = _MAPS.get((basis_key(basis), start, end),
+                        lambda: _constraint_map(basis, start, end))
+    return T.copy(), kept.copy()
+
+
+def _constraint_map(basis: BSplineBasis, start: str, end: str
+                    ) -> tuple[sp.csr_matrix, NDArray[np.int64]]:
+    """:func:`constraint_map` computed, its arrays read-only."""
     size = basis.size
     eliminated: dict[int, NDArray[np.float64]] = {}   # coefficient -> row over all columns
     for which, preset in ((0, start), (1, end)):
-        C = end_constraints(basis, which, preset).toarray()
+        C = _end_rows(basis, which, preset)
         if C.shape[0] == 0:
             continue
         support = np.flatnonzero(np.any(C != 0, axis=0))
@@ -189,7 +223,10 @@ def constraint_map(basis: BSplineBasis, start: str, end: str
         T[e] = row[kept]
         if np.any(row[list(eliminated)] != 0):
             raise InputError("edge conditions couple eliminated coefficients; use more cells")
-    return sp.csr_matrix(T), kept
+    T_1d = sp.csr_matrix(T)
+    T_1d.has_canonical_format = True
+    read_only(T_1d.data, T_1d.indices, T_1d.indptr, kept)
+    return T_1d, kept
 
 
 @dataclass(frozen=True)
@@ -204,6 +241,10 @@ class Constraints:
         Flat index of the control point each free coordinate stands for.
     edges : dict
         The edge presets.
+    masked : ``(T_u, T_v, columns)`` or ``None``
+        Where fixed points leave a free region that is no rectangle: ``T = (T_u ⊗
+        T_v)[:, columns]``, so ``Tᵀ A T`` is the principal submatrix ``columns`` of
+        ``(T_u ⊗ T_v)ᵀ A (T_u ⊗ T_v)`` (:func:`splinedeform.assembly.masked_matrices`).
     """
 
     T: sp.csr_matrix
@@ -212,6 +253,7 @@ class Constraints:
     free_index: NDArray[np.int64]
     edges: dict[str, str]
     has_fixed_points: bool
+    masked: tuple[sp.csr_matrix, sp.csr_matrix, NDArray[np.int64]] | None = None
 
     @property
     def n_free(self) -> int:
@@ -252,7 +294,7 @@ def build_constraints(basis_u: BSplineBasis, basis_v: BSplineBasis,
         return _with_poles(basis_u, basis_v, edges, poles, T_u, T_v, keep_u, keep_v, mask,
                            control_points)
     if mask is None:
-        T = sp.kron(T_u, T_v, format="csr")
+        T = kron(T_u, T_v)
         return Constraints(T, T_u, T_v, free_index, edges, False)
     moving = ~mask[np.ix_(keep_u, keep_v)]
     rows_u, rows_v = np.any(moving, axis=1), np.any(moving, axis=0)
@@ -261,12 +303,13 @@ def build_constraints(basis_u: BSplineBasis, basis_v: BSplineBasis,
         raise InputError("every control point is fixed: nothing can move")
     if rectangle:
         T_u, T_v = T_u[:, rows_u], T_v[:, rows_v]
-        T = sp.kron(T_u, T_v, format="csr")
+        T = kron(T_u, T_v)
         free_index = (keep_u[rows_u][:, None] * n_v + keep_v[rows_v][None, :]).ravel()
         return Constraints(T, T_u, T_v, free_index, edges, bool(mask.any()))
-    T = sp.kron(T_u, T_v, format="csr")[:, moving.ravel()]
-    return Constraints(T.tocsr(), None, None, free_index[moving.ravel()], edges,
-                       bool(mask.any()))
+    columns = np.flatnonzero(moving.ravel())
+    T = kron(T_u, T_v)[:, columns]
+    return Constraints(T.tocsr(), None, None, free_index[columns], edges, bool(mask.any()),
+                       (T_u, T_v, columns))
 
 
 def _check_mask(fixed: NDArray[np.bool_], basis_u: BSplineBasis, basis_v: BSplineBasis
@@ -313,7 +356,7 @@ def _with_poles(basis_u: BSplineBasis, basis_v: BSplineBasis, edges: dict[str, s
     """Merge the coordinates of each pole edge into one: ``T ← T S`` (tensor form is lost);
     the edges must be collapsed (:func:`check_poles`) when the net is given."""
     n_v = basis_v.size
-    T = sp.kron(T_u, T_v, format="csr")
+    T = kron(T_u, T_v)
     points = (keep_u[:, None] * n_v + keep_v[None, :]).ravel()     # control point per column
     group = np.arange(points.size)
     for edge in poles:

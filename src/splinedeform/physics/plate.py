@@ -22,8 +22,8 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
-from ..assembly import (ReducedFactors, full_matrices, gram_matrices, patch_matrices,
-                        reduced_factors, reduced_matrices)
+from ..assembly import (ReducedFactors, full_matrices, gram_matrices, masked_matrices,
+                        patch_matrices, reduced_factors, reduced_matrices)
 from ..body.loads import surface_field
 from ..boundary import Constraints, build_constraints
 from ..errors import InputError, SingularSystemError
@@ -135,11 +135,12 @@ def surface_system(surface: Surface, material: Material, boundary: str | Mapping
     """Assemble the plate of :class:`splinedeform.Model` on one surface.
 
     ``parametric`` with weights that factor: ``K_r``, ``M_r`` from the reduced Kronecker
-    factors (:func:`~splinedeform.assembly.reduced_matrices`) and ``C_r`` with them;
-    otherwise ``K_r = Tᵀ K T``, ``M_r = Tᵀ M T`` of the matrices of the whole net
-    (``intrinsic``, :mod:`.intrinsic`; a trimmed region,
-    :mod:`splinedeform.trim.model_matrices`; general NURBS weights), plus the penalty
-    tying the slopes across each C0 knot line (:mod:`.coupling_model`).
+    factors (:func:`~splinedeform.assembly.reduced_matrices`) and ``C_r`` with them, or
+    their principal submatrices where fixed points leave no rectangle free
+    (:func:`~splinedeform.assembly.masked_matrices`); otherwise ``K_r = Tᵀ K T``,
+    ``M_r = Tᵀ M T`` of the matrices of the whole net (``intrinsic``, :mod:`.intrinsic`; a
+    trimmed region, :mod:`splinedeform.trim.model_matrices`; general NURBS weights), plus
+    the penalty tying the slopes across each C0 knot line (:mod:`.coupling_model`).
     """
     lumped = mass_matrix == "lumped"
     trimmed = None if surface.trim is None else trimmed_system(
@@ -174,6 +175,8 @@ def surface_system(surface: Surface, material: Material, boundary: str | Mapping
     factors = None if full is not None else reduced_factors(gram_u, gram_v, constraints)
     reduced = None if factors is None else reduced_matrices(gram_u, gram_v, material, lumped,
                                                             constraints, factors)
+    if reduced is None and full is None:   # fixed points that leave no rectangle free
+        reduced = masked_matrices(gram_u, gram_v, material, lumped, constraints)
     if reduced is None:                    # Tᵀ K T of the whole net's matrices
         if full is None:
             full = full_matrices(gram_u, gram_v, material, lumped)
