@@ -155,7 +155,8 @@ def body_fixed_mask(patches: Sequence[Surface],
     ------
     InputError
         A count other than one per patch, or a mask of another shape than its patch's net
-        or not boolean, naming the patch.
+        or not boolean, or one that holds a point of a trimmed face (whose map is its own,
+        :func:`~splinedeform.body.trimmed.with_trimmed_faces`), naming the patch.
     """
     if fixed is None:
         return None
