@@ -192,6 +192,10 @@ FILE_TEXTS = [file_scenario("net.json", "frame = 0"),
               # an edge of a body's face clamped: run by tests/test_body_refine_run.py
               file_scenario("box.3dm", 'faces = [0, 1, 2, 3, 4]').replace('"file"', '"cad"')
               + '[boundary.faces]\n0 = { v1 = "clamped" }\n',
+              # the moving control points of one face of a body: run by
+              # tests/test_body_free_points.py
+              file_scenario("two.3dm", "").replace('"file"', '"cad"')
+              + '[boundary.faces_free_points]\n0 = [[2, 2], [2, 3]]\n',
               # probes on named faces of a body: run by tests/test_body_shell_run.py
               file_scenario("roof.3dm", "").replace('"file"', '"cad"')
               + '[output]\nprobes = [[0.0, 25.0]]\nprobe_faces = [0]\n',

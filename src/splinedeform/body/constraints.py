@@ -17,6 +17,12 @@ each), ``N = Σ n_u n_v``. The map ``d = T d_free`` is built in two steps:
    of ``T_b`` to classes, ``T = T_b S``: the columns of one class are summed, and a class
    with a member that its patch's edge condition fixes (a zero row of ``T_b``) is fixed as a
    whole. Displacement continuity across the interface is then exact.
+   **Fixed points.** A mask of fixed control points per patch (:func:`body_fixed_mask`)
+   fixes the classes of the points it marks as the edge presets do: a class with a masked
+   member is dropped from ``S``, so its rows of ``T`` are zero. A point shared by several
+   patches (one class) is therefore fixed when any one of them fixes it. As for a single
+   surface (:func:`splinedeform.boundary.build_constraints`), a point that its edge
+   condition determines from others (not a coefficient of its own) follows that condition.
 3. **Ties.** Where the energy bends, the tangent continuity across smooth conforming
    interfaces and C0 lines is imposed exactly too: ``T = T_b S E`` with
    ``range E = null(C T_b S)`` for the ties ``C d = 0`` of
@@ -34,7 +40,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 import scipy.sparse as sp
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 from scipy.sparse.csgraph import connected_components
 
 from ..boundary import EDGES, build_constraints, edge_points
@@ -63,6 +69,9 @@ class BodyConstraints:
     ties : Ties
         The interfaces and C0 lines whose tangent continuity ``T`` holds exactly
         (:mod:`splinedeform.physics.coupling_ties`), which need no rotation penalty.
+    fixed_patches : frozenset of int
+        The patches with a control point that the mask of fixed points holds (its own
+        mask or a neighbour's across a merged point).
     """
 
     T: sp.csr_matrix
@@ -70,9 +79,14 @@ class BodyConstraints:
     edges: dict[Edge, str]
     offsets: NDArray[np.int64]
     ties: Ties = field(default_factory=lambda: NO_TIES)
+    fixed_patches: frozenset[int] = frozenset()
     T_u: None = field(default=None, init=False)
     T_v: None = field(default=None, init=False)
-    has_fixed_points: bool = field(default=False, init=False)
+
+    @property
+    def has_fixed_points(self) -> bool:
+        """Whether a mask of fixed control points (:func:`body_fixed_mask`) holds a point."""
+        return bool(self.fixed_patches)
 
     @property
     def n_free(self) -> int:
@@ -80,8 +94,10 @@ class BodyConstraints:
 
     @property
     def unconstrained(self) -> bool:
-        """No boundary edge is pinned or clamped: rigid motions are free."""
-        return all(preset == "free" for preset in self.edges.values())
+        """No boundary edge is pinned or clamped and no control point is fixed: rigid
+        motions are free."""
+        return (all(preset == "free" for preset in self.edges.values())
+                and not self.has_fixed_points)
 
 
 def boundary_presets(boundary: str | Mapping[Edge, str], topology: Topology,
@@ -124,10 +140,60 @@ def edge_rows(surface: Surface, edge: str) -> NDArray[np.int64]:
     return edge_points(index, edge)[:, 0]
 
 
+def body_fixed_mask(patches: Sequence[Surface],
+                    fixed: Sequence[ArrayLike | None] | None) -> NDArray[np.bool_] | None:
+    """The body-wide mask of fixed control points: the patches' masks, row-major each,
+    patch after patch (``N = Σ n_u n_v`` values), or ``None`` where none fixes a point.
+
+    Parameters
+    ----------
+    fixed : sequence of bool arrays ``(n_u, n_v)`` or None, optional
+        One entry per patch, ``True`` = held at rest; ``None`` for a patch with nothing
+        fixed beyond its edge conditions.
+
+    Raises
+    ------
+    InputError
+        A count other than one per patch, or a mask of another shape than its patch's net
+        or not boolean, or one that holds a point of a trimmed face (whose map is its own,
+        :func:`~splinedeform.body.trimmed.with_trimmed_faces`), naming the patch.
+    """
+    if fixed is None:
+        return None
+    if isinstance(fixed, np.ndarray) or not isinstance(fixed, Sequence):
+        raise InputError(f"fixed must be a sequence of one mask (or None) per patch, got "
+                         f"{type(fixed).__name__}")
+    if len(fixed) != len(patches):
+        raise InputError(f"fixed has {len(fixed)} masks for a body of {len(patches)} "
+                         "patches: give one per patch (None where nothing is fixed)")
+    masks = []
+    for p, (surface, mask) in enumerate(zip(patches, fixed)):
+        if mask is None:
+            masks.append(np.zeros(surface.shape[0] * surface.shape[1], dtype=bool))
+            continue
+        mask = np.asarray(mask)
+        if mask.shape != tuple(surface.shape):
+            raise InputError(f"fixed[{p}]: the mask of patch {p} must have the shape of its "
+                             f"control net (n_u, n_v) = {tuple(surface.shape)}, got "
+                             f"{mask.shape}")
+        if mask.dtype != bool:
+            raise InputError(f"fixed[{p}]: the mask of patch {p} must be boolean, got dtype "
+                             f"{mask.dtype}")
+        if mask.any() and surface.trim is not None:
+            raise InputError(f"fixed[{p}]: patch {p} is a trimmed face; fixed control points "
+                             "are taken on untrimmed patches only")
+        masks.append(mask.ravel())
+    out = np.concatenate(masks)
+    return out if out.any() else None
+
+
 def build_body_constraints(patches: Sequence[Surface], topology: Topology,
-                           presets: dict[Edge, str], smooth: bool = False) -> BodyConstraints:
+                           presets: dict[Edge, str], smooth: bool = False,
+                           fixed: NDArray[np.bool_] | None = None) -> BodyConstraints:
     """``T = T_b S`` (module docstring): conforming interfaces merged, the given presets;
     with ``smooth`` (an energy that bends) also ``T = T_b S E``, the smooth lines tied.
+    ``fixed`` (:func:`body_fixed_mask`, ``N`` values) fixes the classes of the points it
+    marks: their rows of ``T`` are zero.
 
     Returns
     -------
@@ -136,6 +202,7 @@ def build_body_constraints(patches: Sequence[Surface], topology: Topology,
         (:mod:`splinedeform.physics.coupling_ties`)."""
     sizes = np.array([s.shape[0] * s.shape[1] for s in patches])
     offsets = np.concatenate([[0], np.cumsum(sizes)])
+    mask = None if fixed is None else np.asarray(fixed, dtype=bool)
     maps, columns = [], []
     for p, surface in enumerate(patches):
         own = {e: presets.get((p, e), "free") for e in EDGES}
@@ -168,7 +235,9 @@ def build_body_constraints(patches: Sequence[Surface], topology: Topology,
                          f"patch {p} lies on an interface or pole but its edge condition "
                          "couples it to other control points (uniform knots): use open knots "
                          "at edges that meet")
-    class_fixed = np.bincount(label, weights=fixed, minlength=label.max() + 1) > 0
+    held = np.zeros(n, dtype=bool) if mask is None else mask & is_column
+    held_class = np.bincount(label, weights=held, minlength=label.max() + 1) > 0
+    class_fixed = (np.bincount(label, weights=fixed, minlength=label.max() + 1) > 0) | held_class
     column_class = label[column_point]
     keep = ~class_fixed[column_class]
     classes, new = np.unique(column_class[keep], return_inverse=True)
@@ -177,8 +246,12 @@ def build_body_constraints(patches: Sequence[Surface], topology: Topology,
     first = np.full(label.max() + 1, n, dtype=np.int64)
     np.minimum.at(first, label, np.arange(n))
     T, free_index = (Tb @ S).tocsr(), first[classes]
+    if T.shape[1] == 0 and held.any():
+        raise InputError("every control point is fixed: nothing can move")
     ties = smooth_ties(patches, topology.interfaces, offsets) if smooth else NO_TIES
     if ties.C.shape[0]:
         T, kept = impose(T, ties.C @ T)
         free_index = free_index[kept]
-    return BodyConstraints(T, free_index, dict(presets), offsets, ties)
+    held_patches = frozenset(int(p) for p in np.searchsorted(
+        offsets, np.flatnonzero(held_class[label]), side="right") - 1)
+    return BodyConstraints(T, free_index, dict(presets), offsets, ties, held_patches)

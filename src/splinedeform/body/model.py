@@ -42,6 +42,14 @@ class BodyModel(Model):
         and pole edges have no preset: they are merged or coupled (Notes). A trimmed face's
         loops are keyed ``(patch, "outer")``, ``(patch, "hole1")`` …; a loop it shares with
         another face (:attr:`.Body.trim_interfaces`) has no preset either.
+    fixed : sequence of bool arrays or None, optional
+        One mask per patch, of the shape ``(n_u, n_v)`` of its control net, ``True`` =
+        the control point is held at rest (the paper's reduced set of moving control
+        points, as :class:`splinedeform.Model`'s ``fixed``); ``None`` for a patch with
+        nothing fixed beyond its edges. A control point that several patches share (merged
+        across a conforming interface, or on a pole) is fixed when any one of them fixes
+        it. A point that its edge condition determines from others follows that condition.
+        Trimmed faces take no fixed points.
     mass_matrix : {"consistent", "lumped"}
     rest : {"initial", "none"}
     physics : {"intrinsic", "parametric"}, default "intrinsic"
@@ -56,7 +64,9 @@ class BodyModel(Model):
     ------
     InputError
         For a non-manifold edge (three or more patches on one edge), or an interface whose
-        two edges are parametrised differently along the curve (not an affine map).
+        two edges are parametrised differently along the curve (not an affine map); for
+        ``fixed`` of another count than one per patch, or a mask of another shape than
+        its patch's net or not boolean (naming the patch).
 
     Notes
     -----
@@ -85,12 +95,13 @@ class BodyModel(Model):
     def __init__(self, body: Body | Sequence[Surface], material: Material,
                  boundary: str | Mapping[tuple[int, str], str] = "free",
                  mass_matrix: str = "consistent", rest: str = "initial",
-                 physics: str = "intrinsic"):
+                 physics: str = "intrinsic",
+                 fixed: Sequence[NDArray[np.bool_] | None] | None = None):
         start = time.perf_counter()
         if not isinstance(body, Body):
             body = Body(body)
         check_options(material, mass_matrix, rest, physics)
-        system = body_system(body, material, boundary, mass_matrix, rest, physics)
+        system = body_system(body, material, boundary, mass_matrix, rest, physics, fixed)
         self.body = body
         self.patches: tuple[Surface, ...] = body.patches
         self.surface = None            # no single surface: the read-out has the patches

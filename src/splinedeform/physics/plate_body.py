@@ -36,7 +36,8 @@ from scipy.sparse.linalg import splu
 
 from ..assembly import check_bending, patch_matrices
 from ..body.body import Body
-from ..body.constraints import BodyConstraints, boundary_presets, build_body_constraints
+from ..body.constraints import (BodyConstraints, body_fixed_mask, boundary_presets,
+                                build_body_constraints)
 from ..body.interface import EDGES
 from ..body.loads import OnPatch, along_normal
 from ..body.trim_edges import edge_penalty
@@ -94,15 +95,17 @@ class PlateBodySystem:
 def body_system(body: Body, material: Material,
                 boundary: str | Mapping[tuple[int, str], str] = "free",
                 mass_matrix: str = "consistent", rest: str = "initial",
-                physics: str = "intrinsic") -> PlateBodySystem:
+                physics: str = "intrinsic",
+                fixed: Sequence[Any] | None = None) -> PlateBodySystem:
     """Assemble the plate of a body (module docstring; the parameters are
-    :class:`splinedeform.BodyModel`'s, the options already checked).
+    :class:`splinedeform.BodyModel`'s, the options already checked; ``fixed``, one mask
+    per patch, fixes control points: :func:`~splinedeform.body.constraints.body_fixed_mask`).
 
     Raises
     ------
     InputError
-        A non-manifold edge or an interface not parametrised alike (:func:`refuse`), or a
-        boundary that fixes every control point.
+        A non-manifold edge or an interface not parametrised alike (:func:`refuse`), a
+        bad mask of fixed points, or a boundary that fixes every control point.
     """
     topology = body.topology
     refuse(topology)
@@ -115,7 +118,7 @@ def body_system(body: Body, material: Material,
     presets = boundary_presets(edge_boundary(boundary, loops), topology)
     constraints = build_body_constraints(
         patches, topology, {k: "free" if k[0] in faces else v for k, v in presets.items()},
-        bends(material))
+        bends(material), body_fixed_mask(patches, fixed))
     systems = {p: trimmed_system(patches[p], material,
                                  face_boundary(p, patches[p], presets, loops),
                                  mass_matrix == "lumped", physics, rest=rest)
@@ -173,7 +176,8 @@ def rigid_count(body: Body, material: Material, constraints: BodyConstraints) ->
 
     With tension in both directions (``w10, w01 > 0``) the energy vanishes on constant
     displacements only: one per connected part of the body that no pinned or clamped edge
-    holds. Without tension but with bending in both directions (``w20, w02 > 0``) it is 0
+    and no fixed control point holds. Without tension but with bending in both directions
+    (``w20, w02 > 0``) it is 0
     where a clamped edge holds every part: a field without energy is a polynomial with
     ``d_uu = d_vv = 0`` (``Δ d = 0`` intrinsic) on each span, which vanishes with its value
     and slope on a segment (unique continuation), and the merged points, the ties and the
@@ -196,6 +200,9 @@ def rigid_count(body: Body, material: Material, constraints: BodyConstraints) ->
     held = np.zeros(parts, dtype=bool)
     for (p, _), preset in constraints.edges.items():
         held[label[p]] |= preset in holds
+    if holds == ("pinned", "clamped"):
+        for p in constraints.fixed_patches:
+            held[label[p]] = True
     if holds == ("pinned", "clamped"):
         return int(np.sum(~held))
     return 0 if held.all() else None

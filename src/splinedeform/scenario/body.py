@@ -6,8 +6,10 @@ and a :class:`~splinedeform.body.BodyModel`. What a body takes from a scenario:
 
 * ``[boundary]``: one preset for every boundary edge (an edge no other face meets), so
   ``u0 = u1 = v0 = v1``, replaced edge by edge by ``[boundary.faces]``
-  (``3 = {u0 = "clamped"}``, the file's face numbers; :func:`face_presets`); a free region
-  or listed points are a single surface's;
+  (``3 = {u0 = "clamped"}``, the file's face numbers; :func:`face_presets`); the moving
+  control points of single faces by ``boundary.faces_free_points`` (``0 = [[i, j], ...]``,
+  all others of that face fixed; :func:`face_masks`), where ``free_region`` and
+  ``free_points`` are a single surface's;
 * ``surface.refine`` / ``surface.elevate``: every face alike, in its own u and v; where
   the counts differ in u and v, interfaces are made to conform again by exact elevation
   and knot insertion (:func:`refined_body`);
@@ -190,7 +192,13 @@ def check_body_scenario(scenario: Scenario, body: FileBody) -> None:
     for key in ("free_region", "free_points"):
         if key in raw:
             raise s.error(f"boundary.{key}", "applies to one surface, not to a body of "
-                                             f"{len(body)} faces")
+                                             f"{len(body)} faces; list each face's moving "
+                                             "control points in boundary.faces_free_points "
+                                             "(0 = [[i, j], ...])")
+    if "faces_free_points" in raw and s.material.physics == "shell":
+        raise s.error("boundary.faces_free_points", "fixed control points of a body are "
+                      "taken by the plate (physics intrinsic or parametric), not yet by the "
+                      "shell")
     for ext in s.output.formats:
         if ext not in BODY_FORMATS:
             raise s.error("output.formats", f"{ext} is not written for a body of "
@@ -226,6 +234,10 @@ def check_single_surface_loads(scenario: Scenario, face: int | None) -> None:
     if "faces" in scenario.raw.get("boundary", {}):
         raise scenario.error("boundary.faces", "names edges of the faces of a body of CAD "
                              "faces; one surface takes u0, u1, v0 and v1")
+    if "faces_free_points" in scenario.raw.get("boundary", {}):
+        raise scenario.error("boundary.faces_free_points", "names control points of the faces "
+                             "of a body of CAD faces; one surface lists its own in "
+                             "boundary.free_points")
     for i, spec in enumerate(scenario.loads, start=1):
         if spec.face is not None and spec.face != face:
             where = (f"the one face read ({face})" if face is not None
@@ -269,6 +281,36 @@ def face_presets(scenario: Scenario, body: FileBody) -> str | dict[tuple[int, st
     return out
 
 
+def face_masks(scenario: Scenario, body: FileBody) -> list[Any] | None:
+    """The masks of fixed control points of ``boundary.faces_free_points``
+    (``{face: [[i, j], ...]}``, the file's face numbers), one per patch: on a listed face
+    every point not listed is fixed, a face not listed gets ``None``; ``None`` without the
+    key. A face not in the body, or an index off its face's net, is refused at its key
+    path ``boundary.faces_free_points.<face>[n]`` (``n`` from 1)."""
+    import numpy as np
+
+    named = scenario.raw.get("boundary", {}).get("faces_free_points")
+    if not named:
+        return None
+    masks: list[Any] = [None] * len(body)
+    for key, points in named.items():
+        patch = body.patch_of_face(int(key))
+        if patch is None:
+            raise scenario.error(f"boundary.faces_free_points.{key}", f"face {key} is not in "
+                                 f"this body, whose faces are {list(body.faces)}")
+        shape = body[patch].shape
+        moving = np.zeros(shape, dtype=bool)
+        for n, (i, j) in enumerate(points, start=1):
+            if not (i < shape[0] and j < shape[1]):
+                raise scenario.error(f"boundary.faces_free_points.{key}[{n}]",
+                                     f"[{i}, {j}] is not a control point of face {key}: its "
+                                     f"net has {shape[0]} x {shape[1]} points, i in 0 .. "
+                                     f"{shape[0] - 1}, j in 0 .. {shape[1] - 1}")
+            moving[i, j] = True
+        masks[patch] = ~moving
+    return masks
+
+
 def body_model(scenario: Scenario, body: FileBody) -> Any:
     """The model of a body scenario: a :class:`~splinedeform.body.BodyModel` (the thin plate
     under tension), or under ``physics = "shell"`` a
@@ -280,6 +322,7 @@ def body_model(scenario: Scenario, body: FileBody) -> Any:
 
     check_body_scenario(scenario, body)
     boundary = face_presets(scenario, body)
+    fixed = face_masks(scenario, body)
     if scenario.material.physics == "shell":
         from ..physics.shell import ShellMaterial
         from ..physics.shell_model import ShellModel
@@ -293,7 +336,7 @@ def body_model(scenario: Scenario, body: FileBody) -> Any:
     with _located(scenario, "boundary"):
         return BodyModel(body, material, boundary=boundary,
                          mass_matrix=scenario.material.mass_matrix,
-                         physics=scenario.material.physics)
+                         physics=scenario.material.physics, fixed=fixed)
 
 
 def on_faces(scenario: Scenario, body: Any, load: Any, index: int) -> Any:

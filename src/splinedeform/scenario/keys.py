@@ -57,6 +57,10 @@ BOUNDARY_KEYS: dict[str, Key] = {
     **_keys(S.Boundary, ("free_points",)),
     "faces": Key(located_checker(dict[S.FaceKey, S.FaceEdges], "{k = {u0 = ...}}"), None,
                  _keys(S.Boundary, ("faces",))["faces"].doc, "none"),
+    "faces_free_points": Key(
+        located_checker(dict[S.FaceKey, list[tuple[S.NetIndex, S.NetIndex]]],
+                        "{k = [[i, j], ...]}"), None,
+        _keys(S.Boundary, ("faces_free_points",))["faces_free_points"].doc, "none (all move)"),
     "loops": Key(located_checker(dict[S.LoopKey, S.LoopPresets], '{outer = "clamped"}'), None,
                  _keys(S.Boundary, ("loops",))["loops"].doc, "none (free)"),
 }

@@ -144,6 +144,15 @@ class Boundary(_Table):
             "`symmetry`; they replace the one preset `u0 = u1 = v0 = v1` "
             "on those edges; an edge another face meets (an interface) or a pole takes none"),
         json_schema_extra={"doc_default": "none"})
+    faces_free_points: Optional[dict[FaceKey, list[tuple[NetIndex, NetIndex]]]] = Field(
+        None, title="{k = [[i, j], ...]}", description=(
+            "body of CAD faces only: the moving control points of single faces, keyed by the "
+            "face's number in the file (`{ 0 = [[1, 2], [2, 2]], 2 = [[3, 1]] }`), each "
+            "listed `[i, j]` as in `free_points` (row `i` along u, column `j` along v of that "
+            "face's net, from 0); all other control points of a listed face are fixed at "
+            "rest, a face not listed moves apart from its edges; a point that two faces "
+            "share is fixed when either fixes it"),
+        json_schema_extra={"doc_default": "none (all move)"})
     loops: Optional[dict[LoopKey, LoopPresets]] = Field(
         None, title='{outer = "clamped", ...}', description=(
             "trimmed CAD face only: edge conditions of the face's trim loops, named as "

@@ -206,6 +206,11 @@ def _validate_boundary(raw: Mapping[str, Any], problems: _Problems,
                                              f"only (material.physics = \"shell\"), not of "
                                              f"physics {physics!r}")
     values.pop("faces", None)           # a body's, read by scenario.body.face_presets
+    faces_free = values.pop("faces_free_points", None)      # a body's: scenario.body.face_masks
+    for face, listed in (faces_free or {}).items():
+        if not listed:
+            problems.add(f"boundary.faces_free_points.{face}", "is empty; list at least one "
+                         "[i, j] or leave the face out (then all its control points move)")
     values.pop("loops", None)           # a CAD face's, read by scenario.cad_trim.face_loop_presets
     region = values.pop("free_region", None)
     box: dict[str, tuple[float, float] | None] = {"free_u": None, "free_v": None}

@@ -105,6 +105,10 @@ def scenario_to_toml(scenario: Scenario) -> str:
     faces = s.raw.get("boundary", {}).get("faces")      # a body's presets per edge
     if faces:
         boundary.append(("faces", dict(faces)))
+    faces_free = s.raw.get("boundary", {}).get("faces_free_points")   # a body's moving points
+    if faces_free:
+        boundary.append(("faces_free_points",
+                         {k: [list(p) for p in v] for k, v in faces_free.items()}))
     out += _toml_table("[boundary]", boundary)
     for load in s.loads:
         out += _toml_table("[[load]]", _load_items(load))
