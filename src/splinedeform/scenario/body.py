@@ -287,7 +287,7 @@ def face_masks(scenario: Scenario, body: FileBody) -> list[Any] | None:
     every point not listed is fixed, a face not listed gets ``None``; ``None`` without the
     key. A face not in the body, or an index off its face's net, is refused at its key
     path ``boundary.faces_free_points.<face>[n]`` (``n`` from 1)."""
-    import numpy as np
+    from .checks import moving_points_mask
 
     named = scenario.raw.get("boundary", {}).get("faces_free_points")
     if not named:
@@ -298,16 +298,9 @@ def face_masks(scenario: Scenario, body: FileBody) -> list[Any] | None:
         if patch is None:
             raise scenario.error(f"boundary.faces_free_points.{key}", f"face {key} is not in "
                                  f"this body, whose faces are {list(body.faces)}")
-        shape = body[patch].shape
-        moving = np.zeros(shape, dtype=bool)
-        for n, (i, j) in enumerate(points, start=1):
-            if not (i < shape[0] and j < shape[1]):
-                raise scenario.error(f"boundary.faces_free_points.{key}[{n}]",
-                                     f"[{i}, {j}] is not a control point of face {key}: its "
-                                     f"net has {shape[0]} x {shape[1]} points, i in 0 .. "
-                                     f"{shape[0] - 1}, j in 0 .. {shape[1] - 1}")
-            moving[i, j] = True
-        masks[patch] = ~moving
+        masks[patch] = moving_points_mask(scenario, points, body[patch].shape,
+                                          f"boundary.faces_free_points.{key}",
+                                          f"face {key}: its net")
     return masks
 
 

@@ -259,18 +259,10 @@ def free_region_mask(scenario: Scenario, surface: Any) -> Any:
 
 def _free_points_mask(scenario: Scenario, shape: tuple[int, int]) -> Any:
     """``fixed`` mask of ``boundary.free_points``; an index off the net names its entry."""
-    import numpy as np
+    from .checks import moving_points_mask
 
-    points = scenario.boundary.free_points or ()
-    moving = np.zeros(shape, dtype=bool)
-    for n, (i, j) in enumerate(points, start=1):
-        if not (i < shape[0] and j < shape[1]):
-            raise scenario.error(f"boundary.free_points[{n}]",
-                                 f"[{i}, {j}] is not a control point of this surface: the net "
-                                 f"has {shape[0]} x {shape[1]} points, i in 0 .. {shape[0] - 1}"
-                                 f", j in 0 .. {shape[1] - 1}")
-        moving[i, j] = True
-    return ~moving
+    return moving_points_mask(scenario, scenario.boundary.free_points or (), shape,
+                              "boundary.free_points", "this surface: the net")
 
 
 def _check_parameters(scenario: Scenario, surface: Any) -> None:

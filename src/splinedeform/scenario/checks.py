@@ -182,3 +182,20 @@ def located_checker(annotation: Any, title: str = "") -> Callable[[Any], Any]:
             raise _Invalid(reason + given, sub=sub) from None
     check.allowed = text  # type: ignore[attr-defined]
     return check
+
+
+def moving_points_mask(scenario: Any, points: Any, shape: tuple[int, int], key: str,
+                       what: str) -> Any:
+    """``fixed`` mask of a net of ``shape`` where only ``points`` (``[i, j]`` pairs) move; an
+    index off the net names ``key[n]`` and ``what`` ("face 2: its net") has the points."""
+    import numpy as np
+
+    moving = np.zeros(shape, dtype=bool)
+    for n, (i, j) in enumerate(points, start=1):
+        if not (i < shape[0] and j < shape[1]):
+            raise scenario.error(f"{key}[{n}]",
+                                 f"[{i}, {j}] is not a control point of {what} has "
+                                 f"{shape[0]} x {shape[1]} points, i in 0 .. {shape[0] - 1}"
+                                 f", j in 0 .. {shape[1] - 1}")
+        moving[i, j] = True
+    return ~moving
