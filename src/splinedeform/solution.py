@@ -321,6 +321,10 @@ class ModalSolution(Solution):
         d = np.zeros((times.size, n, columns))
         v = np.zeros((times.size, n, columns)) if velocities else None
         active = getattr(self.response, "active", np.arange(columns))   # columns that move
+        # a correction in some coordinates only (the transient one), all among the active
+        # ones: added to the modal expansion before it goes into d (in place, one product)
+        moving = getattr(self.correction, "moving", None)
+        early = moving is not None and active.size > 0 and bool(np.isin(moving, active).all())
         i = 0
         for part in self._chunks(times):
             span = slice(i, i + part.size)
@@ -329,10 +333,15 @@ class ModalSolution(Solution):
                     Q, V = self.response.active_part(part)
                 else:
                     Q, V = self.response(part)
-                d[span, :, active] = self.basis.expand(Q)
+                expanded = self.basis.expand(Q)
+                if early:
+                    if not expanded.flags.writeable:
+                        expanded = expanded.copy()
+                    self.correction.add_to(part, expanded, columns=active)
+                d[span, :, active] = expanded
                 if v is not None:
                     v[span, :, active] = self.basis.expand(V)
-            if self.correction is not None:
+            if self.correction is not None and not early:
                 add = getattr(self.correction, "add_to", None)     # in place, if it can
                 if add is not None:
                     add(part, d[span])
