@@ -91,10 +91,13 @@ def _over_damped_response(lam: Array, a: Array, d: Array, tau: Array) -> Array:
     ``r = λ/s``, ``κ = √d``; ``e^{−aτ}(1 + aτ)`` where ``s = r``."""
     fast = a + np.sqrt(d)
     slow = lam / np.where(fast > 0, fast, 1.0)
-    gap = np.where(fast - slow > 0, fast - slow, 1.0)
-    return np.where(fast - slow > 0,
-                    (fast * np.exp(-slow * tau) - slow * np.exp(-fast * tau)) / gap,
-                    np.exp(-a * tau) * (1.0 + a * tau))
+    gap = fast - slow
+    equal = ~(gap > 0)                      # critically damped: the limit, only there
+    out = (fast * np.exp(-slow * tau) - slow * np.exp(-fast * tau)) / np.where(equal, 1.0, gap)
+    if equal.any():
+        a_e, t_e = a[equal], tau[equal]
+        out[equal] = np.exp(-a_e * t_e) * (1.0 + a_e * t_e)
+    return out
 
 
 def _chebyshev(x: Array, degree: int) -> Array:
