@@ -18,7 +18,7 @@ import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
 from .errors import InputError
-from .readout import BodyReadout, Readout  # noqa: F401 (Readout: public here)
+from .readout import BodyReadout, Readout, _selected_rows  # noqa: F401 (Readout: public here)
 from .solvers.bases import DenseBasis, ModalBasis
 from .surface import Surface
 from .threads import owned
@@ -315,16 +315,17 @@ class ModalSolution(Solution):
                 return d, v
         return self._own(times, velocities)
 
-    def _own(self, times: Array, velocities: bool) -> tuple[Array, Array | None]:
-        """``d`` (and ``v``) at ``times`` from this solution's own basis and correction."""
+    def _own(self, times: Array, velocities: bool,
+             into: tuple[Array, Array] | None = None) -> tuple[Array, Array | None]:
+        """``d`` (and ``v``) at ``times`` from this solution's own basis and correction;
+        ``into = (full, rows)``: the displacements of the free unknowns go straight into
+        rows ``rows`` of ``full`` (``(F, n_points, columns)``, zero elsewhere) and ``d`` is
+        ``full`` (a correction added to the expansion only, :meth:`_direct`)."""
         n, columns = self.basis.n_free, self.readout.columns
-        d = np.zeros((times.size, n, columns))
+        d = np.zeros((times.size, n, columns)) if into is None else into[0]
         v = np.zeros((times.size, n, columns)) if velocities else None
         active = getattr(self.response, "active", np.arange(columns))   # columns that move
-        # a correction in some coordinates only (the transient one), all among the active
-        # ones: added to the modal expansion before it goes into d (in place, one product)
-        moving = getattr(self.correction, "moving", None)
-        early = moving is not None and active.size > 0 and bool(np.isin(moving, active).all())
+        early = self._early(active)
         i = 0
         for part in self._chunks(times):
             span = slice(i, i + part.size)
@@ -338,7 +339,10 @@ class ModalSolution(Solution):
                     if not expanded.flags.writeable:
                         expanded = expanded.copy()
                     self.correction.add_to(part, expanded, columns=active)
-                d[span, :, active] = expanded
+                if into is None:
+                    d[span, :, active] = expanded
+                else:
+                    d[span][:, into[1][:, None], active] = expanded
                 if v is not None:
                     v[span, :, active] = self.basis.expand(V)
             if self.correction is not None and not early:
@@ -357,11 +361,42 @@ class ModalSolution(Solution):
         assert v is not None
         return self.readout.from_columns(d), self.readout.from_columns(v)
 
+    def _early(self, active: Array) -> bool:
+        """Whether the correction is one in some coordinates only (the transient one), all
+        among the ``active`` ones: then it is added to the modal expansion before that goes
+        into the displacements (in place, one product a coordinate)."""
+        moving = getattr(self.correction, "moving", None)
+        return moving is not None and active.size > 0 and bool(np.isin(moving, active).all())
+
+    def _direct(self, times: Array) -> Array | None:
+        """Control nets ``p_rest + T d`` formed without ``d``: where ``T`` selects points
+        (one unknown per point, :func:`~.readout._selected_rows`), every time is this
+        solution's own and no correction is left to add to ``d``, the expansion goes
+        straight into the free points' rows of the nets (the others zero), so the
+        ``(F, n_free, 3)`` displacements are never stored (at 128², 200 frames: 77 MB);
+        ``None`` where that does not apply (then :meth:`_displacements`)."""
+        readout = self.readout
+        if not isinstance(readout, Readout) or readout.per_point != 1:
+            return None
+        rows = _selected_rows(readout.T)
+        active = getattr(self.response, "active", np.arange(readout.columns))
+        if rows is None or not (self.correction is None or self._early(active)):
+            return None
+        if self.accuracy is not None and np.any(self.accuracy.outside(times)):
+            return None
+        full = np.zeros((times.size, readout.T.shape[0], readout.columns))
+        self._own(times, False, into=(full, rows))
+        nets = full.reshape((times.size,) + readout.surface.shape + (3,))
+        nets += readout.surface.control_points
+        return nets
+
     @owned
     def control_points(self, t: ArrayLike) -> Array:
         """Control net at ``t``: ``(n_u, n_v, 3)`` for a number, ``(F, n_u, n_v, 3)`` for an array."""
         times, scalar = _check_times(t)
-        nets = self._full(self.readout.from_columns(self._displacements(times, False)[0]))
+        nets = self._direct(times)
+        if nets is None:
+            nets = self._full(self.readout.from_columns(self._displacements(times, False)[0]))
         return _first(nets) if scalar else nets
 
     def modal(self, t: ArrayLike) -> tuple[Array, Array]:
