@@ -22,8 +22,8 @@ LAPACK's band solve (``dpbtrs``) takes the right-hand sides one by one, reading 
 band for each (memory-bound). Measured on the bench plate, one BLAS thread
 (benchmarks/results.md): at 128² (``N = 16 129``, ``b = 384``) the band solve took
 8.1 ms a vector, these sweeps 2.2 ms in blocks of 16 (:data:`CACHED_BAND`), the two
-solutions within 1.3e-12 of each other relative to their size. The factor keeps ``2 N w``
-numbers (twice the band's: the coupling blocks are stored dense).
+solutions within 1.3e-12 of each other relative to their size. The factor keeps ``N w``
+numbers, packed (:class:`BlockCholesky`): as many as the band's.
 """
 
 from __future__ import annotations
@@ -37,7 +37,8 @@ from .factor import half_bandwidth
 
 Array = NDArray[np.float64]
 BLOCK_BYTES = 256 * 2**20
-"""Largest storage ``16 N w`` bytes of a block factor (128² cubic: 99 MB)."""
+"""Largest ``16 N w`` bytes for a block factor (128² cubic: 99 MB); the packed factor keeps
+half that, ``8 N w`` (the limit was set when it kept all of it)."""
 CACHED_BAND = 16 * 2**20
 """Band storage (bytes) up to which the band solve is kept: at 64² (6 MB) it solved 0.42 ms
 a vector in blocks of 8 against these sweeps' 0.79 ms, at 128² (50 MB) 8.1 ms against 3.8
