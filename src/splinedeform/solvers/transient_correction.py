@@ -239,7 +239,9 @@ class TransientCorrection:
                 raise ValueError(f"coordinate {column} moves but is not in the output")
             target = out[:, :, where[0]]
             if target.flags.f_contiguous and target.dtype == np.float64:
-                gemm(1.0, A, self.terms[c], 1.0, target)    # in place (Fortran order)
+                summed = gemm(1.0, A, self.terms[c], 1.0, target)   # in place (Fortran order)
+                if not np.shares_memory(summed, target):
+                    target[...] = summed
             else:
                 target += A @ self.terms[c]
 
