@@ -318,9 +318,8 @@ class ModalSolution(Solution):
     def _own(self, times: Array, velocities: bool,
              into: tuple[Array, Array] | None = None) -> tuple[Array, Array | None]:
         """``d`` (and ``v``) at ``times`` from this solution's own basis and correction;
-        ``into = (full, rows)``: the displacements of the free unknowns go straight into
-        rows ``rows`` of ``full`` (``(F, n_points, columns)``, zero elsewhere) and ``d`` is
-        ``full`` (a correction added to the expansion only, :meth:`_direct`)."""
+        with ``into = (full, rows)`` ``d`` is ``full`` ``(F, n_points, columns)``, the free
+        unknowns' rows ``rows`` filled (:meth:`_direct`)."""
         n, columns = self.basis.n_free, self.readout.columns
         d = np.zeros((times.size, n, columns)) if into is None else into[0]
         v = np.zeros((times.size, n, columns)) if velocities else None
@@ -363,18 +362,15 @@ class ModalSolution(Solution):
 
     def _early(self, active: Array) -> bool:
         """Whether the correction is one in some coordinates only (the transient one), all
-        among the ``active`` ones: then it is added to the modal expansion before that goes
-        into the displacements (in place, one product a coordinate)."""
+        ``active``: it is then added to the modal expansion in place, before ``d``."""
         moving = getattr(self.correction, "moving", None)
         return moving is not None and active.size > 0 and bool(np.isin(moving, active).all())
 
     def _direct(self, times: Array) -> Array | None:
-        """Control nets ``p_rest + T d`` formed without ``d``: where ``T`` selects points
-        (one unknown per point, :func:`~.readout._selected_rows`), every time is this
-        solution's own and no correction is left to add to ``d``, the expansion goes
-        straight into the free points' rows of the nets (the others zero), so the
-        ``(F, n_free, 3)`` displacements are never stored (at 128², 200 frames: 77 MB);
-        ``None`` where that does not apply (then :meth:`_displacements`)."""
+        """Nets ``p_rest + T d`` without storing ``d`` (at 128², 200 frames: 77 MB) where
+        ``T`` selects points (:func:`~.readout._selected_rows`), every time is this
+        solution's own and no correction is left for ``d``: the expansion goes straight
+        into the free points' rows; ``None`` elsewhere (then :meth:`_displacements`)."""
         readout = self.readout
         if not isinstance(readout, Readout) or readout.per_point != 1:
             return None

@@ -185,11 +185,11 @@ class BlockLanczos:
         """Room for ``size`` basis vectors: :data:`ROOM` times ``size`` and at least twice
         the room before (twice ``size`` where that much address space is refused; the
         starting block alone gets no more than its own room, :meth:`lowest` knowing the
-        mode count). Column-major: the vectors in use are one contiguous prefix, and the memory of the
-        columns not yet written is never touched, so the room costs address space, not
-        memory, while a copy into a larger room touches the memory of every vector again
-        (at 128² a copy of 688 columns of ``V`` and ``MV`` cost 0.36 s of processor time
-        when the mode count grew from 256 to 322). The automatic mode count
+        mode count). Column-major: the vectors in use are one contiguous prefix, and the
+        memory of the columns not yet written is never touched, so the room costs address
+        space, not memory, while a copy into a larger room touches the memory of every
+        vector again (at 128² a copy of 688 columns of ``V`` and ``MV`` cost 0.36 s of
+        processor time when the mode count grew from 256 to 322). The automatic mode count
         (:func:`.mode_select.automatic_basis`) asks 17, 65, then 154 pairs on the bench
         plate at 128²: with twice the room its space was copied at 144 and 288 vectors,
         with eight times not at all (920 vectors reserved, 464 used)."""
