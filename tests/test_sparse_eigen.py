@@ -87,3 +87,29 @@ def test_a_tiny_system_returns_all_its_modes():
     assert modes.lam.size == model.n_free
     assert np.max(np.abs(modes.lam - lam_ref) / lam_ref) <= 1e-9
 
+
+
+
+def test_a_refused_room_falls_back_to_twice_the_vectors_asked(models, monkeypatch):
+    """Where the address space of eight times the vectors asked is refused (MemoryError),
+    the basis takes twice what it asks and gives the dense eigenvalues (to the 1e-9 of the
+    module docstring). Here 5 pairs in blocks of 2 ask 3·5 + 4·2 = 23 vectors: eight times
+    that (capped at n = 130) is refused, twice (46) is not."""
+    M, _, K = models["clamped plate with twist"].matrices()
+    assert K.shape[0] == 130
+    lam_ref = sla.eigh(K.toarray(), M.toarray(), eigvals_only=True)
+    empty, refused = np.empty, []
+
+    def tight(shape, *args, **kwargs):
+        if isinstance(shape, tuple) and len(shape) == 2 and shape[0] == K.shape[0] \
+                and shape[1] > 64:
+            refused.append(shape[1])
+            raise MemoryError
+        return empty(shape, *args, **kwargs)
+
+    monkeypatch.setattr(sparse_eigen.np, "empty", tight)
+    krylov = sparse_eigen.BlockLanczos(K, M)
+    modes = krylov.lowest(4)
+    assert refused == [130]
+    assert krylov.V.shape[1] == 46
+    assert np.max(np.abs(modes.lam - lam_ref[:5]) / lam_ref[:5]) <= 1e-9

@@ -18,7 +18,7 @@ import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
 from .errors import InputError
-from .readout import BodyReadout, Readout  # noqa: F401 (Readout: public here)
+from .readout import BodyReadout, Readout, _selected_rows  # noqa: F401 (Readout: public here)
 from .solvers.bases import DenseBasis, ModalBasis
 from .surface import Surface
 from .threads import owned
@@ -315,12 +315,16 @@ class ModalSolution(Solution):
                 return d, v
         return self._own(times, velocities)
 
-    def _own(self, times: Array, velocities: bool) -> tuple[Array, Array | None]:
-        """``d`` (and ``v``) at ``times`` from this solution's own basis and correction."""
+    def _own(self, times: Array, velocities: bool,
+             into: tuple[Array, Array] | None = None) -> tuple[Array, Array | None]:
+        """``d`` (and ``v``) at ``times`` from this solution's own basis and correction;
+        with ``into = (full, rows)`` ``d`` is ``full`` ``(F, n_points, columns)``, the free
+        unknowns' rows ``rows`` filled (:meth:`_direct`)."""
         n, columns = self.basis.n_free, self.readout.columns
-        d = np.zeros((times.size, n, columns))
+        d = np.zeros((times.size, n, columns)) if into is None else into[0]
         v = np.zeros((times.size, n, columns)) if velocities else None
         active = getattr(self.response, "active", np.arange(columns))   # columns that move
+        early = self._early(active)
         i = 0
         for part in self._chunks(times):
             span = slice(i, i + part.size)
@@ -329,10 +333,18 @@ class ModalSolution(Solution):
                     Q, V = self.response.active_part(part)
                 else:
                     Q, V = self.response(part)
-                d[span, :, active] = self.basis.expand(Q)
+                expanded = self.basis.expand(Q)
+                if early:
+                    if not expanded.flags.writeable:
+                        expanded = expanded.copy()
+                    self.correction.add_to(part, expanded, columns=active)
+                if into is None:
+                    d[span, :, active] = expanded
+                else:
+                    d[span][:, into[1][:, None], active] = expanded
                 if v is not None:
                     v[span, :, active] = self.basis.expand(V)
-            if self.correction is not None:
+            if self.correction is not None and not early:
                 add = getattr(self.correction, "add_to", None)     # in place, if it can
                 if add is not None:
                     add(part, d[span])
@@ -348,11 +360,39 @@ class ModalSolution(Solution):
         assert v is not None
         return self.readout.from_columns(d), self.readout.from_columns(v)
 
+    def _early(self, active: Array) -> bool:
+        """Whether the correction is one in some coordinates only (the transient one), all
+        ``active``: it is then added to the modal expansion in place, before ``d``."""
+        moving = getattr(self.correction, "moving", None)
+        return moving is not None and active.size > 0 and bool(np.isin(moving, active).all())
+
+    def _direct(self, times: Array) -> Array | None:
+        """Nets ``p_rest + T d`` without storing ``d`` (at 128², 200 frames: 77 MB) where
+        ``T`` selects points (:func:`~.readout._selected_rows`), every time is this
+        solution's own and no correction is left for ``d``: the expansion goes straight
+        into the free points' rows; ``None`` elsewhere (then :meth:`_displacements`)."""
+        readout = self.readout
+        if not isinstance(readout, Readout) or readout.per_point != 1:
+            return None
+        rows = _selected_rows(readout.T)
+        active = getattr(self.response, "active", np.arange(readout.columns))
+        if rows is None or not (self.correction is None or self._early(active)):
+            return None
+        if self.accuracy is not None and np.any(self.accuracy.outside(times)):
+            return None
+        full = np.zeros((times.size, readout.T.shape[0], readout.columns))
+        self._own(times, False, into=(full, rows))
+        nets = full.reshape((times.size,) + readout.surface.shape + (3,))
+        nets += readout.surface.control_points
+        return nets
+
     @owned
     def control_points(self, t: ArrayLike) -> Array:
         """Control net at ``t``: ``(n_u, n_v, 3)`` for a number, ``(F, n_u, n_v, 3)`` for an array."""
         times, scalar = _check_times(t)
-        nets = self._full(self.readout.from_columns(self._displacements(times, False)[0]))
+        nets = self._direct(times)
+        if nets is None:
+            nets = self._full(self.readout.from_columns(self._displacements(times, False)[0]))
         return _first(nets) if scalar else nets
 
     def modal(self, t: ArrayLike) -> tuple[Array, Array]:

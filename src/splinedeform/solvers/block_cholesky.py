@@ -22,8 +22,8 @@ LAPACK's band solve (``dpbtrs``) takes the right-hand sides one by one, reading 
 band for each (memory-bound). Measured on the bench plate, one BLAS thread
 (benchmarks/results.md): at 128² (``N = 16 129``, ``b = 384``) the band solve took
 8.1 ms a vector, these sweeps 2.2 ms in blocks of 16 (:data:`CACHED_BAND`), the two
-solutions within 1.3e-12 of each other relative to their size. The factor keeps ``2 N w``
-numbers (twice the band's: the coupling blocks are stored dense).
+solutions within 1.3e-12 of each other relative to their size. The factor keeps ``N w``
+numbers, packed (:class:`BlockCholesky`): as many as the band's.
 """
 
 from __future__ import annotations
@@ -37,7 +37,8 @@ from .factor import half_bandwidth
 
 Array = NDArray[np.float64]
 BLOCK_BYTES = 256 * 2**20
-"""Largest storage ``16 N w`` bytes of a block factor (128² cubic: 99 MB)."""
+"""Largest ``16 N w`` bytes for a block factor (128² cubic: 99 MB); the packed factor keeps
+half that, ``8 N w`` (the limit was set when it kept all of it)."""
 CACHED_BAND = 16 * 2**20
 """Band storage (bytes) up to which the band solve is kept: at 64² (6 MB) it solved 0.42 ms
 a vector in blocks of 8 against these sweeps' 0.79 ms, at 128² (50 MB) 8.1 ms against 3.8
@@ -49,6 +50,16 @@ FEW = 4
 
 class BlockCholesky:
     """``A = L Lᵀ`` with ``L`` block bidiagonal (module docstring); :meth:`solve`.
+
+    Stored packed, one ``w × w`` array a block row: ``L_ii⁻¹ = Δ_i U_i`` with ``Δ_i`` its
+    diagonal and ``U_i`` unit lower triangular, so ``L_ii⁻¹ x = Δ_i (U_i x)`` and
+    ``L_ii^{−T} x = U_iᵀ (Δ_i x)`` (a triangular product that takes the diagonal as ones);
+    ``U_i``'s strict lower triangle and the upper triangle of ``C_{i−1}`` share block
+    ``i``'s array. Each sweep reads that array twice in a row (the second time from
+    cache), so the factor's memory is read once a sweep: ``N w`` numbers instead of
+    ``2 N w`` (at 128² a solve of 16 columns took 18 ms against 20, of 2 columns 6.1 ms
+    against 7.0, one BLAS thread, the machine possibly busy). A short last block keeps
+    its rectangular ``C`` apart.
 
     Parameters
     ----------
@@ -72,69 +83,83 @@ class BlockCholesky:
         self.n = n
         self.edges = np.append(np.arange(0, n, w), n)
         A = sp.csr_matrix(A)
-        self.inverse: list[Array] = []          # L_ii⁻¹ (lower triangular, Fortran order)
-        self.coupling: list[Array] = []         # C_i = L_{i+1,i}
+        self.packed: list[Array] = []     # U_i below the diagonal, C_{i−1} on and above
+        self.diagonal: list[Array] = []   # Δ_i, as a column
+        self.tail: Array | None = None    # C of a short last block (rectangular)
         previous: Array | None = None
         for i, (lo, hi) in enumerate(zip(self.edges[:-1], self.edges[1:])):
-            block = np.asfortranarray(A[lo:hi, lo:hi].toarray())
+            block = A[lo:hi, lo:hi].toarray(order="F")
             if previous is not None:        # the lower triangle of A_ii − C Cᵀ (dsyrk)
                 block = sla.blas.dsyrk(-1.0, previous, 1.0, block, lower=1, overwrite_c=1)
-            L, info = sla.lapack.dpotrf(block, lower=1, clean=1, overwrite_a=1)
+            # the upper triangle is left as it was (clean=0 saved 0.5 of 1 ms at w = 384):
+            # no product reads it
+            L, info = sla.lapack.dpotrf(block, lower=1, clean=0, overwrite_a=1)
             if info:
                 raise np.linalg.LinAlgError("a diagonal block of the factor is not positive "
                                             "definite")
-            inverse, info = sla.lapack.dtrtri(L, lower=1)
+            inverse, info = sla.lapack.dtrtri(L, lower=1, overwrite_c=1)
             if info:
                 raise np.linalg.LinAlgError("a diagonal block of the factor is singular")
-            self.inverse.append(np.asfortranarray(np.tril(inverse)))
+            d = inverse.diagonal().copy()
+            if previous is None or previous.shape[0] != previous.shape[1]:
+                self.tail = previous
+                packed = inverse                                # no C above the diagonal
+            else:
+                packed = previous                               # C_{i−1}: upper triangular
             if hi < n:
-                below = np.asfortranarray(A[hi:self.edges[i + 2], lo:hi].toarray())
+                below = A[hi:self.edges[i + 2], lo:hi].toarray(order="F")
                 # C_i = A_{i+1,i} L_ii^{-T}: upper triangular (trapezoidal for a short last
                 # block) since A_{i+1,i} is, with w ≥ b; a triangular product (dtrmm)
-                previous = sla.blas.dtrmm(1.0, self.inverse[-1], below, side=1, lower=1,
-                                          trans_a=1)
-                self.coupling.append(np.asfortranarray(np.triu(previous)))
+                previous = sla.blas.dtrmm(1.0, inverse, below, side=1, lower=1, trans_a=1,
+                                          overwrite_b=1)
+            # U_i = Δ_i⁻¹ L_ii⁻¹ below the diagonal
+            np.divide(inverse, d[:, None], out=packed, where=np.tri(hi - lo, k=-1, dtype=bool))
+            self.packed.append(packed)
+            self.diagonal.append(d[:, None])
 
     def solve(self, rhs: Array) -> Array:
-        """``A⁻¹ rhs`` for ``rhs`` of shape ``(N,)`` or ``(N, r)``.
+        """``A⁻¹ rhs`` for ``rhs`` of shape ``(N,)`` or ``(N, r)``, in Fortran order.
 
-        Every product is a triangular one (``dtrmm``) on the transposed block rows
-        ``x_iᵀ`` (contiguous in Fortran order): ``(L_ii⁻¹ x_i)ᵀ = x_iᵀ L_ii^{−T}``, and so on.
+        Every product is a triangular one (``dtrmm`` from the left) on the block rows
+        ``x_i`` of the column-major ``x``: the modal solvers' blocks of vectors are
+        column-major, and a transposing copy of one (``16 129 × 16``) took about as long as
+        a tenth of the solve.
         """
         f = np.asarray(rhs, dtype=float)
-        x = np.array(f.reshape(self.n, -1), order="C")
-        edges, D, C = self.edges, self.inverse, self.coupling
-        blocks = len(D)
+        x = np.array(f.reshape(self.n, -1), order="F")
+        edges, P, d, tail = self.edges, self.packed, self.diagonal, self.tail
+        blocks = len(P)
         for i in range(blocks):                             # L y = f
             lo, hi = edges[i], edges[i + 1]
             if i:
-                x[lo:hi] -= _times(C[i - 1], x[edges[i - 1]:lo], upper=True, transpose=False)
-            x[lo:hi] = _times(D[i], x[lo:hi], upper=False, transpose=False)
+                before = x[edges[i - 1]:lo]
+                x[lo:hi] -= tail @ before if i == blocks - 1 and tail is not None else \
+                    _times(P[i], before, upper=True, transpose=False)
+            np.multiply(d[i], _times(P[i], x[lo:hi], upper=False, transpose=False),
+                        out=x[lo:hi])
         for i in range(blocks - 1, -1, -1):                 # Lᵀ x = y
             lo, hi = edges[i], edges[i + 1]
             if i < blocks - 1:
-                x[lo:hi] -= _times(C[i], x[hi:edges[i + 2]], upper=True, transpose=True)
-            x[lo:hi] = _times(D[i], x[lo:hi], upper=False, transpose=True)
-        return x.reshape(f.shape)
+                after = x[hi:edges[i + 2]]
+                x[lo:hi] -= tail.T @ after if i == blocks - 2 and tail is not None else \
+                    _times(P[i + 1], after, upper=True, transpose=True)
+            x[lo:hi] = _times(P[i], d[i] * x[lo:hi], upper=False, transpose=True)
+        return x.reshape(f.shape, order="F")
 
 
 def _times(T: Array, x: Array, upper: bool, transpose: bool) -> Array:
-    """``T x`` (or ``Tᵀ x``) for triangular ``T`` and ``x`` of shape ``(k, r)`` in C order,
-    by ``dtrmm`` on ``xᵀ``; fewer than :data:`FEW` columns by ``dtrmv`` column by column
+    """``T x`` (or ``Tᵀ x``) for ``x`` of shape ``(k, r)`` and ``T`` the upper triangle of
+    a packed block (``upper``) or its unit lower triangle (the diagonal taken as ones), by
+    ``dtrmm`` from the left; fewer than :data:`FEW` columns by ``dtrmv`` column by column
     (``dtrmm`` on one column took ten times as long; numpy's product on two columns twice
-    as long as two ``dtrmv``: 31 against 15 ms for the 84 blocks of a 128² factor); a
-    rectangular ``T`` (the short last block) by numpy's product."""
-    if T.shape[0] != T.shape[1]:
-        return T.T @ x if transpose else T @ x
+    as long as two ``dtrmv``: 31 against 15 ms for the 84 blocks of a 128² factor)."""
+    lower, unit, trans = (0, 0, int(transpose)) if upper else (1, 1, int(transpose))
     if x.shape[1] < FEW:
-        out = np.empty(x.shape)
+        out = np.empty(x.shape, order="F")
         for c in range(x.shape[1]):
-            out[:, c] = sla.blas.dtrmv(T, x[:, c], lower=0 if upper else 1,
-                                       trans=1 if transpose else 0)
+            out[:, c] = sla.blas.dtrmv(T, x[:, c], lower=lower, trans=trans, diag=unit)
         return out
-    # (T x)ᵀ = xᵀ Tᵀ and (Tᵀ x)ᵀ = xᵀ T: a product from the right
-    return sla.blas.dtrmm(1.0, T, x.T, side=1, lower=0 if upper else 1,
-                          trans_a=0 if transpose else 1).T
+    return sla.blas.dtrmm(1.0, T, x, side=0, lower=lower, trans_a=trans, diag=unit)
 
 
 def block_cholesky(A: sp.spmatrix) -> BlockCholesky | None:

@@ -47,6 +47,8 @@ from .products import gemm as _gemm
 Array = NDArray[np.float64]
 TOLERANCE = 1e-10
 """Relative residual ``‖S y − ν y‖_M / ν`` of an accepted Ritz pair."""
+ROOM = 8
+"""Basis vectors reserved per vector asked (:meth:`BlockLanczos._reserve`)."""
 
 
 def factorise(K: sp.spmatrix) -> Any:
@@ -180,23 +182,33 @@ class BlockLanczos:
         self._append(Q, MQ)
 
     def _reserve(self, size: int) -> None:
-        """Room for ``size`` basis vectors: twice ``size`` and at least twice the room
-        before (copies add up to at most the final size; a later call asking up to twice
-        as many modes copies nothing). Column-major: the vectors in use are one contiguous
-        prefix, and the memory of the columns not yet written is never touched, so the
-        room costs address space, not memory (at 128² a copy of 688 columns of ``V`` and
-        ``MV`` cost 0.36 s of processor time when the mode count grew from 256 to 322)."""
+        """Room for ``size`` basis vectors: :data:`ROOM` times ``size`` and at least twice
+        the room before (twice ``size`` where that much address space is refused; the
+        starting block alone gets no more than its own room, :meth:`lowest` knowing the
+        mode count). Column-major: the vectors in use are one contiguous prefix, and the
+        memory of the columns not yet written is never touched, so the room costs address
+        space, not memory, while a copy into a larger room touches the memory of every
+        vector again (at 128² a copy of 688 columns of ``V`` and ``MV`` cost 0.36 s of
+        processor time when the mode count grew from 256 to 322). The automatic mode count
+        (:func:`.mode_select.automatic_basis`) asks 17, 65, then 154 pairs on the bench
+        plate at 128²: with twice the room its space was copied at 144 and 288 vectors,
+        with eight times not at all (920 vectors reserved, 464 used)."""
         if size <= self.V.shape[1]:
             return
-        size = min(self.n, 2 * max(size, self.V.shape[1]))
-        for name in ("V", "MV"):
-            old = getattr(self, name)
-            new = np.empty((self.n, size), order="F")
-            new[:, :self.p] = old[:, :self.p]
-            setattr(self, name, new)
-        H = np.zeros((size, size))
+        wanted = ROOM * size if self.p else size
+        for room in (max(wanted, 2 * self.V.shape[1]), 2 * size):
+            room = min(self.n, room)
+            try:
+                V, MV = (np.empty((self.n, room), order="F") for _ in range(2))
+                H = np.zeros((room, room))
+                break
+            except MemoryError:
+                if room <= min(self.n, 2 * size):
+                    raise
+        V[:, :self.p] = self.V[:, :self.p]
+        MV[:, :self.p] = self.MV[:, :self.p]
         H[:self.p, :self.p] = self.H[:self.p, :self.p]
-        self.H = H
+        self.V, self.MV, self.H = V, MV, H
 
     def _append(self, Q: Array, MQ: Array) -> None:
         grow = min(Q.shape[1], self.n - self.p)

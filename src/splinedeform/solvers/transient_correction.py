@@ -91,10 +91,13 @@ def _over_damped_response(lam: Array, a: Array, d: Array, tau: Array) -> Array:
     ``r = λ/s``, ``κ = √d``; ``e^{−aτ}(1 + aτ)`` where ``s = r``."""
     fast = a + np.sqrt(d)
     slow = lam / np.where(fast > 0, fast, 1.0)
-    gap = np.where(fast - slow > 0, fast - slow, 1.0)
-    return np.where(fast - slow > 0,
-                    (fast * np.exp(-slow * tau) - slow * np.exp(-fast * tau)) / gap,
-                    np.exp(-a * tau) * (1.0 + a * tau))
+    gap = fast - slow
+    equal = ~(gap > 0)                      # critically damped: the limit, only there
+    out = (fast * np.exp(-slow * tau) - slow * np.exp(-fast * tau)) / np.where(equal, 1.0, gap)
+    if equal.any():
+        a_e, t_e = a[equal], tau[equal]
+        out[equal] = np.exp(-a_e * t_e) * (1.0 + a_e * t_e)
+    return out
 
 
 def _chebyshev(x: Array, degree: int) -> Array:
@@ -201,9 +204,11 @@ class TransientCorrection:
         terms = [R, Z(R)] if degree >= 1 else [R]
         while len(terms) <= degree:
             terms.append(2.0 * Z(terms[-1]) - terms[-2])
-        # T_k(2X − I) R_j as (J, w, d + 1, n): each jump's and coordinate's terms contiguous
+        terms.append(R)                         # R_j itself, weighted by H(τ_j)
+        # T_k(2X − I) R_j and R_j as (w, J (d + 2), n): a coordinate's rows contiguous
         self.terms = np.ascontiguousarray(
-            np.array(terms).reshape(degree + 1, n, J, w).transpose(2, 3, 0, 1))
+            np.array(terms).reshape(degree + 2, n, J, w).transpose(3, 2, 0, 1)
+        ).reshape(w, J * (degree + 2), n)
 
     def bound_factor(self, tau: Array) -> Array:
         """``E_d(λ_{m+1}, τ)`` at ``tau`` (``‖e‖_M ≤ Σ_j ‖R_j‖_M E_d(τ_j)``)."""
@@ -216,12 +221,29 @@ class TransientCorrection:
         self.add_to(t, out)
         return out
 
-    def add_to(self, t: Array, out: Array) -> None:
+    def add_to(self, t: Array, out: Array, columns: Array | None = None) -> None:
         """``out += `` the correction at times ``t`` (``out`` of shape ``(F, n, c)``), in
-        place and in the moving coordinates only."""
+        place and in the moving coordinates only; ``columns``: the coordinates of ``out``'s
+        last axis (default all), which must hold the moving ones.
+
+        Per coordinate one product ``out_c += A B``, ``A = [−c(τ_j)ᵀ, H(τ_j)]_j`` of shape
+        ``(F, J (d + 2))`` and ``B`` the rows ``T_k(2X − I) R_j`` and ``R_j``, written into
+        ``out`` by ``dgemm`` where its coordinate is Fortran-ordered (a modal expansion of
+        one coordinate is)."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
+        columns = np.arange(out.shape[-1]) if columns is None else np.asarray(columns)
+        A = self._weights(t)
         for c, column in enumerate(self.moving):
-            out[:, :, column] += self._at(t, slice(None), c)
+            where = np.flatnonzero(columns == column)
+            if not where.size:
+                raise ValueError(f"coordinate {column} moves but is not in the output")
+            target = out[:, :, where[0]]
+            if target.flags.f_contiguous and target.dtype == np.float64:
+                summed = gemm(1.0, A, self.terms[c], 1.0, target)   # in place (Fortran order)
+                if not np.shares_memory(summed, target):
+                    target[...] = summed
+            else:
+                target += A @ self.terms[c]
 
     def coordinate(self, t: Array, p: int, c: int) -> Array:
         """The correction of coordinate ``c`` of unknown ``p`` at times ``t`` → ``(F,)``."""
@@ -229,24 +251,19 @@ class TransientCorrection:
         where = np.flatnonzero(self.moving == c)
         if not where.size:
             return np.zeros(t.size)
-        return self._at(t, slice(p, p + 1), int(where[0]))[:, 0]
+        return self._weights(t) @ self.terms[int(where[0]), :, p]
 
-    def _at(self, t: Array, rows: slice, c: int) -> Array:
-        """The correction in moving coordinate number ``c`` at ``t`` → ``(F, r)``."""
-        parts = self.jump_parts[:, rows, self.moving[c]]           # (J, r)
-        J, r = parts.shape
-        out = np.zeros((t.size, r))
+    def _weights(self, t: Array) -> Array:
+        """``A`` of :meth:`add_to`: ``A[:, j (d + 2) + k] = −H(τ_j) c_k(τ_j)`` for
+        ``k ≤ d`` and ``H(τ_j)`` for ``k = d + 1``, ``τ_j = t − t_j`` (``H(τ) = 0`` for
+        ``τ ≤ 0``), shape ``(F, J (d + 2))``."""
+        J, d = self.jump_times.size, self.degree
+        A = np.zeros((t.size, J, d + 2))
         for j in range(J):                      # a few jumps; vectorised over times
-            tau = t - self.jump_times[j]
-            on = np.flatnonzero(tau > 0)
-            if not on.size:
-                continue
-            coef, _ = fitted(self.lam_next, self.gamma, self.beta, tau[on], self.degree)
-            # Σ_k c_k(τ) T_k(2X − I) R_j as one matrix product over the degrees
-            transient = coef.T @ self.terms[j, c, :, rows]          # (on, r)
-            transient -= parts[j]
-            if on.size == t.size:
-                out -= transient
-            else:
-                out[on] -= transient
-        return out
+            on = np.flatnonzero(t - self.jump_times[j] > 0)
+            if on.size:
+                coef, _ = fitted(self.lam_next, self.gamma, self.beta,
+                                 t[on] - self.jump_times[j], d)
+                A[on, j, :d + 1] = -coef.T
+                A[on, j, d + 1] = 1.0
+        return A.reshape(t.size, J * (d + 2))
