@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import spectrum
 from .errors import InputError
-from .solution import ModalSolution
+from .modal_solution import ModalSolution
 from .solvers import modal_basis, mode_select
 from .solvers.sparse_eigen import BlockLanczos
 from .solvers.analytic import ModalResponse

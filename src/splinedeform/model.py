@@ -37,7 +37,8 @@ from .physics.plate import METHODS, surface_system
 from . import modal_solve
 from .modal_solve import check_count as _check_count
 from .readout import free_coordinates
-from .solution import ModalSolution, Readout, SampledSolution, StaticSolution
+from .modal_solution import ModalSolution
+from .solution import Readout, SampledSolution, StaticSolution
 from . import spectrum
 from .solvers import modal_basis, numeric
 from .solvers.forcing import ReducedForcing

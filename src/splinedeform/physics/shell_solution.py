@@ -3,7 +3,7 @@
 A shell's state is its reduced unknowns ``d_free (..., n_free)`` (x, y and z coupled, the
 rows of ``T`` interleaved, :mod:`splinedeform.readout` with ``per_point = 3``); control
 points are ``p(t) = p_rest + reshape(T d_free(t))``. The solutions are the model's
-(:class:`~splinedeform.solution.StaticSolution`, :class:`~splinedeform.solution.ModalSolution`);
+(:class:`~splinedeform.solution.StaticSolution`, :class:`~splinedeform.modal_solution.ModalSolution`);
 what the shell adds is the stresses of a displacement net (:func:`.shell_stress.stresses`).
 """
 
