@@ -6,8 +6,10 @@ the normal about the edge, ``a_3·∂_n d = 0``; the in-plane slope across the e
 which the exact solution of a curved shell does not make zero. Holding the whole slope
 ``∂_n d = 0`` (the second row of control points at rest, :mod:`.shell_edges`) would hold
 them too: an over-constraint that converges only slowly on a curved shell. On a flat
-one membrane and bending decouple under normal loads, and the whole slope stays held
-there (the plate's clamping, exact).
+one whose normal is a coordinate axis ``e_a`` the rotation is the slope of ``d_a`` alone:
+``d = 0`` and ``∂_n d_a = 0`` are held exactly in ``T`` (the plate's clamping), and the
+in-plane slopes stay free, as the membrane under in-plane loads needs (:func:`normal_axis`).
+A flat surface in a tilted plane takes Nitsche's terms, as a curved one does.
 
 So on a curved surface a clamped edge is pinned in ``T`` (``d = 0``) and the rotation is
 held by the clamped Nitsche terms of the trimmed shell
@@ -38,20 +40,20 @@ Array = NDArray[np.float64]
 FLAT = 1e-10
 
 
-def is_flat(surface: Surface) -> bool:
-    """Whether the surface lies in a plane, ``b_αβ = a_αβ·a_3 = 0``: exactly when its control
-    points do (``n·x − c = Σ_k R_k (n·P_k − c)`` vanishes identically only with every
-    coefficient, the basis being linearly independent and a partition of unity on the
-    domain): the smallest singular value of the centred net against the largest."""
+def normal_axis(surface: Surface) -> int | None:
+    """``a`` where the surface lies in a plane ``x_a = const`` (its normal ``±e_a``, the
+    net's spread along ``e_a`` within :data:`FLAT` of its extent); ``None`` otherwise."""
     P = surface.control_points.reshape(-1, 3)
-    s = np.linalg.svd(P - P.mean(axis=0), compute_uv=False)
-    return bool(s[-1] <= FLAT * max(s[0], 1e-300))
+    spread = np.ptp(P, axis=0)
+    flat = np.flatnonzero(spread <= FLAT * max(float(spread.max()), 1e-300))
+    return int(flat[0]) if flat.size == 1 else None
 
 
 def weak_clamps(surface: Surface, edges: Mapping[str, str]) -> tuple[str, ...]:
-    """The clamped edges whose rotation Nitsche's terms hold: all of a curved surface's."""
+    """The clamped edges whose rotation Nitsche's terms hold: all of a surface's that does
+    not lie in a coordinate plane (:func:`normal_axis`)."""
     clamped = tuple(e for e, kind in edges.items() if kind == "clamped")
-    return clamped if clamped and not is_flat(surface) else ()
+    return clamped if clamped and normal_axis(surface) is None else ()
 
 
 def edge_quadrature(surface: Surface, edge: str) -> tuple[Array, Array, Array, Array, Array]:

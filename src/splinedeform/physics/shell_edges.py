@@ -8,12 +8,14 @@ the 1-D basis at the end (:func:`end_map`, as :mod:`splinedeform.boundary` does 
 plate), so component ``c`` has ``T_c = T_u^c ⊗ T_v^c`` and ``T`` interleaves the three
 (dof ``3k + c``). On an edge ``x = 0`` (``∂`` across it, ``j`` the derivative orders):
 
-- ``free``: none; ``pinned``: ``d = 0`` (``j = 0`` for x, y, z); ``clamped``: ``d = 0`` and
-  ``∂d = 0`` (``j = 0, 1``), which holds the rotation of the normal about the edge, on a
-  flat surface; on a curved one ``∂d = 0`` would hold the membrane strains ``ε_nn``,
-  ``ε_ns`` at the edge too, so there (``weak_rotation``: the shell's formulation, a single
-  surface or a body's patches) ``T`` holds ``d = 0`` only and the rotation
-  ``a_3·∂_n d = 0`` is Nitsche's (:mod:`.shell_clamp`);
+- ``free``: none; ``pinned``: ``d = 0`` (``j = 0`` for x, y, z); ``clamped``: ``d = 0``
+  and, on a surface in the plane ``x_a = const``, ``∂d_a = 0`` (``j = 0, 1`` for ``d_a``,
+  ``j = 0`` for the in-plane components), which holds the rotation of the normal about the
+  edge and leaves the membrane's in-plane slopes free; on any other surface
+  ``∂d = 0`` would hold the membrane strains ``ε_nn``, ``ε_ns`` at the edge too, so there
+  (``weak_rotation``: the shell's formulation, a single surface or a body's patches)
+  ``T`` holds ``d = 0`` only and the rotation ``a_3·∂_n d = 0`` is Nitsche's
+  (:mod:`.shell_clamp`);
 - ``diaphragm`` in the plane ``x_a = const`` containing the edge and the surface normal
   (Scordelis–Lo ends): rigid in that plane, ``d_b = 0`` for ``b ≠ a``; ``d_a`` free;
 - ``symmetry`` about the plane ``x_a = const``: ``d_a = 0`` and no slope across the plane,
@@ -41,7 +43,7 @@ from numpy.typing import NDArray
 from ..errors import InputError
 from ..surface import Basis, Surface
 from . import metric
-from .shell_clamp import weak_clamps
+from .shell_clamp import normal_axis, weak_clamps
 from .shell_symmetry import slope_rows
 
 Array = NDArray[np.float64]
@@ -155,9 +157,13 @@ def end_map(basis: Basis, start: tuple[int, ...], end: tuple[int, ...]
 
 
 def _orders(kind: str, axis: int | None, c: int) -> tuple[int, ...]:
-    """Derivative orders across the edge constrained for component ``c``."""
-    if kind in ("pinned", "clamped"):
-        return (0,) if kind == "pinned" else (0, 1)
+    """Derivative orders across the edge constrained for component ``c`` (``axis``: the
+    plane's for a diaphragm or symmetry edge, the surface's normal axis for a clamped one,
+    ``None`` there: every component's slope)."""
+    if kind == "pinned":
+        return (0,)
+    if kind == "clamped":
+        return (0, 1) if axis is None or c == axis else (0,)
     if kind == "diaphragm":
         return () if c == axis else (0,)
     if kind == "symmetry":
@@ -188,6 +194,8 @@ def constraint_matrix(surface: Surface, boundary: Mapping[str, str],
     for edge, kind in edges.items():
         if kind in ("diaphragm", "symmetry"):
             axes[edge] = plane_axis(surface, edge, kind)
+        elif kind == "clamped" and weak_rotation:
+            axes[edge] = normal_axis(surface)          # None: a weak clamp, pinned here
     blocks, dofs = [], []
     for c in range(3):
         T_u, keep_u = end_map(surface.basis_u,
