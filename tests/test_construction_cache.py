@@ -65,7 +65,8 @@ def test_a_constraint_map_is_a_copy_of_the_cached_one():
     basis = sd.shapes.plane(cells=(6, 5)).basis_u
     clear_caches()
     T, kept = constraint_map(basis, "clamped", "clamped")
-    np.testing.assert_array_equal(kept, np.arange(2, basis.size - 2))
+    assert kept.shape == (basis.size - 4,)          # indices: compared to half a unit
+    assert np.abs(kept - np.arange(2, basis.size - 2)).max() < 0.5
     T.data[:] = 7.0
     kept[:] = 0
     again, kept_again = constraint_map(basis, "clamped", "clamped")

@@ -125,6 +125,13 @@ def test_mixed_edges_and_kronecker_structure():
     assert cons.n_free == (9 - 3) * (8 - 2)
 
 
+def _moved(d):
+    """Points that move: displacement above 1e-9 of the largest (held points are zero rows
+    of T; a free point under this load moves by at least 0.046 of the largest: measured)."""
+    size = np.abs(d).max(axis=-1)
+    return size > 1e-9 * size.max()
+
+
 def test_fixed_mask_moves_only_the_free_region():
     surf = sd.shapes.plane(cells=(8, 8))
     fixed = np.ones(surf.shape, dtype=bool)
@@ -132,14 +139,14 @@ def test_fixed_mask_moves_only_the_free_region():
     model = sd.Model(surf, sd.Material(w10=1, w01=1), fixed=fixed)
     assert model.n_free == 16 and model.constraints.T_u is not None
     st = model.static(sd.Point(0.5, 0.45, (0, 0, -1)))
-    moved = np.abs(st.control_points() - surf.control_points).max(axis=-1) > 0
-    assert np.array_equal(moved, ~fixed)
+    moved = _moved(st.control_points() - surf.control_points)
+    assert np.abs(moved.astype(int) - (~fixed).astype(int)).max() < 0.5   # 0/1 flags
     fixed[3, 2] = True                          # not a rectangle any more
     model = sd.Model(surf, sd.Material(w10=1, w01=1), fixed=fixed)
     assert model.n_free == 15 and model.constraints.T_u is None
-    moved = np.abs(model.static(sd.Point(0.5, 0.45, (0, 0, -1))).control_points()
-                   - surf.control_points).max(axis=-1) > 0
-    assert np.array_equal(moved, ~fixed)
+    moved = _moved(model.static(sd.Point(0.5, 0.45, (0, 0, -1))).control_points()
+                   - surf.control_points)
+    assert np.abs(moved.astype(int) - (~fixed).astype(int)).max() < 0.5
 
 
 def test_static_equals_energy_minimiser():
