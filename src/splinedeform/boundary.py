@@ -144,18 +144,10 @@ def trim_conditions(boundary: str | Mapping[str, str], loops: tuple[str, ...],
     return edges, presets
 
 
-def end_constraints(basis: BSplineBasis, end: int, preset: str) -> sp.csr_matrix:
-    """Rows ``D^j b(x_e)``, ``j < r``, with ``r = 0, 1, 2`` for free, pinned, clamped."""
-    order = {"free": 0, "pole": 0, "pinned": 1, "clamped": 2}[preset]
-    if order == 0:
-        return sp.csr_matrix((0, basis.size))
-    x = np.array([0.0 if end == 0 else basis.length])
-    return sp.vstack([basis.matrix(x, j) for j in range(order)]).tocsr()
-
-
 def _end_rows(basis: BSplineBasis, end: int, preset: str) -> NDArray[np.float64]:
-    """The rows of :func:`end_constraints` as a dense ``(r, size)`` array (one evaluation
-    of the basis and its derivatives at the end)."""
+    """Rows ``D^j b(x_e)``, ``j < r``, with ``r = 0, 1, 2`` for free (or pole), pinned,
+    clamped, as a dense ``(r, size)`` array (one evaluation of the basis and its
+    derivatives at the end)."""
     order = {"free": 0, "pole": 0, "pinned": 1, "clamped": 2}[preset]
     C = np.zeros((order, basis.size))
     if order:

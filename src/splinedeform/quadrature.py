@@ -12,11 +12,11 @@ and the order; read-only there, each caller gets a copy);
 
 from __future__ import annotations
 
+from typing import Iterable
+
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
-
-from typing import Iterable
 
 from .basis import BSplineBasis
 from .construction_cache import BoundedCache, basis_key, read_only
@@ -55,22 +55,6 @@ def gauss_points(basis: Basis, points_per_cell: int | None = None
     x = left + 0.5 * h * (ref_x + 1.0)
     w = np.broadcast_to(0.5 * h * ref_w, x.shape)
     return x.ravel(), w.ravel().copy()
-
-
-def weighted_products(basis: Basis, x: NDArray[np.float64], w: NDArray[np.float64],
-                      order_left: int, order_right: int) -> sp.csr_matrix:
-    """Sparse ``Σ_q w_q D^{a} b_k(x_q) D^{c} b_l(x_q)`` with ``a = order_left``, ``c = order_right``.
-
-    Vectorised over points: each point contributes an ``(n+1) × (n+1)`` block.
-    """
-    top = max(order_left, order_right)
-    index, values = basis.nonzero_derivatives(x, top)
-    left = values[order_left] * w[:, None]
-    right = values[order_right]
-    blocks = left[:, :, None] * right[:, None, :]
-    rows = np.broadcast_to(index[:, :, None], blocks.shape).ravel()
-    cols = np.broadcast_to(index[:, None, :], blocks.shape).ravel()
-    return sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(basis.size, basis.size))
 
 
 def gram_matrix(basis: Basis, order: int) -> sp.csr_matrix:
