@@ -17,7 +17,7 @@ import splinedeform.solvers
 PACKAGE = Path(splinedeform.__file__).parent
 SOLVERS = sorted(Path(splinedeform.solvers.__file__).parent.glob("*.py"))
 ABOVE = {"model", "solution", "cli", "pipeline", "scenario", "export", "modal_solve",
-         "spectrum", "bench", "bench_goals", "sculpt", "outputs", "budget", "body", "readout"}
+         "spectrum", "bench", "bench_goals", "sculpt", "outputs", "budget", "body", "readout", "modal_solution"}
 """Modules of the layers above the solvers (``splinedeform.<name>`` and below it)."""
 
 

@@ -9,9 +9,10 @@ from typing import Any, Callable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .readout import Readout, _selected_rows
+from .readout import Readout
 from .solution import Solution, _check_times, _first
 from .solvers.bases import DenseBasis, ModalBasis
+from .solvers.products import selected_rows
 from .threads import owned
 
 Array = NDArray[np.float64]
@@ -122,13 +123,13 @@ class ModalSolution(Solution):
 
     def _direct(self, times: Array) -> Array | None:
         """Nets ``p_rest + T d`` without storing ``d`` (at 128², 200 frames: 77 MB) where
-        ``T`` selects points (:func:`~.readout._selected_rows`), every time is this
+        ``T`` selects points (:func:`~.solvers.products.selected_rows`), every time is this
         solution's own and no correction is left for ``d``: the expansion goes straight
         into the free points' rows; ``None`` elsewhere (then :meth:`_displacements`)."""
         readout = self.readout
         if not isinstance(readout, Readout) or readout.per_point != 1:
             return None
-        rows = _selected_rows(readout.T)
+        rows = selected_rows(readout.T)
         active = getattr(self.response, "active", np.arange(readout.columns))
         if rows is None or not (self.correction is None or self._early(active)):
             return None

@@ -18,6 +18,7 @@ import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
 from .errors import InputError
+from .solvers.products import selected_rows
 from .surface import Surface
 
 Array = NDArray[np.float64]
@@ -194,7 +195,7 @@ def _expand(T: sp.spmatrix, d_free: Array, per_point: int = 1) -> Array:
         full = np.asarray(T @ flat).reshape((T.shape[0],) + lead)
         return np.moveaxis(full, 0, -1).reshape(lead + (-1, 3))
     lead = d_free.shape[:-2]
-    rows = _selected_rows(T)
+    rows = selected_rows(T)
     if rows is not None:                # gather each point's free row, zero the others
         source = np.zeros(T.shape[0], dtype=np.intp)
         source[rows] = np.arange(rows.size)
@@ -205,18 +206,6 @@ def _expand(T: sp.spmatrix, d_free: Array, per_point: int = 1) -> Array:
         return full
     flat = np.moveaxis(d_free, -2, 0).reshape(T.shape[1], -1)
     return np.moveaxis((T @ flat).reshape((T.shape[0],) + lead + (3,)), 0, -2)
-
-
-def _selected_rows(T: sp.spmatrix) -> NDArray[np.int64] | None:
-    """The row of each column of ``T`` when ``T`` is a selection (one entry 1 per column,
-    distinct rows), else ``None``."""
-    if not sp.issparse(T) or T.nnz != T.shape[1]:
-        return None
-    C = T.tocsc()
-    if not (np.all(np.diff(C.indptr) == 1) and np.all(C.data == 1.0)):
-        return None
-    rows = np.asarray(C.indices)
-    return rows if np.unique(rows).size == rows.size else None
 
 
 def free_coordinates(readout: Readout | BodyReadout, T: sp.spmatrix, net: ArrayLike | None,

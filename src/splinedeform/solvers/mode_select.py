@@ -58,6 +58,7 @@ from numpy.typing import NDArray
 from .bases import DenseBasis
 from .mode_acceleration import StaticCorrection
 from .modal_basis import DEFAULT_ADVICE
+from .products import selected_rows
 from .mode_count import decay_bound, error_bound
 from .rigid import check_resolved
 from .sparse_eigen import BlockLanczos, factorise
@@ -119,8 +120,8 @@ def pointwise_bound(M: sp.spmatrix, T: sp.spmatrix | None = None,
     diagonal ``M`` gives ``1/M_pp`` and a general one ``1/λ_min(M)`` (``(M⁻¹)_pp ≤
     λ_max(M⁻¹)``), ``λ_min`` from Lanczos less its residual norm (a lower bound).
     """
-    if inverse_diagonal is not None and T is not None and _selects(T):
-        rows = np.asarray(T.tocsc().indices)
+    rows = None if inverse_diagonal is None or T is None else selected_rows(T)
+    if rows is not None:
         return float(np.sqrt(np.max(inverse_diagonal[rows])))
     diagonal = M.diagonal()
     if sp.issparse(M) and M.nnz == np.count_nonzero(diagonal):
@@ -134,13 +135,6 @@ def pointwise_bound(M: sp.spmatrix, T: sp.spmatrix | None = None,
         residual = float(np.linalg.norm(M @ vector[:, 0] - value[0] * vector[:, 0]))
         low = float(value[0]) - residual
     return float(np.sqrt(1.0 / max(low, 1e-300)))
-
-
-def _selects(T: sp.spmatrix) -> bool:
-    """Whether ``T`` is a selection: one entry ``1`` per column, distinct rows."""
-    T = sp.csc_matrix(T)
-    return bool(T.nnz == T.shape[1] and np.all(np.diff(T.indptr) == 1)
-                and np.all(T.data == 1.0) and np.unique(T.indices).size == T.nnz)
 
 
 def envelope_table(lam_low: float, gamma: float, beta: float, tau: Array
