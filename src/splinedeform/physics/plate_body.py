@@ -201,9 +201,7 @@ def rigid_count(body: Body, material: Material, constraints: BodyConstraints) ->
     for (p, _), preset in constraints.edges.items():
         held[label[p]] |= preset in holds
     if holds == ("pinned", "clamped"):
-        for p in constraints.fixed_patches:
-            held[label[p]] = True
-    if holds == ("pinned", "clamped"):
+        held[label[list(constraints.fixed_patches)]] = True
         return int(np.sum(~held))
     return 0 if held.all() else None
 
