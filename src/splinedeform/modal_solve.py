@@ -22,7 +22,8 @@ from numpy.typing import ArrayLike, NDArray
 from . import spectrum
 from .errors import InputError
 from .modal_solution import ModalSolution
-from .solvers import modal_basis, mode_select
+from .solvers import kronecker_product, modal_basis, mode_select
+from .solvers.kronecker_product import KroneckerProduct
 from .solvers.sparse_eigen import BlockLanczos
 from .solvers.analytic import ModalResponse
 from .solvers.rigid import UnresolvedSpectrum
@@ -198,13 +199,14 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
     # load (fewer solves), for this call alone; else the model's random-start space, kept
     # for further load cases
     one_off = krylov is None and times is not None and at.size <= ONE_OFF_TIMES
+    mass_product = kronecker_mass(model, M)
     if krylov is None and not one_off:
-        krylov = _KRYLOV[model] = BlockLanczos(K, M)
+        krylov = _KRYLOV[model] = BlockLanczos(K, M, mass_product=mass_product)
     gamma, beta, c_inf = physics.damping_rate, physics.rayleigh, pointwise_factor(model)
     out_of_reach = model.n_free > modal_basis.DENSE_MAX    # all modes cannot be had
     basis, correction, report = mode_select.automatic_basis(
         K, M, spatial[0], gamma, beta, at, tolerance, krylov=krylov, pointwise=c_inf,
-        best_effort=out_of_reach, load_started=one_off)
+        best_effort=out_of_reach, load_started=one_off, mass_product=mass_product)
     krylov = report.pop("krylov")
     if one_off and not report.get("load_started"):
         _KRYLOV[model] = krylov               # the search went on in a random-start space
@@ -219,7 +221,8 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
                 else mode_select.automatic_basis(K, M, spatial[0], gamma, beta, at, below,
                                                  krylov=krylov, pointwise=c_inf,
                                                  best_effort=out_of_reach,
-                                                 load_started=one_off)
+                                                 load_started=one_off,
+                                                 mass_product=mass_product)
             report.update(tolerance=tolerance, of_static=below)
             if one_off and not report.get("load_started", True):
                 _KRYLOV[model] = report["krylov"]       # went on in a random-start space
@@ -244,6 +247,17 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
         report["correction"] = correction
         report["times"] = at
     return report
+
+
+def kronecker_mass(model: Model, M: Any) -> KroneckerProduct | None:
+    """``M_r = μ Ĝ0u ⊗ Ĝ0v`` applied through its reduced 1-D factors
+    (:mod:`~splinedeform.solvers.kronecker_product`) where the model has them (tensor-product
+    constraints, a consistent mass) and they reproduce ``M_r``; else ``None``."""
+    factors = getattr(model, "_factors", None)
+    if factors is None or getattr(model, "mass_matrix", "") != "consistent":
+        return None
+    product = KroneckerProduct(factors.u[0], factors.v[0], model.material.mass)
+    return kronecker_product.checked(product, M)
 
 
 def default_times(t_end: float, jump_times: list[float]) -> Array:

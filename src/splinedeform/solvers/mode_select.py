@@ -177,7 +177,8 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
                     gamma: float, beta: float, times: Array, tolerance: float,
                     start: int = START, advice: str = "", krylov: BlockLanczos | None = None,
                     pointwise: float | None = None, best_effort: bool = False,
-                    load_started: bool = False) -> tuple[Any, Any, dict[str, Any]]:
+                    load_started: bool = False, mass_product: Any | None = None
+                    ) -> tuple[Any, Any, dict[str, Any]]:
     """The fewest lowest modes whose a-priori bound (module docstring) meets ``tolerance``
     at ``times``: relative to ``max_t ‖K⁻¹F(t)‖_M`` in the M-norm, or, with ``pointwise``,
     in the largest control-point coordinate (:func:`pointwise_bound`).
@@ -200,6 +201,7 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
     best_effort : where all modes would be needed, return the computed ones instead (their
         bound, above ``tolerance``, in the report with ``met = False``): for nets whose
         complete eigen-solution is out of reach.
+    mass_product : ``X ↦ M X`` for the Krylov space (:class:`~.sparse_eigen.BlockLanczos`).
     pointwise : ``c_∞ ≥ max_p √((M⁻¹)_pp)``: the bound becomes
         ``c_∞ Σ_j ‖R_j‖_M E(t − t_j) / max_t ‖K⁻¹F(t)‖_∞`` (:func:`pointwise_bound`).
 
@@ -232,7 +234,8 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
     statics = solved.reshape(n, J, a).transpose(1, 0, 2)
     if krylov is None:
         load_started = bool(load_started and np.any(solved))
-        krylov = BlockLanczos(K, M, lu, start=solved if load_started else None)
+        krylov = BlockLanczos(K, M, lu, start=solved if load_started else None,
+                              mass_product=mass_product)
     report.update(krylov=krylov, load_started=load_started)
     if pointwise is None:
         scale = np.sqrt(max((_m_norm2(M, s) for s in np.cumsum(statics, axis=0)),
@@ -252,7 +255,7 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
         if load_started and k > LOAD_STARTED_MODES:
             # many modes: narrow blocks orthogonalise slowly, and a load exciting few modes
             # fills its invariant subspace; the model's random-start space, same LU
-            krylov, load_started = BlockLanczos(K, M, lu), False
+            krylov, load_started = BlockLanczos(K, M, lu, mass_product=mass_product), False
             report.update(krylov=krylov, load_started=False)
         modes = krylov.lowest(k)
         lam = check_resolved(modes.lam, 0, "sparse eigen-solution",
