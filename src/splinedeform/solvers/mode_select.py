@@ -74,6 +74,12 @@ START = 16
 FEW_TIMES = 16
 """Up to this many times, a count that meets the tolerance with the static correction is
 kept without looking for fewer modes with the transient one."""
+NEAR = 8
+"""At up to :data:`FEW_TIMES` times, a static estimate (:func:`_grown`) within this many
+modes of those computed is grown to without trying the transient correction: its
+:data:`~.transient_correction.DEGREE` solves per load jump and its fit cost about what
+five to ten more modes of a one-vector Krylov space cost (about three solves a mode: 60
+for 20 at 64²)."""
 LOAD_STARTED_MODES = 48
 """A space started from the load serves up to this many modes (its blocks are one vector
 per load direction); a search for more goes on in a random-start space."""
@@ -283,8 +289,12 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
         last = (k, modes, lam, coef, norms, relative)
         weight = factor / max(scale, 1e-300)
         # where the static bound meets the tolerance at a few times, fewer modes with the
-        # transient correction would save little of their evaluation and cost its solves
-        dynamic = None if fits.size and times.size <= FEW_TIMES else transient_count(
+        # transient correction would save little of their evaluation and cost its solves;
+        # so would it where the static one is expected to with a few more modes (NEAR)
+        estimate = None if fits.size or times.size > FEW_TIMES else _grown(
+            k, lam, norms, grid, E, column, tolerance * scale / factor)
+        near = estimate is not None and estimate[1] <= k + NEAR
+        dynamic = None if (fits.size and times.size <= FEW_TIMES) or near else transient_count(
             int(fits[0]) - 1 if fits.size else k, lam, norms, jump_times, gamma, beta, times,
             weight, tolerance, weight * bound)
         if fits.size or dynamic is not None:
@@ -311,7 +321,8 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
             else:
                 correction = StaticCorrection(jump_times, jump_parts, [])
             return basis, correction, report
-        grown, needed = _grown(k, lam, norms, grid, E, column, tolerance * scale / factor)
+        grown, needed = estimate or _grown(k, lam, norms, grid, E, column,
+                                           tolerance * scale / factor)
         if k >= 64 and lam[k] < over_damped_from(gamma, beta):
             # the transient correction applies from the first over-damped mode on: grow to
             # it where the static correction is expected to need more modes (or half)
