@@ -283,16 +283,17 @@ def _largest_below(basis: Any, correction: Any, report: dict[str, Any], jumps: l
     for t_j, F in jumps:
         merged[t_j] = merged.get(t_j, 0.0) + np.asarray(F, dtype=float)
     order = sorted(merged)
-    coef = [basis.project(merged[t_j]) / basis.lam[:, None] for t_j in order]
+    projected = [basis.project(merged[t_j]) for t_j in order]
+    coef = [g / basis.lam[:, None] for g in projected]
     statics = np.cumsum([basis.expand(g[None])[0] + part
                          for g, part in zip(coef, correction.jump_parts)], axis=0)
     _, p, c = np.unravel_index(int(np.argmax(np.abs(statics))), statics.shape)
     lam = basis.lam
-    zero = np.zeros((lam.size, statics.shape[-1]))       # 3 coordinates, or 1 column
+    zero = np.zeros((lam.size, 1))                      # the one coordinate c
     response = ModalResponse(lam, gamma + beta * lam, zero, zero,
-                             [(t_j, basis.project(merged[t_j])) for t_j in order], [])
+                             [(t_j, g[:, c:c + 1]) for t_j, g in zip(order, projected)], [])
     row = basis.phi[p]                          # a DenseBasis (automatic_basis)
-    d = response(times)[0][:, :, c] @ row + correction.coordinate(times, p, c)
+    d = response(times)[0][:, :, 0] @ row + correction.coordinate(times, p, c)
     # max_t |d(t)| − bound(t)·S: the times by |d| falling, the bound evaluated a few at a
     # time until no time left can exceed the best (the bound is ≥ 0)
     size = np.abs(d)
