@@ -323,6 +323,10 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
             return basis, correction, report
         grown, needed = estimate or _grown(k, lam, norms, grid, E, column,
                                            tolerance * scale / factor)
+        if near and load_started:
+            # the space serves this call alone and grows a vector at a time: ask for the
+            # count estimated (one more round if it is short) rather than 1.25 k
+            grown = max(k + 1, int(np.ceil(needed)))
         if k >= 64 and lam[k] < over_damped_from(gamma, beta):
             # the transient correction applies from the first over-damped mode on: grow to
             # it where the static correction is expected to need more modes (or half)
