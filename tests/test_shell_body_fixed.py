@@ -218,6 +218,40 @@ def test_a_trimmed_face_of_a_shell_body_takes_no_fixed_points():
         ShellModel(body, SHELL, "free", fixed=[None, mask])
 
 
+def test_an_untrimmed_patch_of_a_body_with_trimmed_faces_takes_held_points():
+    # the left half untrimmed, the right one holed by a circle (coupled to it by the
+    # iso-edge penalty, physics/shell_body_trimmed.py). Holding the left side's row 0
+    # whole and row 1 in z is the flat plate's clamp of that side (open knots: the slope
+    # at u = 0 is a multiple of d_1 − d_0, and a clamp in the plane z = 0 holds z's slope
+    # only, physics/shell_edges.py), so the two maps hold the same coordinates and the
+    # answers agree to round-off (measured 0; 1e-12 of the scale)
+    from splinedeform.trim import CircleLoop, PolygonLoop, TrimDomain
+
+    left = flat_patch((0, 0.5), (0, 1), (3, 3))
+    outer = PolygonLoop([[0.0, 0.0], [0.5, 0.0], [0.5, 1.0], [0.0, 1.0]])
+    right = flat_patch((0.5, 1), (0, 1), (3, 3)).with_trim(
+        TrimDomain(outer, (CircleLoop((0.25, 0.5), 0.15),)))
+    body = sd.Body([left, right])
+    mask = np.zeros((N, N, 3), dtype=bool)
+    mask[0], mask[1, :, 2] = True, True
+    held = ShellModel(body, SHELL, "free", fixed=[mask, None])
+    clamped = ShellModel(body, SHELL, {(0, "u0"): "clamped"})
+    # the free rigid motions are counted on every point of the untrimmed patch, the
+    # held ones at rest: none is left (counts, exact)
+    assert held.rigid.shape[1] == clamped.rigid.shape[1] == 0
+    assert held.n_free == clamped.n_free
+    a = [np.asarray(d) for d in held.static(BENDING).net_displacement()]
+    b = [np.asarray(d) for d in clamped.static(BENDING).net_displacement()]
+    scale = max(float(np.abs(d).max()) for d in b)
+    for x, y in zip(a, b):
+        np.testing.assert_allclose(x, y, rtol=0, atol=1e-12 * scale)
+    # a pinned side leaves the rotation about it, and only that (before, the pinned
+    # points of an untrimmed patch were left out and all six motions counted free)
+    pinned = ShellModel(body, SHELL, {(0, "u0"): "pinned"})
+    assert pinned.rigid_motions == ["rotation about the axis along (0, 1, 0) through "
+                                    "(0, 0, 0)"]
+
+
 # -- the scenario key boundary.faces_free_points under physics = "shell" -------------------
 PATCH = "[[2, 2], [2, 3], [3, 2], [3, 3]]"
 
