@@ -19,9 +19,9 @@ points of the two edges) asks ``d_{r_a} = d_{r_b}``: where both rows of ``T_b`` 
 class, the classes being the connected components of that graph); where one row is zero
 (the component is held: by the edge condition, or by the patch's mask of ``fixed``
 components, :func:`~splinedeform.body.constraints.body_fixed_mask`) the other's column is
-held too, so a point patches share is held when any of them holds it. Where a row combines several
-columns (the points of a pole, tied to one point by a null-space basis of ``T_p``) the pair
-is imposed instead, ``T = T_b S N`` with ``range N = null((T_b S)[r_a] − (T_b S)[r_b])``.
+held too, so a point patches share is held when any of them holds it. Where a row
+combines several columns (the points of a pole, tied to one point by a null-space basis
+of ``T_p``) the pair is imposed instead, ``T = T_b S N`` with ``range N = null((T_b S)[r_a] − (T_b S)[r_b])``.
 So merged control points share all three displacements exactly. Last, across every
 conforming interface, seam and C0 line where the rest shape is smooth, the slopes are tied
 on each component, ``T ← T E`` (:func:`.coupling_ties.tie_components`), with no rotation
