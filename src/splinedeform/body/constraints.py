@@ -140,8 +140,8 @@ def edge_rows(surface: Surface, edge: str) -> NDArray[np.int64]:
     return edge_points(index, edge)[:, 0]
 
 
-def body_fixed_mask(patches: Sequence[Surface],
-                    fixed: Sequence[ArrayLike | None] | None) -> NDArray[np.bool_] | None:
+def body_fixed_mask(patches: Sequence[Surface], fixed: Sequence[ArrayLike | None] | None,
+                    components: bool = False) -> NDArray[np.bool_] | None:
     """The body-wide mask of fixed control points: the patches' masks, row-major each,
     patch after patch (``N = Σ n_u n_v`` values), or ``None`` where none fixes a point.
 
@@ -150,6 +150,11 @@ def body_fixed_mask(patches: Sequence[Surface],
     fixed : sequence of bool arrays ``(n_u, n_v)`` or None, optional
         One entry per patch, ``True`` = held at rest; ``None`` for a patch with nothing
         fixed beyond its edge conditions.
+    components : bool
+        Also take a mask ``(n_u, n_v, 3)`` per displacement component (the shell's three
+        unknowns per point); the result is then per component, interleaved (``3N``
+        values, entry ``3k + c`` component ``c`` of point ``k``), a mask ``(n_u, n_v)``
+        holding all three components of its points.
 
     Raises
     ------
@@ -166,22 +171,26 @@ def body_fixed_mask(patches: Sequence[Surface],
     if len(fixed) != len(patches):
         raise InputError(f"fixed has {len(fixed)} masks for a body of {len(patches)} "
                          "patches: give one per patch (None where nothing is fixed)")
+    per = 3 if components else 1
     masks = []
     for p, (surface, mask) in enumerate(zip(patches, fixed)):
+        net = tuple(surface.shape)
         if mask is None:
-            masks.append(np.zeros(surface.shape[0] * surface.shape[1], dtype=bool))
+            masks.append(np.zeros(net[0] * net[1] * per, dtype=bool))
             continue
         mask = np.asarray(mask)
-        if mask.shape != tuple(surface.shape):
+        if mask.shape != net and not (components and mask.shape == net + (3,)):
+            also = f" or, per component, {net + (3,)}" if components else ""
             raise InputError(f"fixed[{p}]: the mask of patch {p} must have the shape of its "
-                             f"control net (n_u, n_v) = {tuple(surface.shape)}, got "
-                             f"{mask.shape}")
+                             f"control net (n_u, n_v) = {net}{also}, got {mask.shape}")
         if mask.dtype != bool:
             raise InputError(f"fixed[{p}]: the mask of patch {p} must be boolean, got dtype "
                              f"{mask.dtype}")
         if mask.any() and surface.trim is not None:
             raise InputError(f"fixed[{p}]: patch {p} is a trimmed face; fixed control points "
                              "are taken on untrimmed patches only")
+        if components and mask.shape == net:         # a whole point: its three components
+            mask = np.repeat(mask[..., None], 3, axis=-1)
         masks.append(mask.ravel())
     out = np.concatenate(masks)
     return out if out.any() else None

@@ -17,9 +17,11 @@ identifies. A merged pair of dofs ``(r_a, r_b)`` (the same component of the ``k`
 points of the two edges) asks ``d_{r_a} = d_{r_b}``: where both rows of ``T_b`` are unit rows
 ``e_{j_a}``, ``e_{j_b}`` this is ``x_{j_a} = x_{j_b}`` (the columns are joined into one
 class, the classes being the connected components of that graph); where one row is zero
-(the component is held) the other's column is held too. Where a row combines several
-columns (the points of a pole, tied to one point by a null-space basis of ``T_p``) the pair
-is imposed instead, ``T = T_b S N`` with ``range N = null((T_b S)[r_a] − (T_b S)[r_b])``.
+(the component is held: by the edge condition, or by the patch's mask of ``fixed``
+components, :func:`~splinedeform.body.constraints.body_fixed_mask`) the other's column is
+held too, so a point patches share is held when any of them holds it. Where a row
+combines several columns (the points of a pole, tied to one point by a null-space basis
+of ``T_p``) the pair is imposed instead, ``T = T_b S N`` with ``range N = null((T_b S)[r_a] − (T_b S)[r_b])``.
 So merged control points share all three displacements exactly. Last, across every
 conforming interface, seam and C0 line where the rest shape is smooth, the slopes are tied
 on each component, ``T ← T E`` (:func:`.coupling_ties.tie_components`), with no rotation
@@ -87,8 +89,8 @@ class ShellBodySystem:
 
 def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
                 boundary: str | Mapping[tuple[int, str], str] = "free",
-                given: Mapping[int, tuple[sp.spmatrix, sp.spmatrix]] | None = None
-                ) -> ShellBodySystem:
+                given: Mapping[int, tuple[sp.spmatrix, sp.spmatrix]] | None = None,
+                fixed: NDArray[np.bool_] | None = None) -> ShellBodySystem:
     """Assemble the shell body of the module docstring.
 
     Parameters
@@ -101,6 +103,13 @@ def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
     given : mapping, optional
         ``{patch: (K_p, M_p)}``: the matrices of those patches, taken instead of
         :func:`.shell.matrices` (a trimmed face's, :mod:`.shell_body_trimmed`).
+    fixed : bool array ``(3N,)``, optional
+        Held displacement components, interleaved, patch after patch
+        (:func:`~splinedeform.body.constraints.body_fixed_mask` with ``components``): each
+        patch's share is its ``fixed`` of :func:`.shell_edges.constraint_matrix`, so a held
+        component is a zero row of ``T_b``, and :func:`merge_columns` holds its partner
+        across a conforming interface too (a point shared by patches is held when any
+        holds it); the pole maps and the slope ties ``E`` are imposed on that ``T_b S``.
     """
     if not isinstance(body, Body):
         body = Body(body)
@@ -112,8 +121,11 @@ def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
     offsets = np.concatenate([[0], np.cumsum(sizes)])
     own = [check_edges(s, {e: presets.get((p, e), "free") for e in EDGES})
            for p, s in enumerate(patches)]
-    Tb = sp.block_diag([constraint_matrix(s, e, weak_rotation=True)
-                        for s, e in zip(patches, own)], format="csr")
+    held = [None if fixed is None else
+            fixed[3 * offsets[p]:3 * offsets[p + 1]].reshape(s.shape + (3,))
+            for p, s in enumerate(patches)]
+    Tb = sp.block_diag([constraint_matrix(s, e, mask, weak_rotation=True, alone=False)
+                        for s, e, mask in zip(patches, own, held)], format="csr")
     given = given or {}
     blocks = [given[p] if p in given else matrices(s, material)
               for p, s in enumerate(patches)]
@@ -145,8 +157,8 @@ def body_system(body: Body | Sequence[Surface], material: ShellMaterial,
         T = impose(T, T[rest[:, 0]] - T[rest[:, 1]])
     T = tie_components(T, ties.C)
     if T.shape[1] == 0:
-        raise InputError("no free displacement: the boundary holds every control point of "
-                         f"the {len(patches)} patches")
+        raise InputError("no free displacement: the boundary and the fixed components hold "
+                         f"every control point of the {len(patches)} patches")
     return ShellBodySystem(K, M, T, presets, offsets, ties,
                            any(c is not None for c in clamps))
 
@@ -180,7 +192,7 @@ def merge_columns(Tb: sp.csr_matrix, pairs: NDArray[np.int64]
     links = first[pairs[both]]
     graph = sp.coo_matrix((np.ones(len(links)), (links[:, 0], links[:, 1])), shape=(n, n))
     _, label = connected_components(graph, directed=False)
-    held = np.zeros(label.max() + 1, dtype=bool)
+    held = np.zeros(label.max(initial=-1) + 1, dtype=bool)
     beside_held = np.concatenate([pairs[zero[pairs[:, 0]] & unit[pairs[:, 1]], 1],
                                   pairs[unit[pairs[:, 0]] & zero[pairs[:, 1]], 0]])
     held[label[first[beside_held]]] = True

@@ -52,13 +52,17 @@ Array = NDArray[np.float64]
 
 
 def trimmed_body_system(body: Body, material: ShellMaterial,
-                        boundary: str | Mapping[Any, str] = "free") -> ShellBodySystem:
+                        boundary: str | Mapping[Any, str] = "free",
+                        fixed: NDArray[np.bool_] | None = None) -> ShellBodySystem:
     """The shell of a body with trimmed faces (module docstring).
 
     ``boundary`` is one kind for every boundary edge and trim loop, or a mapping keyed
     ``(patch, edge)`` and ``(face, loop)`` (``"outer"``, ``"hole1"``, ``"outer.2"`` …) as
     :class:`splinedeform.BodyModel` takes it; a loop or trim edge shared with another face
-    takes none (:func:`~splinedeform.body.trimmed.loop_presets`).
+    takes none (:func:`~splinedeform.body.trimmed.loop_presets`). ``fixed`` holds
+    components of the untrimmed patches as :func:`.shell_body.body_system` does (a mask
+    on a trimmed face is refused by :func:`~splinedeform.body.constraints.body_fixed_mask`:
+    its map is Höllig's extension, not its control points).
     """
     patches = body.patches
     faces = sorted(p for p, s in enumerate(patches) if s.trim is not None)
@@ -69,7 +73,8 @@ def trimmed_body_system(body: Body, material: ShellMaterial,
               for p in faces}
     system = body_system(body, material, {k: v for k, v in presets.items()
                                           if k[0] not in shells},
-                         given={p: (s.stiffness, s.mass) for p, s in shells.items()})
+                         given={p: (s.stiffness, s.mass) for p, s in shells.items()},
+                         fixed=fixed)
     offsets = system.offsets
     K = system.K
     edges = {**presets, **loops}
@@ -115,8 +120,9 @@ def with_face_maps(T: sp.csr_matrix, offsets: NDArray[np.int64],
 def body_motions(body: Body, T: sp.csr_matrix, offsets: NDArray[np.int64],
                  held: set[int]) -> RigidMotions:
     """The free rigid motions of the body (module docstring): those in ``range T`` on the
-    moving control points of the connected parts without a face in ``held`` (a face whose
-    loops or edges Nitsche's terms hold)."""
+    control points of the connected parts without a face in ``held`` (a face whose loops
+    or edges Nitsche's terms hold), a trimmed face's moving ones only (its dropped
+    functions are no points of the shell; an untrimmed patch's held points are, at rest)."""
     n = len(body.patches)
     links = [(i.a, i.b) for i in body.topology.interfaces + body.trim_interfaces
              + body.edge_interfaces] or [(0, 0)]
@@ -125,7 +131,8 @@ def body_motions(body: Body, T: sp.csr_matrix, offsets: NDArray[np.int64],
     free_parts = set(label.tolist()) - {int(label[p]) for p in held}
     points = np.concatenate([s.control_points.reshape(-1, 3) for s in body.patches])
     patch_of = np.searchsorted(offsets, np.arange(len(points)), side="right") - 1
-    moving = np.diff(T.indptr)[::3] > 0
+    trimmed = np.array([s.trim is not None for s in body.patches])
+    moving = (np.diff(T.indptr)[::3] > 0) | ~trimmed[patch_of]
     chosen = np.flatnonzero(moving & np.isin(label[patch_of], list(free_parts)))
     if chosen.size == 0:
         return RigidMotions(np.zeros((T.shape[1], 0)), np.zeros((6, 0)))

@@ -172,10 +172,13 @@ def _orders(kind: str, axis: int | None, c: int) -> tuple[int, ...]:
 
 
 def constraint_matrix(surface: Surface, boundary: Mapping[str, str],
-                      fixed: Array | None = None, weak_rotation: bool = False) -> sp.csr_matrix:
+                      fixed: Array | None = None, weak_rotation: bool = False,
+                      alone: bool = True) -> sp.csr_matrix:
     """``T`` with ``d = T d_free`` over the interleaved ``3n`` displacements (module doc);
     with ``weak_rotation`` a curved surface's clamped edges are pinned, their rotation left
-    to :func:`.shell_clamp.clamp_rotation` (else the whole slope is held)."""
+    to :func:`.shell_clamp.clamp_rotation` (else the whole slope is held). A surface
+    ``alone`` must keep a free displacement; a body's patch (``alone=False``) may be held
+    whole, its neighbours moving."""
     edges = check_edges(surface, boundary)
     weak = weak_clamps(surface, edges) if weak_rotation else ()
     kinds = {**edges, **{e: "pinned" for e in weak}}
@@ -210,7 +213,7 @@ def constraint_matrix(surface: Surface, boundary: Mapping[str, str],
         T = _impose(T, slope_rows(surface, edge, axes[edge]) @ T)
     for edge in (e for e, kind in edges.items() if kind == "pole"):
         T = _impose(T, _pole_rows(T, surface, edge))
-    if T.shape[1] == 0:
+    if T.shape[1] == 0 and alone:
         raise InputError("the shell's boundary conditions and fixed components leave no "
                          "displacement free")
     return T

@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from ..body.body import Body
+from ..body.constraints import body_fixed_mask
 from ..body.loads import surface_field
 from ..errors import InputError, SingularSystemError
 from ..solvers.system import Reduction
@@ -72,8 +73,9 @@ class ShellFormulation:
     boundary : mapping edge -> kind, optional
         For a body one kind for every boundary edge, or ``{(patch, edge): kind}``.
     fixed : bool array ``(n_u, n_v, 3)`` or ``(n_u, n_v)``, optional
-        Displacement components (or whole control points) that do not move (a single
-        surface only).
+        Displacement components (or whole control points) that do not move; for a body
+        one such mask (or None) per patch
+        (:func:`~splinedeform.body.constraints.body_fixed_mask`).
 
     Attributes
     ----------
@@ -91,21 +93,21 @@ class ShellFormulation:
     methods = ("analytic",)
 
     def __init__(self, surface: Surface | Body | Sequence[Surface], material: ShellMaterial,
-                 boundary: Mapping | str | None = None, fixed: ArrayLike | None = None):
+                 boundary: Mapping | str | None = None,
+                 fixed: ArrayLike | Sequence[ArrayLike | None] | None = None):
         if not isinstance(material, ShellMaterial):
             raise InputError("a shell needs a ShellMaterial(E, nu, thickness, density)")
         self.material = material
         motions = None
         if isinstance(surface, (Body, list, tuple)):
-            if fixed is not None:
-                raise InputError("a shell body is held by its boundary edges; fixed "
-                                 "components are for a single surface")
             self.body = surface if isinstance(surface, Body) else Body(surface)
+            mask = body_fixed_mask(self.body.patches, fixed, components=True)
             if any(s.trim is not None for s in self.body.patches):   # :mod:`.shell_body_trimmed`
                 from .shell_body_trimmed import trimmed_body_system as build
             else:
                 build = body_system
-            system = build(self.body, material, "free" if boundary is None else boundary)
+            system = build(self.body, material, "free" if boundary is None else boundary,
+                           fixed=mask)
             motions = system.motions
             self.patches: tuple[Surface, ...] | None = self.body.patches
             self.surface, self.offsets = None, system.offsets

@@ -83,8 +83,11 @@ class ShellModel(Model):
         boundary edge, or ``{(patch, edge): kind}`` (a trimmed face's loops and trim edges
         keyed ``(face, "outer")``, ``(face, "hole1.0")`` …).
     fixed : bool array ``(n_u, n_v, 3)`` or ``(n_u, n_v)``, optional
-        Individual displacement components (or whole control points) that do not move
-        (a single surface only).
+        Individual displacement components (or whole control points) that do not move.
+        For a body a sequence of one such mask (or None) per patch, as
+        :class:`~splinedeform.body.BodyModel`'s ``fixed``: a control point that patches
+        share (merged across a conforming interface) is held where any patch holds it;
+        a trimmed face takes none.
     """
 
     mass_matrix = "consistent"
@@ -93,7 +96,8 @@ class ShellModel(Model):
 
     @owned
     def __init__(self, surface: Surface | Body | Sequence[Surface], material: ShellMaterial,
-                 boundary: Mapping | str | None = None, fixed: ArrayLike | None = None):
+                 boundary: Mapping | str | None = None,
+                 fixed: ArrayLike | Sequence[ArrayLike | None] | None = None):
         start = time.perf_counter()
         self.formulation = shell = ShellFormulation(surface, material, boundary, fixed)
         self.material, self.physics = material, "shell"

@@ -195,10 +195,6 @@ def check_body_scenario(scenario: Scenario, body: FileBody) -> None:
                                              f"{len(body)} faces; list each face's moving "
                                              "control points in boundary.faces_free_points "
                                              "(0 = [[i, j], ...])")
-    if "faces_free_points" in raw and s.material.physics == "shell":
-        raise s.error("boundary.faces_free_points", "fixed control points of a body are "
-                      "taken by the plate (physics intrinsic or parametric), not yet by the "
-                      "shell")
     for ext in s.output.formats:
         if ext not in BODY_FORMATS:
             raise s.error("output.formats", f"{ext} is not written for a body of "
@@ -298,6 +294,11 @@ def face_masks(scenario: Scenario, body: FileBody) -> list[Any] | None:
         if patch is None:
             raise scenario.error(f"boundary.faces_free_points.{key}", f"face {key} is not in "
                                  f"this body, whose faces are {list(body.faces)}")
+        if body[patch].trim is not None:
+            raise scenario.error(f"boundary.faces_free_points.{key}", f"face {key} is trimmed: "
+                                 "its moving points are those its region covers, held by its "
+                                 "loops' conditions; fixed control points are taken on "
+                                 "untrimmed faces only")
         masks[patch] = moving_points_mask(scenario, points, body[patch].shape,
                                           f"boundary.faces_free_points.{key}",
                                           f"face {key}: its net")
@@ -308,7 +309,8 @@ def body_model(scenario: Scenario, body: FileBody) -> Any:
     """The model of a body scenario: a :class:`~splinedeform.body.BodyModel` (the thin plate
     under tension), or under ``physics = "shell"`` a
     :class:`~splinedeform.physics.shell_model.ShellModel` of the body (conforming interfaces
-    merged, the rest and every interface's rotation coupled, :mod:`..physics.shell_body`)."""
+    merged, the rest and every interface's rotation coupled, :mod:`..physics.shell_body`),
+    both with the masks of ``boundary.faces_free_points`` (:func:`face_masks`)."""
     from ..body.model import BodyModel
     from ..material import Material
     from .build import _located
@@ -323,7 +325,7 @@ def body_model(scenario: Scenario, body: FileBody) -> Any:
         with _located(scenario, "material"):
             shell = ShellMaterial(**scenario.material.shell())
         with _located(scenario, "boundary"):
-            return ShellModel(body, shell, boundary)
+            return ShellModel(body, shell, boundary, fixed=fixed)
     with _located(scenario, "material"):
         material = Material(**scenario.material.weights())
     with _located(scenario, "boundary"):
