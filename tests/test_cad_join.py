@@ -121,3 +121,22 @@ def test_a_scenario_reports_the_edges_joined_by_geometry(files, tmp_path):
     body = json.loads((tmp_path / "out" / "report.json").read_text())["body"]
     assert body["topology"]["joined_by_geometry"] == 1
     assert body["topology"]["shared"] == 1 and body["interfaces"] == 1
+
+
+def test_the_faces_command_lists_the_joins_of_plain_surfaces(files):
+    from typer.testing import CliRunner
+
+    from splinedeform import cli
+
+    runner = CliRunner()
+    for path in files:
+        result = runner.invoke(cli.app, ["faces", str(path)])
+        assert result.exit_code == 0, result.output
+        assert ("edges: 1 shared, 6 boundary, 0 seam(s), 0 non-manifold; 1 interface(s), "
+                "1 conforming; 1 joined by geometry\n") in result.output
+        result = runner.invoke(cli.app, ["faces", "--json", str(path)])
+        topology = json.loads(result.output)["topology"]
+        # counts are integers: compared exactly
+        assert (topology["joined_by_geometry"], topology["shared"]) == (1, 1)
+        assert [(i["a"], i["edge_a"], i["b"], i["edge_b"]) for i in topology["interfaces"]] \
+            == [(0, "u1", 1, "u0")]

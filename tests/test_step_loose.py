@@ -228,3 +228,26 @@ def test_a_loose_face_is_joined_to_a_shell_s_free_side(tmp_path):
     # face's 3 free sides
     assert topology.counts == {"shared": 2, "boundary": 8, "seam": 0, "non_manifold": 0,
                                "off_sides": 0, "joined_by_geometry": 1}
+
+
+def test_a_scenario_on_the_loose_tee_uses_and_reports_the_joins(files, tmp_path):
+    import shutil
+
+    shutil.copy(files["tee"], tmp_path / "tee.step")
+    path = tmp_path / "tee.toml"
+    path.write_text('[surface]\nshape = "cad"\npath = "tee.step"\n'
+                    '[material]\nw10 = 1.0\nw01 = 1.0\n[boundary]\nu0 = "clamped"\n'
+                    'u1 = "clamped"\nv0 = "clamped"\nv1 = "clamped"\n'
+                    '[[load]]\nkind = "uniform"\nforce = [0.0, 0.0, 1.0]\n'
+                    '[solve]\nkind = "static"\nframes = 2\n[output]\nformats = ["report"]\n')
+    result = runner.invoke(cli.app, ["validate", str(path)])
+    assert result.exit_code == 0, result.output
+    assert ("3 shared, 7 boundary, 0 seam, 0 non-manifold, 0 off-sides, 2 partly-shared, "
+            "3 joined-by-geometry, 2 partly-joined-by-geometry") in result.output
+    result = runner.invoke(cli.app, ["run", str(path), "-o", str(tmp_path / "out")])
+    assert result.exit_code == 0, result.output
+    body = json.loads((tmp_path / "out" / "report.json").read_text())["body"]
+    # integers, exactly: the body merges the one whole interface
+    assert body["interfaces"] == 1
+    assert (body["topology"]["joined_by_geometry"],
+            body["topology"]["partly_joined_by_geometry"]) == (3, 2)
