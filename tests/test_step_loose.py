@@ -251,3 +251,25 @@ def test_a_scenario_on_the_loose_tee_uses_and_reports_the_joins(files, tmp_path)
     assert body["interfaces"] == 1
     assert (body["topology"]["joined_by_geometry"],
             body["topology"]["partly_joined_by_geometry"]) == (3, 2)
+
+
+def test_three_loose_faces_on_one_side_are_one_non_manifold_edge(tmp_path):
+    """Three pages of a book, ``x = 0`` their common side: one curve where three sides
+    meet, counted as the body counts it (:meth:`splinedeform.Body.summary`)."""
+    pages = []
+    for angle in (0.0, 2.0, 4.0):
+        page = sd.shapes.plane(size=(1.0, 1.0), cells=2)
+        P = page.control_points
+        pages.append(page.with_control_points(np.stack(
+            [P[..., 0] * np.cos(angle), P[..., 1], P[..., 0] * np.sin(angle)], axis=-1)))
+    path = write_step(tmp_path / "book.step", [patch_from_surface(p) for p in pages])
+    surfaces, topology, info = read_body(path)
+    # integers, exactly: each pair of the three u0 sides is an interface, the curve is
+    # one non-manifold edge and no shared one, as the body of the pages counts them
+    found = sd.Body(pages).summary()
+    assert (found["non_manifold"], found["shared"], found["boundary"]) == (1, 0, 9)
+    assert {k: topology.counts[k] for k in ("non_manifold", "shared", "boundary")} == {
+        "non_manifold": 1, "shared": 0, "boundary": 9}
+    assert topology.counts["joined_by_geometry"] == 3
+    assert {frozenset(sides(i)) for i in topology.interfaces} == {
+        frozenset({(a, "u0"), (b, "u0")}) for a, b in ((0, 1), (0, 2), (1, 2))}

@@ -60,12 +60,13 @@ def join_loose_faces(surfaces: Sequence[Any], topology: Topology, loose: set[int
 
     With ``A`` the interfaces added, ``T`` the stretches (each pair of sides once) and
     ``F`` the sides no interface takes: ``joined_by_geometry = |A| + |T|``,
-    ``partly_joined_by_geometry = |T|``; ``shared`` plus the interfaces of ``A`` between
-    two surfaces and ``|T|``, ``partly_shared`` plus ``|T|``, ``seam`` plus those of one
-    surface with itself; ``boundary`` plus the loose surfaces' sides in ``F`` on no
-    stretch, less the other surfaces' sides (each one file edge) in ``A`` or on a
-    stretch; ``non_manifold`` plus the curves where three or more sides of loose
-    surfaces meet. :attr:`~splinedeform.cad_topology.Topology.stretches` lists ``T`` as
+    ``partly_joined_by_geometry = |T|``; ``non_manifold`` plus the curves where three or
+    more sides meet, one of a loose surface (each pair of them an interface of ``A``, as
+    :func:`~splinedeform.body.topology.find_topology` gives them), ``shared`` plus the
+    other interfaces of ``A`` between two surfaces and ``|T|``, ``partly_shared`` plus
+    ``|T|``, ``seam`` plus those of one surface with itself; ``boundary`` plus the loose
+    surfaces' sides in ``F`` on no stretch, less the other surfaces' sides (each one file
+    edge) in ``A`` or on a stretch. :attr:`~splinedeform.cad_topology.Topology.stretches` lists ``T`` as
     ``(a, edge_a, b, edge_b)``.
     """
     if not loose:
@@ -85,13 +86,15 @@ def join_loose_faces(surfaces: Sequence[Any], topology: Topology, loose: set[int
     stretches = list(parts)
     coupled = {s for a, ea, b, eb in stretches for s in ((a, ea), (b, eb))}
     counts = dict(topology.counts)
-    counts["shared"] += sum(i.a != i.b for i in added) + len(stretches)
-    counts["seam"] += sum(i.a == i.b for i in added)
+    groups = [group for group in found.non_manifold if any(p in loose for p, _ in group)]
+    grouped = {side for group in groups for side in group}
+    manifold = [i for i in added if (i.a, i.edge_a) not in grouped]
+    counts["shared"] += sum(i.a != i.b for i in manifold) + len(stretches)
+    counts["seam"] += sum(i.a == i.b for i in manifold)
     counts["boundary"] += (sum(p in loose for p, e in free if (p, e) not in coupled)
                            - sum((i.a not in loose) + (i.b not in loose) for i in added)
                            - sum(p not in loose for p, _ in coupled))
-    counts["non_manifold"] += sum(any(p in loose for p, _ in group)
-                                  for group in found.non_manifold)
+    counts["non_manifold"] += len(groups)
     if stretches:
         counts["partly_shared"] = counts.get("partly_shared", 0) + len(stretches)
     counts["joined_by_geometry"] = len(added) + len(stretches)
