@@ -66,7 +66,8 @@ def join_loose_faces(surfaces: Sequence[Any], topology: Topology, loose: set[int
     other interfaces of ``A`` between two surfaces and ``|T|``, ``partly_shared`` plus
     ``|T|``, ``seam`` plus those of one surface with itself; ``boundary`` plus the loose
     surfaces' sides in ``F`` on no stretch, less the other surfaces' sides (each one file
-    edge) in ``A`` or on a stretch. :attr:`~splinedeform.cad_topology.Topology.stretches` lists ``T`` as
+    edge) in ``A`` or on a stretch. The result's
+    :attr:`~splinedeform.cad_topology.Topology.stretches` lists ``T`` as
     ``(a, edge_a, b, edge_b)``.
     """
     if not loose:
@@ -95,7 +96,7 @@ def join_loose_faces(surfaces: Sequence[Any], topology: Topology, loose: set[int
                            - sum((i.a not in loose) + (i.b not in loose) for i in added)
                            - sum(p not in loose for p, _ in coupled))
     counts["non_manifold"] += len(groups)
-    if stretches:
+    if stretches:                        # keys in the order they are reported
         counts["partly_shared"] = counts.get("partly_shared", 0) + len(stretches)
     counts["joined_by_geometry"] = len(added) + len(stretches)
     if stretches:
