@@ -1,9 +1,9 @@
 """A .3dm mixing Breps and loose surfaces: the loose ones joined where their edges meet.
 
-The file holds a Brep (rhino3dm's ``Brep.CreateFromSurface``, with its own edges) and a
-plain NURBS surface sharing one edge with it. The Brep's edges come from the file, the
-plain surface's from matching its sides (:mod:`splinedeform.cad_join`), and the report
-says which. Checked against the same two surfaces written as plain surfaces only (every
+The file holds a Brep (rhino3dm's ``Brep.CreateFromSurface``, with its own edges, each
+used by its one face: joined to nothing, so loose too) and a plain NURBS surface sharing
+one edge with it. The join comes from matching their sides (:mod:`splinedeform.cad_join`),
+and the report says so. Checked against the same two surfaces written as plain surfaces only (every
 interface from the geometry): the same interface, the same answer.
 """
 
@@ -73,12 +73,15 @@ def test_the_loose_surface_is_joined_to_the_brep_face_by_geometry(files):
     assert joined.conforming and not joined.reversed
     assert info["joined_by_geometry"] == [{"face_a": 0, "edge_a": "u1", "face_b": 1,
                                            "edge_b": "u0"}]
-    # from the file: the Brep's 4 edges, each used once; the matching joins one of them
-    # with the loose surface's u0 and leaves its other 3 sides free: 1 shared, 6 boundary
+    # the Brep's 4 edges are each used once: a Brep of one face joined to nothing, loose
+    # as the plain surface is; the matching joins its u1 with the plain surface's u0 and
+    # leaves the other 3 sides of each free: 1 shared, 6 boundary
     assert topology.counts == {"shared": 1, "boundary": 6, "seam": 0, "non_manifold": 0,
                                "off_sides": 0, "joined_by_geometry": 1}
-    # a file of plain surfaces only keeps its own path (no file edges, nothing to join)
-    assert read_body(plain)[2]["joined_by_geometry"] == []
+    # a file of plain surfaces only: the same matching, the same join listed
+    plain_topology, plain_info = read_body(plain)[1:]
+    assert plain_info["joined_by_geometry"] == info["joined_by_geometry"]
+    assert plain_topology.counts == topology.counts
 
 
 def test_the_mixed_body_deforms_as_the_plain_one(files):
@@ -118,3 +121,22 @@ def test_a_scenario_reports_the_edges_joined_by_geometry(files, tmp_path):
     body = json.loads((tmp_path / "out" / "report.json").read_text())["body"]
     assert body["topology"]["joined_by_geometry"] == 1
     assert body["topology"]["shared"] == 1 and body["interfaces"] == 1
+
+
+def test_the_faces_command_lists_the_joins_of_plain_surfaces(files):
+    from typer.testing import CliRunner
+
+    from splinedeform import cli
+
+    runner = CliRunner()
+    for path in files:
+        result = runner.invoke(cli.app, ["faces", str(path)])
+        assert result.exit_code == 0, result.output
+        assert ("edges: 1 shared, 6 boundary, 0 seam(s), 0 non-manifold; 1 interface(s), "
+                "1 conforming; 1 joined by geometry\n") in result.output
+        result = runner.invoke(cli.app, ["faces", "--json", str(path)])
+        topology = json.loads(result.output)["topology"]
+        # counts are integers: compared exactly
+        assert (topology["joined_by_geometry"], topology["shared"]) == (1, 1)
+        assert [(i["a"], i["edge_a"], i["b"], i["edge_b"]) for i in topology["interfaces"]] \
+            == [(0, "u1", 1, "u0")]

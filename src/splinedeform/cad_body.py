@@ -6,8 +6,8 @@ child (:func:`splinedeform.cad_3dm_read.list_3dm_body`,
 face numbers as ``splinedeform faces`` lists them, or object names and layers), makes
 each a deformable :class:`~splinedeform.surface.Surface`
 (:func:`splinedeform.cad.surface_from_patch`) and finds the interfaces between them from
-the file's edges (:func:`splinedeform.cad_topology.body_topology`), and where the file
-mixes Breps and plain surfaces, those of the plain surfaces from the geometry
+the file's edges (:func:`splinedeform.cad_topology.body_topology`), and those of the faces that the
+file joins to nothing (plain surfaces, STEP faces sewn to none) from the geometry
 (:mod:`splinedeform.cad_join`). A face that cannot
 be deformed (unreadable, general weights on unclamped knots) is skipped, and ``info``
 says why; a trimmed face is taken untrimmed, with one warning line naming it.
@@ -23,7 +23,7 @@ from typing import Any, Sequence, Union
 from .cad import CAD_SUFFIXES, NurbsPatch, surface_from_patch
 from .cad_child import check_cad_file, read_in_child
 from .cad_faces import is_trimmed
-from .cad_join import join_loose_faces, loose_faces
+from .cad_join import file_edges, join_loose_faces, loose_faces
 from .cad_topology import Topology, body_topology
 from .errors import InputError, InputWarning
 
@@ -123,10 +123,12 @@ def read_body(path: str | os.PathLike, faces: FaceChoice = "all"
         ``names`` (object name of each, or None), ``reversed`` (whether each is marked
         reversed in its Brep: its outward normal is ``-(S_u × S_v)``), ``trimmed`` (file
         face numbers taken untrimmed), ``skipped`` (``{face number: why}``) and
-        ``joined_by_geometry``: where the file mixes Breps and plain surfaces, the
-        interfaces found by matching the plain surfaces' sides
-        (:mod:`splinedeform.cad_join`), ``{"face_a", "edge_a", "face_b", "edge_b"}`` in
-        file face numbers; the file's own interfaces come first in ``topology``.
+        ``joined_by_geometry``: the interfaces found by matching the sides of the loose
+        faces, those the file joins to nothing (plain surfaces, STEP faces sewn to none;
+        :mod:`splinedeform.cad_join`), ``{"face_a", "edge_a", "face_b", "edge_b"}`` in
+        file face numbers (the file's own interfaces come first in ``topology``), and
+        ``partly_joined_by_geometry`` the sides of theirs that share only a stretch with
+        another (T-junctions, coupled along it by the body), likewise.
     """
     path = Path(path)
     listing = read_listing(path)
@@ -164,18 +166,21 @@ def body_of(path: Path, listing: dict[str, Any], chosen: list[int]
     if not surfaces:
         raise InputError(f"{path}: none of the faces chosen can be deformed: "
                          + "; ".join(f"face {k}: {why}" for k, why in skipped.items()))
-    topology = body_topology(patches, listing["edges"], kept)
+    loose = loose_faces(listing, kept, trimmed)
+    edges = file_edges(listing, {kept[k] for k in loose})
+    topology = body_topology(patches, edges, kept)
     file_count = len(topology.interfaces)
-    loose = loose_faces(listing, kept)
-    if loose and len(loose) < len(kept):     # Breps and loose surfaces: join them
-        topology = join_loose_faces(surfaces, topology, loose)
+    topology = join_loose_faces(surfaces, topology, loose)
     info = {"units": listing["units"], "faces": kept,
             "names": [listing["faces"][k].get("name") for k in kept],
             "reversed": [bool(listing["faces"][k].get("reversed")) for k in kept],
             "trimmed": trimmed, "skipped": skipped,
             "joined_by_geometry": [
                 {"face_a": kept[i.a], "edge_a": i.edge_a, "face_b": kept[i.b],
-                 "edge_b": i.edge_b} for i in topology.interfaces[file_count:]]}
+                 "edge_b": i.edge_b} for i in topology.interfaces[file_count:]],
+            "partly_joined_by_geometry": [
+                {"face_a": kept[a], "edge_a": ea, "face_b": kept[b], "edge_b": eb}
+                for a, ea, b, eb in topology.stretches]}
     return surfaces, topology, info
 
 

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import json
 import os
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -46,19 +47,52 @@ def read_faces(path: str | os.PathLike) -> dict[str, Any]:
     ``degenerate``, ``area`` (of the untrimmed surface), ``reversed`` (marked reversed in
     its Brep: ``TopAbs_REVERSED``, ``BrepFace.OrientationIsReversed``) and
     ``trimmed_area`` (inside the face's loops, by OpenCASCADE; None for ``.3dm``), or
-    ``error`` for a face that cannot be read. Knot values are the file's parameters. ``topology`` holds the counts of
-    shared, boundary, seam, non-manifold and off-side edges of the whole file and its
-    interfaces (:mod:`splinedeform.cad_topology`)."""
+    ``error`` for a face that cannot be read. Knot values are the file's parameters.
+    ``topology`` holds the counts of shared, boundary, seam, non-manifold and off-side
+    edges of the whole file and its interfaces (:mod:`splinedeform.cad_topology`); where
+    the file joins some faces to nothing (plain surfaces, STEP faces sewn to none), those
+    of the body of every face that can be deformed, as ``faces = "all"`` reads it
+    (:func:`splinedeform.cad_body.read_body`): with the interfaces and T-junction
+    stretches found from the geometry (:mod:`splinedeform.cad_join`; the file's
+    interfaces first), counted ``joined_by_geometry`` and ``partly_joined_by_geometry``,
+    the stretches listed as ``stretches``; face numbers are the file's."""
     from .cad_body import patches_of, read_listing
     from .cad_topology import body_topology
 
     path = Path(path)
     data = read_listing(path)
     patches = patches_of(data)
-    topology = body_topology(patches, data["edges"], range(len(patches)))
     faces = [_describe(number, entry) for number, entry in enumerate(data["faces"])]
+    topology = _joined(path, data, faces) or body_topology(
+        patches, data["edges"], range(len(patches))).as_dict()
     return {"file": str(path), "units": data["units"], "faces": faces,
-            "topology": topology.as_dict()}
+            "topology": topology}
+
+
+def _joined(path: Path, data: dict[str, Any], faces: list[dict[str, Any]]
+            ) -> dict[str, Any] | None:
+    """The topology of the body of every deformable face with its geometric joins, in
+    file face numbers (see :func:`read_faces`); None where no face is loose or none can
+    be deformed."""
+    from .cad_body import body_of
+    from .cad_join import loose_faces
+    from .errors import InputError
+
+    trimmed = [f["face"] for f in faces if f.get("trimmed")]
+    if not loose_faces(data, range(len(faces)), trimmed):
+        return None
+    chosen = [f["face"] for f in faces if "error" not in f]
+    try:
+        with warnings.catch_warnings():      # trimmed faces: listed in the table already
+            warnings.simplefilter("ignore")
+            _, topology, info = body_of(path, data, chosen)
+    except InputError:
+        return None
+    out = topology.as_dict()
+    kept = info["faces"]
+    for item in out["interfaces"] + out.get("stretches", []):
+        item["a"], item["b"] = kept[item["a"]], kept[item["b"]]
+    return out
 
 
 def _describe(number: int, entry: dict[str, Any]) -> dict[str, Any]:
@@ -178,7 +212,10 @@ def loop_names_line(face: dict[str, Any]) -> str | None:
 
 def topology_line(topology: dict[str, Any]) -> str:
     """``edges: 12 shared, 0 boundary, 0 seams, 0 non-manifold`` (and the edges on no side
-    of their face's rectangle, and the interfaces found, conforming or not)."""
+    of their face's rectangle, the interfaces found, conforming or not, and where the
+    file joins some faces to nothing, how many joins were found from the geometry and how
+    many of them share only part of a side: ``; 3 joined by geometry (2 of them along
+    part of a side)``)."""
     conforming = sum(i["conforming"] for i in topology["interfaces"])
     line = (f"edges: {topology['shared']} shared, {topology['boundary']} boundary, "
             f"{topology['seam']} seam(s), {topology['non_manifold']} non-manifold")
@@ -189,7 +226,12 @@ def topology_line(topology: dict[str, Any]) -> str:
         trims = topology.get("trim_edges") or {}
         line += (f", {topology['off_sides']} on trimming loops ({trims.get('shared', 0)} "
                  f"shared by two faces, {trims.get('free', 0)} free)")
-    return (line + f"; {len(topology['interfaces'])} interface(s), {conforming} conforming")
+    line += f"; {len(topology['interfaces'])} interface(s), {conforming} conforming"
+    if "joined_by_geometry" in topology:
+        partly = topology.get("partly_joined_by_geometry", 0)
+        line += (f"; {topology['joined_by_geometry']} joined by geometry"
+                 + (f" ({partly} of them along part of a side)" if partly else ""))
+    return line
 
 
 def _loops_text(face: dict[str, Any]) -> tuple[str, str]:

@@ -61,17 +61,27 @@ class Topology:
         Of the ``off_sides`` edges: ``shared`` (two faces use it: a body whose faces are
         simulated trimmed couples them along it, :mod:`splinedeform.body.trim_edges`) and
         ``free`` (one face).
+    stretches : list of (int, str, int, str)
+        Sides of two faces that share only part of their length, found from the geometry
+        where the file gives a face no edges (:func:`splinedeform.cad_join.join_loose_faces`):
+        ``(a, edge_a, b, edge_b)``, coupled by the body along the stretch.
     """
 
     interfaces: list[Interface] = field(default_factory=list)
     counts: dict[str, int] = field(default_factory=lambda: dict.fromkeys(EDGE_KINDS, 0))
     trim_edges: dict[str, int] = field(default_factory=lambda: {"shared": 0, "free": 0})
+    stretches: list[tuple[int, str, int, str]] = field(default_factory=list)
 
     def as_dict(self) -> dict[str, Any]:
-        """Plain data (for JSON): the counts and one dict per interface."""
-        return {**self.counts, "trim_edges": dict(self.trim_edges), "interfaces": [
+        """Plain data (for JSON): the counts, one dict per interface and, where there are
+        any, one per stretch found from the geometry."""
+        out = {**self.counts, "trim_edges": dict(self.trim_edges), "interfaces": [
             {"a": i.a, "edge_a": i.edge_a, "b": i.b, "edge_b": i.edge_b,
              "reversed": i.reversed, "conforming": i.conforming} for i in self.interfaces]}
+        if self.stretches:
+            out["stretches"] = [{"a": a, "edge_a": ea, "b": b, "edge_b": eb}
+                                for a, ea, b, eb in self.stretches]
+        return out
 
 
 def coverage(s: NDArray[np.float64]) -> float:

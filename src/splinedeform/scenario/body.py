@@ -73,9 +73,9 @@ def is_body(surface: Any) -> bool:
 def body_from_cad(scenario: Scenario) -> tuple[Any, int, str | None]:
     """``(body, face, units)`` of ``surface.faces`` (``"all"`` when neither ``face`` nor
     ``faces`` is given): one face chosen gives no body and that face (read as ``face``
-    is); several give a :class:`FileBody` of their surfaces and the file's interfaces, or,
-    where the file has no edges among them (plain surfaces, no Brep), the interfaces found
-    where their edges meet."""
+    is); several give a :class:`FileBody` of their surfaces and their interfaces: the
+    file's, and those of the faces that the file joins to nothing (plain surfaces, STEP
+    faces sewn to none) found where their sides meet (:mod:`splinedeform.cad_join`)."""
     from ..cad_body import body_of, choose_faces, read_listing
     from ..errors import InputError
     from .build import _located
@@ -100,8 +100,8 @@ def body_from_cad(scenario: Scenario) -> tuple[Any, int, str | None]:
         if any(topology.counts.values()):
             return (FileBody(surfaces, topology.interfaces, info["faces"], topology.counts,
                              signs), chosen[0], info["units"])
-        # plain surfaces, not a Brep or shell: the file has no edges, so where the faces
-        # touch is found from their geometry (:func:`splinedeform.body.topology.find_topology`)
+        # nothing counted (no file edge and no side: faces closed in both directions):
+        # the body finds its own (:func:`splinedeform.body.topology.find_topology`)
         return FileBody(surfaces, None, info["faces"], {}, signs), chosen[0], info["units"]
 
 
