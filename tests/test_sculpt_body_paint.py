@@ -200,3 +200,21 @@ def test_bake_keeps_the_painted_set_under_the_new_files_face_numbers(tmp_path):
     listed = np.zeros((N, N), bool)
     listed[tuple(np.array(PAINTED).T)] = True
     assert np.abs(kept[~listed]).max() <= ZERO * top
+
+
+def test_the_message_bounds_a_bodys_painted_points_together():
+    from pydantic import ValidationError
+
+    from splinedeform.sculpt.messages import MAX_NET_POINTS, ResolveMessage, describe_error
+
+    half = [[0, 0]] * (MAX_NET_POINTS // 2 + 1)      # each face within the limit, not both
+    for extra, words in (({"faces_free_points": {"0": half, "1": half}},
+                          f"more than the {MAX_NET_POINTS}"),
+                         ({"faces_free_points": {"0": PAINTED}, "free_points": PAINTED},
+                          "not both")):
+        with pytest.raises(ValidationError) as info:
+            ResolveMessage.model_validate({"material": MATERIAL, "boundary": EVERY, **extra})
+        assert words in describe_error(info.value)
+    message = ResolveMessage.model_validate({"material": MATERIAL, "boundary": EVERY,
+                                             "faces_free_points": {"3": PAINTED}})
+    assert message.faces_free_points == {"3": [(2, 2), (3, 3)]}
