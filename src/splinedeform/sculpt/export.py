@@ -25,8 +25,9 @@ def payload(basis: SculptBasis) -> dict[str, Any]:
 
     The samples of a body's patches follow each other (``S = P ru rv``): ``grid`` is then
     ``[P ru, rv]``, ``u`` the patches' u samples one after the other and ``faces`` per patch
-    its ``v`` samples, control net shape and periodic directions, so the page draws each
-    patch as its own grid (no triangle joins two patches).
+    its ``v`` samples, control net shape, periodic directions, Greville abscissae and
+    parameter lengths, so the page draws each patch as its own grid (no triangle joins two
+    patches) and paints each patch's control points.
 
     With trimmed patches (:mod:`.trimmed`) the trim crossings follow the grids and
     ``trim`` holds the triangles to draw (int32 ``(F, 3)``), which samples lie inside the
@@ -50,7 +51,9 @@ def payload(basis: SculptBasis) -> dict[str, Any]:
             "u": np.concatenate([u for u, _ in basis.samples]).tolist(),
             "v": basis.samples[0][1].tolist(),
             "faces": [{"v": v.tolist(), "net": list(s.shape),
-                       "periodic": [bool(s.basis_u.periodic), bool(s.basis_v.periodic)]}
+                       "periodic": [bool(s.basis_u.periodic), bool(s.basis_v.periodic)],
+                       "greville": [s.basis_u.greville().tolist(), s.basis_v.greville().tolist()],
+                       "domain": [float(s.basis_u.length), float(s.basis_v.length)]}
                       for s, (_, v) in zip(basis.patches, basis.samples)],
             "lam": _b64(basis.lam, "<f8"), "damping": _b64(basis.damping, "<f8"),
             "phi": _b64(basis.phi_samples), "rest": _b64(np.concatenate(rest))}

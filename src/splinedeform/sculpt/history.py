@@ -116,7 +116,8 @@ def _baked_body(scenario: Scenario, basis: SculptBasis, nets: list[NDArray[np.fl
                 path: Path) -> tuple[Scenario, Path]:
     """The body's faces with ``nets`` as one sewn STEP shell (patch ``p`` its face ``p``;
     the refinement already done, so none asked again) and ``scenario`` on it: the faces
-    named by ``boundary.faces`` and by loads renumbered to the new file's."""
+    named by ``boundary.faces``, ``boundary.faces_free_points`` and by loads renumbered
+    to the new file's."""
     from ..export.body import write_body_step
 
     faces = list(getattr(basis.model.body, "faces", range(len(basis.patches))))
@@ -124,9 +125,10 @@ def _baked_body(scenario: Scenario, basis: SculptBasis, nets: list[NDArray[np.fl
                     orientation=getattr(basis.model.body, "orientation", None))
     number = {face: patch for patch, face in enumerate(faces)}
     overrides: dict[str, Any] = {"surface": {"shape": "cad", "path": path.name, "faces": "all"}}
-    named = scenario.raw.get("boundary", {}).get("faces")
-    if named:
-        overrides["boundary.faces"] = {str(number[int(k)]): v for k, v in named.items()}
+    for key in ("faces", "faces_free_points"):      # edge presets, painted sets
+        named = scenario.raw.get("boundary", {}).get(key)
+        if named:
+            overrides[f"boundary.{key}"] = {str(number[int(k)]): v for k, v in named.items()}
     loads = scenario.raw.get("load")
     if loads:
         overrides["load"] = [{**t, "face": number[int(t["face"])]} if "face" in t else t

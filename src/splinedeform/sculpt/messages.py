@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, Strict, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, Strict, ValidationError, model_validator
 
 MAX_PUSHES = 20000
 """Most force segments one save may hold (a drag changes the force once per frame)."""
@@ -80,16 +80,35 @@ MAX_NET_POINTS = 160000
 NetIndex = Annotated[Count, Field(ge=0, le=100000)]
 
 
+NetPoints = Annotated[list[tuple[NetIndex, NetIndex]], Field(max_length=MAX_NET_POINTS)]
+"""Control points listed ``[i, j]``: row ``i`` along u, column ``j`` along v, from 0."""
+FacesPoints = Annotated[dict[FaceNumber, NetPoints], Field(max_length=MAX_FACES)]
+"""A body's painted control points per face, keyed by the file's face number."""
+
+
 class ResolveMessage(_Message):
     """Re-solve the modes with a new material, boundary and moving set: a box
     (``free_region``), control points listed ``[i, j]`` (``free_points``, what the page
-    paints), or neither (the whole net moves)."""
+    paints on one surface; ``faces_free_points`` ``{"3": [[i, j], …]}`` on a body's faces,
+    the other faces moving), or neither (the whole net moves). A body's painted points
+    together are at most :data:`MAX_NET_POINTS`."""
 
     material: MaterialMessage
     boundary: BoundaryMessage
     free_region: FreeRegionMessage | None = None
-    free_points: Annotated[list[tuple[NetIndex, NetIndex]],
-                           Field(max_length=MAX_NET_POINTS)] | None = None
+    free_points: NetPoints | None = None
+    faces_free_points: FacesPoints | None = None
+
+    @model_validator(mode="after")
+    def _bounded(self) -> "ResolveMessage":
+        total = sum(len(points) for points in (self.faces_free_points or {}).values())
+        if total > MAX_NET_POINTS:
+            raise ValueError(f"faces_free_points lists {total} control points, more than "
+                             f"the {MAX_NET_POINTS} one message may hold")
+        if self.free_points is not None and self.faces_free_points is not None:
+            raise ValueError("give free_points (one surface) or faces_free_points (a "
+                             "body's faces), not both")
+        return self
 
 
 class CorrectionMessage(_Message):

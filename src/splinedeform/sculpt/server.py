@@ -8,7 +8,8 @@ page shows it):
 - ``GET /api/page``: the page for the current basis without the session token, to be kept
   as a file ("Save offline page");
 - ``GET /api/status``: progress of a re-solve ``{busy, stage, elapsed, error, version}``;
-- ``POST /api/resolve``: ``{material, boundary, free_region | free_points}`` → new modes,
+- ``POST /api/resolve``: ``{material, boundary, free_region | free_points |
+  faces_free_points}`` → new modes,
   answered with the new data and ``carry``, the map of the old modal state onto the new
   modes (:mod:`.carry`);
 - ``POST /api/correction``: ``{version, index}`` → the static correction column of a sample;

@@ -9,7 +9,8 @@ the same scenario with the pushes as ``[[load]]`` point forces with step profile
 A scenario of several CAD faces (``shape = "cad"``, ``faces = "all"``) opens as a body: the
 modes are those of its :class:`~splinedeform.body.BodyModel`, sampled face by face
 (:mod:`.modal`); a grab lands on the face under the pointer, whose number the saved load
-names; bake and export keep every face (:mod:`.history`, :mod:`.shape_files`).
+names; bake and export keep every face (:mod:`.history`, :mod:`.shape_files`); the page
+paints each face's moving control points, ``boundary.faces_free_points`` (:mod:`.body_paint`).
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from ..errors import InputError, ScenarioError
 from ..scenario import build, free_region_mask, scenario_to_toml, with_overrides
 from ..scenario.spec import Scenario
 from .body_edges import boundary_edges, faces_override
+from .body_paint import body_free_mask, painted_overrides
 from .carry import transfer
 from .correction import StaticCorrection, offline_data, static_correction
 from .export import _b64, payload
@@ -138,8 +140,7 @@ class Session:
             box = None if region is None else {k: list(getattr(region, k)) for k in "uv"
                                                if getattr(region, k) is not None} or None
             overrides["boundary.free_region"] = box     # None (or {}): the whole net moves
-            points = message.free_points
-            overrides["boundary.free_points"] = None if points is None else [list(p) for p in points]
+            overrides.update(painted_overrides(message, self.basis.is_body))
             try:
                 self._solve(with_overrides(self.scenario, overrides, origin="sculpt page"))
             except ScenarioError as exc:    # the page's settings, not a line of the file
@@ -232,8 +233,8 @@ class Session:
     def payload(self) -> dict[str, Any]:
         """The modal data (see :func:`.export.payload`) plus the control net, the current
         material and boundary, and what the server offers; a body's adds ``body`` (its
-        faces' numbers, unit and boundary edges with their presets, :mod:`.body_edges`) and
-        has no free set."""
+        faces' numbers, unit and boundary edges with their presets, :mod:`.body_edges`),
+        whose free set is painted face by face (:mod:`.body_paint`)."""
         basis, model = self.basis, self.basis.model
         data = payload(basis)
         s = self.scenario
@@ -274,8 +275,8 @@ class Session:
     def _free_mask(self) -> np.ndarray:
         """The moving set the scenario names (box or list), row-major, True = free; the
         edge presets may hold some of these points too (:meth:`_still_mask` says which)."""
-        if self.basis.is_body:                  # a body: every face's net moves
-            return np.ones(self.basis.phi_net.shape[0], bool)
+        if self.basis.is_body:                  # a body: the faces' painted sets
+            return body_free_mask(self.scenario, self.basis)
         fixed = free_region_mask(self.scenario, self.basis.model.surface)
         shape = self.basis.model.surface.shape
         return np.ones(shape[0] * shape[1], bool) if fixed is None else ~np.ravel(fixed)

@@ -7,7 +7,8 @@ import re
 
 PAGE_FIELDS = {"material": "Material", "boundary": "Boundary",
                "boundary.free_region": "Free set: the free region box",
-               "boundary.free_points": "Free set: the painted control points"}
+               "boundary.free_points": "Free set: the painted control points",
+               "boundary.faces_free_points": "Free set: the painted control points of face"}
 """What the page calls a key of the scenario (material weights and edges: ``Material
 w10``, ``Boundary u0``)."""
 

@@ -29,7 +29,7 @@
       "spring": "spring stiffness as a multiple of the grabbed point's own stiffness (1/flexibility): at 1 the point goes half-way to the pointer when it comes to rest",
       "show-net": "show the control net (its points move with the surface)",
       "colour": "colour the surface by the size of its displacement |d| (plasma), or plain",
-      "paint": "drag over the surface to free the control points under the brush (shift: fix them); Apply re-solves",
+      "paint": data.body ? "drag over a face to free its control points under the brush (shift: fix them), one face at a time; Apply re-solves" : "drag over the surface to free the control points under the brush (shift: fix them); Apply re-solves",
       "brush": "brush radius on the parameter domain scaled to [0, 1]²",
       "paint-all": "every control point free", "paint-none": "every control point fixed",
       "apply": "re-solve with the painted free set",

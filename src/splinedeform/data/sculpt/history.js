@@ -118,7 +118,7 @@
   }
   // pin the control point nearest (Greville points, parameter domain) to sample n
   function pin(n) {
-    if (data.body) { showMessage("pinning a control point is for one surface; a body's faces move as one net"); return Promise.resolve(null); }
+    if (data.body) { showMessage("pinning a control point is for one surface; on a body, paint each face's free set instead"); return Promise.resolve(null); }
     const { u: cu, v: cv } = sampleAt(n);
     return bake(nearestNetPoint(cu, cv));
   }

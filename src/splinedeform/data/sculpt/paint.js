@@ -6,6 +6,9 @@
   // parameter domain scaled to [0, 1]² (wrapped across a periodic seam); the control point
   // nearest to it is always included (r = 0 picks one point). With the net shown, a press
   // near a drawn control point centres the brush on that point. Apply re-solves.
+  // A body's faces are painted one at a time: the face under the pointer (or of the control
+  // point picked), in its own parameters; its points are rows start … start + nu·nv - 1
+  // of the net (data.faces[p]: net, greville, domain), sent as faces_free_points.
   const paintBox = document.getElementById("paint"), brushBox = document.getElementById("brush");
   const paintInfo = document.getElementById("paint-info");
   let painting = false;
@@ -22,34 +25,56 @@
       c[3 * k] = rgb[0]; c[3 * k + 1] = rgb[1]; c[3 * k + 2] = rgb[2];
     }
     netColors.needsUpdate = true;
+    const perFace = data.body ? faceList.map((face, p) => {
+      const start = faceStart(p), size = face.net[0] * face.net[1];
+      return "face " + data.body.faces[p] + ": " + freeMask.subarray(start, start + size).reduce((a, b) => a + b, 0);
+    }).join(", ") : "";
     paintInfo.textContent = count + " of " + NN + " control points free (green)" +
-      (held ? ", " + held + " of them held by the edges (orange)" : "") +
+      (perFace ? " (" + perFace + ")" : "") +
+      (held ? ", " + held + " of them held by the edges" + (data.body ? " or a neighbouring face" : "") + " (orange)" : "") +
       (freeEdited ? ": not applied yet" : "");
     dirty = true;
   }
   let freeEdited = false;
+  // face p's first row in the net; the face of net row k with its (i, j); its Greville
+  // abscissae and parameter lengths (one surface: the panel's)
+  function faceStart(p) {
+    let start = 0;
+    for (let m = 0; m < p; m++) start += faceList[m].net[0] * faceList[m].net[1];
+    return start;
+  }
+  function netFace(k) {
+    for (let p = 0, start = 0; p < faceList.length; p++) {
+      const [nu, nv] = faceList[p].net;
+      if (k < start + nu * nv) return { p, i: Math.floor((k - start) / nv), j: (k - start) % nv };
+      start += nu * nv;
+    }
+    return null;
+  }
+  const faceGreville = (p) => faceList[p].greville || [gU, gV];
+  const faceDomain = (p) => faceList[p].domain || data.domain;
   function gap(a, b, length, periodic) {
     const d = Math.abs(a - b) / length;
     return periodic ? Math.min(d % 1, 1 - (d % 1)) : d;
   }
-  function nearestNetPoint(cu, cv) {
-    const [lu, lv] = data.domain, [pu, pv] = data.periodic;
+  function nearestNetPoint(cu, cv, p = 0) {
+    const [lu, lv] = faceDomain(p), [pu, pv] = faceList[p].periodic, [fu, fv] = faceGreville(p);
     let bi = 0, bj = 0;
-    for (let i = 1; i < gU.length; i++) if (gap(gU[i], cu, lu, pu) < gap(gU[bi], cu, lu, pu)) bi = i;
-    for (let j = 1; j < gV.length; j++) if (gap(gV[j], cv, lv, pv) < gap(gV[bj], cv, lv, pv)) bj = j;
-    return bi * gV.length + bj;
+    for (let i = 1; i < fu.length; i++) if (gap(fu[i], cu, lu, pu) < gap(fu[bi], cu, lu, pu)) bi = i;
+    for (let j = 1; j < fv.length; j++) if (gap(fv[j], cv, lv, pv) < gap(fv[bj], cv, lv, pv)) bj = j;
+    return faceStart(p) + bi * fv.length + bj;
   }
-  function brush(cu, cv, fix, centre) {
-    const [lu, lv] = data.domain, [pu, pv] = data.periodic, r = Number(brushBox.value);
-    const nv = gV.length, want = fix ? 0 : 1;
+  function brush(cu, cv, fix, centre, p = 0) {
+    const [lu, lv] = faceDomain(p), [pu, pv] = faceList[p].periodic, r = Number(brushBox.value);
+    const [fu, fv] = faceGreville(p), nv = fv.length, start = faceStart(p), want = fix ? 0 : 1;
     let changed = 0;
     const set = (k) => { if (freeMask[k] !== want) { freeMask[k] = want; changed++; } };
-    for (let i = 0; i < gU.length; i++) {
-      const du = gap(gU[i], cu, lu, pu);
+    for (let i = 0; i < fu.length; i++) {
+      const du = gap(fu[i], cu, lu, pu);
       if (du > r) continue;
       for (let j = 0; j < nv; j++) {
-        const dv = gap(gV[j], cv, lv, pv);
-        if (du * du + dv * dv <= r * r) set(i * nv + j);
+        const dv = gap(fv[j], cv, lv, pv);
+        if (du * du + dv * dv <= r * r) set(start + i * nv + j);
       }
     }
     set(centre);
@@ -75,12 +100,16 @@
     return best;
   }
   function stroke(event) {                   // true when the pointer is over the net or surface
-    const k = pickNet(event.clientX, event.clientY), nv = gV.length;
-    if (k >= 0) { brush(gU[Math.floor(k / nv)], gV[k % nv], event.shiftKey, k); return true; }
+    const k = pickNet(event.clientX, event.clientY);
+    if (k >= 0) {
+      const at = netFace(k), [fu, fv] = faceGreville(at.p);
+      brush(fu[at.i], fv[at.j], event.shiftKey, k, at.p);
+      return true;
+    }
     const n = pick(event.clientX, event.clientY);
     if (n < 0) return n === -2;                // outside the trims: refused, no rotation
-    const { u: cu, v: cv } = sampleAt(n);
-    brush(cu, cv, event.shiftKey, nearestNetPoint(cu, cv));
+    const { face: p, u: cu, v: cv } = sampleAt(n);
+    brush(cu, cv, event.shiftKey, nearestNetPoint(cu, cv, p), p);
     return true;
   }
   container.addEventListener("pointerdown", (event) => {
@@ -118,10 +147,20 @@
     }
     freeEdited = true; freeSource = "box"; paintNet();
   }
-  // what a re-solve sends: the box, or the listed points (nothing: the whole net moves)
+  // what a re-solve sends: the box, or the listed points (nothing: the whole net moves);
+  // a body's per face whose net is not all free, keyed by the file's face number
   function freeSet() {
     if (freeSource === "box") return { free_region: freeRegion() };
     if (freeMask.every((x) => x === 1)) return {};
+    if (data.body) {
+      const faces = {};
+      faceList.forEach((face, p) => {
+        const [nu, nv] = face.net, start = faceStart(p), points = [];
+        for (let k = 0; k < nu * nv; k++) if (freeMask[start + k]) points.push([Math.floor(k / nv), k % nv]);
+        if (points.length < nu * nv) faces[data.body.faces[p]] = points;
+      });
+      return { faces_free_points: faces };
+    }
     const nv = gV.length, points = [];
     for (let k = 0; k < NN; k++) if (freeMask[k]) points.push([Math.floor(k / nv), k % nv]);
     return { free_points: points };
