@@ -47,6 +47,7 @@ DEFAULT_TIMES = 201
 """Without ``times=`` the modes are chosen for this many evenly spaced times on ``[0, t_end]``
 and, after each load jump, the time half their spacing later (:func:`default_times`)."""
 _POINTWISE: weakref.WeakKeyDictionary[Any, float] = weakref.WeakKeyDictionary()
+_MASS: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()
 ONE_OFF_TIMES = 16
 """Up to this many times given at the call, on a model with no Krylov space yet, the modes
 are computed from a space started from the load (:func:`_automatic_modes`)."""
@@ -252,12 +253,14 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
 def kronecker_mass(model: Model, M: Any) -> KroneckerProduct | None:
     """``M_r = μ Ĝ0u ⊗ Ĝ0v`` applied through its reduced 1-D factors
     (:mod:`~splinedeform.solvers.kronecker_product`) where the model has them (tensor-product
-    constraints, a consistent mass) and they reproduce ``M_r``; else ``None``."""
-    factors = getattr(model, "_factors", None)
-    if factors is None or getattr(model, "mass_matrix", "") != "consistent":
-        return None
-    product = KroneckerProduct(factors.u[0], factors.v[0], model.material.mass)
-    return kronecker_product.checked(product, M)
+    constraints, a consistent mass) and they reproduce ``M_r``; else ``None``. Made once
+    per model."""
+    if model not in _MASS:
+        factors = getattr(model, "_factors", None)
+        _MASS[model] = None if factors is None or getattr(model, "mass_matrix", "") != \
+            "consistent" else kronecker_product.checked(
+                KroneckerProduct(factors.u[0], factors.v[0], model.material.mass), M)
+    return _MASS[model]
 
 
 def default_times(t_end: float, jump_times: list[float]) -> Array:
