@@ -140,3 +140,20 @@ def test_the_faces_command_lists_the_joins_of_plain_surfaces(files):
         assert (topology["joined_by_geometry"], topology["shared"]) == (1, 1)
         assert [(i["a"], i["edge_a"], i["b"], i["edge_b"]) for i in topology["interfaces"]] \
             == [(0, "u1", 1, "u0")]
+
+
+def test_a_file_body_reports_its_poles_beside_the_files_edge_counts():
+    """Two hemispheres (a pole at each end of v, both shared): the file's counts say nothing
+    of poles, the body's own topology finds them; the report's counts carry both (integers,
+    compared to half a unit)."""
+    import math
+
+    from body_patches import hemisphere
+    from splinedeform.scenario.body import FileBody
+
+    patches = [hemisphere(1.0, 0.0), hemisphere(1.0, math.pi)]
+    body = FileBody(patches, sd.Body(patches).interfaces, (0, 1),
+                    {"shared": 2, "boundary": 0, "seam": 0, "non_manifold": 0})
+    assert abs(body.counts["poles"] - body.summary()["poles"]) < 0.5
+    assert body.counts["poles"] >= 1.5 and abs(body.counts["shared"] - 2) < 0.5
+    assert abs(body.counts["non_conforming"]) < 0.5

@@ -46,7 +46,9 @@ class FileBody(Body):
     faces : sequence of int
         The file's face number of each patch.
     counts : dict
-        The file's edge counts (shared, boundary, seam, non_manifold, off_sides).
+        The file's edge counts (shared, boundary, seam, non_manifold, off_sides, and the
+        joins found by geometry); the body adds its ``poles`` and ``non_conforming``
+        interfaces (:meth:`~splinedeform.body.Body.summary`).
     orientation : sequence of {+1, -1}, optional
         Per patch ``-1`` where the file's Brep marks the face reversed
         (:attr:`~splinedeform.body.Body.orientation`: a pressure pushes along the Brep's
@@ -58,7 +60,9 @@ class FileBody(Body):
                  orientation: Sequence[int] | None = None):
         super().__init__(patches, interfaces, orientation=orientation)
         self.faces = tuple(int(f) for f in faces)
-        self.counts = dict(counts)
+        own = self.summary()          # what the file's edges do not say: poles, matching
+        self.counts = {**dict(counts), "poles": own["poles"],
+                       "non_conforming": own["non_conforming"]}
 
     def patch_of_face(self, face: int) -> int | None:
         """The patch index of the file's face ``face`` (None if the body lacks it)."""
