@@ -27,7 +27,7 @@ from ..errors import InputError, ScenarioError
 from ..scenario import build, free_region_mask, scenario_to_toml, with_overrides
 from ..scenario.spec import Scenario
 from .body_edges import boundary_edges, faces_override
-from .body_paint import body_free_mask, painted_overrides
+from .body_paint import body_free_mask, painted_overrides, pinned_body, point_classes
 from .carry import transfer
 from .correction import StaticCorrection, offline_data, static_correction
 from .export import _b64, payload
@@ -167,21 +167,29 @@ class Session:
 
     def bake(self, message: BakeMessage) -> None:
         """Make the shape of the modal state ``message.q`` the rest shape and re-solve
-        (:mod:`.history`); :attr:`transfer` maps the old modes onto the new ones."""
+        (:mod:`.history`); :attr:`transfer` maps the old modes onto the new ones. A pin
+        gives the new free set: ``free_points`` of one surface, ``faces_free_points`` of a
+        body (:func:`.body_paint.pinned_body`)."""
         with self._re_solving("baking"):
             with self._state_lock:
                 self._check_version(message.version)
                 basis, scenario = self.basis, self.scenario
             nets = baked_nets(basis, np.asarray(message.q, dtype=float))
+            # a pin: the free set less the pinned point (the wrong kind refused); a body's
+            # is applied before the bake, which renumbers its faces to the baked file's
+            pin = None if message.free_points is None and message.faces_free_points is None \
+                else painted_overrides(message, basis.is_body)
+            if pin is not None and basis.is_body:
+                scenario = pinned_body(scenario, basis, pin)
             folder = self.save_path.parent
             baked, path = baked_scenario(scenario, basis, nets, folder,
                                          f"{self.save_path.stem}-baked-{self._versions + 1}")
             try:
-                if message.free_points is not None:   # a pin: the set less the pinned point
-                    baked = with_overrides(baked, {
-                        "boundary.free_region": None,
-                        "boundary.free_points": [list(p) for p in message.free_points]},
-                        origin="sculpt page")
+                if pin is not None and not basis.is_body:
+                    baked = with_overrides(baked, {"boundary.free_region": None,
+                                                   "boundary.free_points":
+                                                   pin["boundary.free_points"]},
+                                           origin="sculpt page")
                 self._solve(baked)
             except ScenarioError as exc:
                 path.unlink(missing_ok=True)
@@ -252,7 +260,8 @@ class Session:
             data.update(net_shape=[int(net_rest.shape[0]), 1], periodic=[False, False],
                         free_region=None, greville=[[], []], body={
                             "faces": face_numbers(basis), "units": basis.units,
-                            "edges": boundary_edges(s, model)})
+                            "edges": boundary_edges(s, model),
+                            "classes": _b64(point_classes(basis), "<i4")})
             data["domain"] = [float(basis.patches[0].basis_u.length),
                               float(basis.patches[0].basis_v.length)]
             return data
