@@ -10,7 +10,8 @@ A scenario of several CAD faces (``shape = "cad"``, ``faces = "all"``) opens as 
 modes are those of its :class:`~splinedeform.body.BodyModel`, sampled face by face
 (:mod:`.modal`); a grab lands on the face under the pointer, whose number the saved load
 names; bake and export keep every face (:mod:`.history`, :mod:`.shape_files`); the page
-paints each face's moving control points, ``boundary.faces_free_points`` (:mod:`.body_paint`).
+paints each face's moving control points, ``boundary.faces_free_points`` (:mod:`.body_paint`),
+and a pin takes one point of a face out of that set (a bake, :meth:`Session.bake`).
 """
 
 from __future__ import annotations
@@ -241,8 +242,9 @@ class Session:
     def payload(self) -> dict[str, Any]:
         """The modal data (see :func:`.export.payload`) plus the control net, the current
         material and boundary, and what the server offers; a body's adds ``body`` (its
-        faces' numbers, unit and boundary edges with their presets, :mod:`.body_edges`),
-        whose free set is painted face by face (:mod:`.body_paint`)."""
+        faces' numbers, unit and boundary edges with their presets, :mod:`.body_edges`, and
+        ``classes``, the point of the body each net row is, int32), whose free set is
+        painted face by face (:mod:`.body_paint`)."""
         basis, model = self.basis, self.basis.model
         data = payload(basis)
         s = self.scenario
