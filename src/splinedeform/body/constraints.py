@@ -196,6 +196,27 @@ def body_fixed_mask(patches: Sequence[Surface], fixed: Sequence[ArrayLike | None
     return out if out.any() else None
 
 
+def merged_classes(patches: Sequence[Surface], topology: Topology) -> NDArray[np.int64]:
+    """The class of each control point of the body (rows patch after patch, row-major in
+    each): points that move as one (a conforming interface's ``k``-th points, a pole's
+    points) share a class, the connected components of those pairs (module docstring,
+    step 2); a point on no interface or pole is a class of its own."""
+    sizes = np.array([s.shape[0] * s.shape[1] for s in patches])
+    offsets = np.concatenate([[0], np.cumsum(sizes)])
+    pairs = [np.zeros((0, 2), dtype=np.int64)]
+    for i in (i for i in topology.interfaces if i.conforming):
+        ra = offsets[i.a] + edge_rows(patches[i.a], i.edge_a)
+        rb = offsets[i.b] + edge_rows(patches[i.b], i.edge_b)
+        pairs.append(np.stack([ra, rb[::-1] if i.reversed else rb], axis=1))
+    for p, e in topology.poles:
+        rows = offsets[p] + edge_rows(patches[p], e)
+        pairs.append(np.stack([np.full(rows.size, rows[0]), rows], axis=1))
+    pair = np.concatenate(pairs)
+    n = int(offsets[-1])
+    graph = sp.coo_matrix((np.ones(len(pair)), (pair[:, 0], pair[:, 1])), shape=(n, n))
+    return connected_components(graph, directed=False)[1].astype(np.int64)
+
+
 def build_body_constraints(patches: Sequence[Surface], topology: Topology,
                            presets: dict[Edge, str], smooth: bool = False,
                            fixed: NDArray[np.bool_] | None = None) -> BodyConstraints:
@@ -220,18 +241,8 @@ def build_body_constraints(patches: Sequence[Surface], topology: Topology,
         columns.append(offsets[p] + c.free_index)
     Tb = sp.block_diag(maps, format="csr")
     column_point = np.concatenate(columns)
-    pairs = [np.zeros((0, 2), dtype=np.int64)]
-    for i in (i for i in topology.interfaces if i.conforming):
-        ra = offsets[i.a] + edge_rows(patches[i.a], i.edge_a)
-        rb = offsets[i.b] + edge_rows(patches[i.b], i.edge_b)
-        pairs.append(np.stack([ra, rb[::-1] if i.reversed else rb], axis=1))
-    for p, e in topology.poles:
-        rows = offsets[p] + edge_rows(patches[p], e)
-        pairs.append(np.stack([np.full(rows.size, rows[0]), rows], axis=1))
-    pair = np.concatenate(pairs)
     n = int(offsets[-1])
-    graph = sp.coo_matrix((np.ones(len(pair)), (pair[:, 0], pair[:, 1])), shape=(n, n))
-    _, label = connected_components(graph, directed=False)
+    label = merged_classes(patches, topology)
     merged = np.bincount(label, minlength=n)[label] > 1
     is_column = np.zeros(n, dtype=bool)
     is_column[column_point] = True

@@ -86,6 +86,18 @@ FacesPoints = Annotated[dict[FaceNumber, NetPoints], Field(max_length=MAX_FACES)
 """A body's painted control points per face, keyed by the file's face number."""
 
 
+def _one_free_set(message: "ResolveMessage | BakeMessage") -> "ResolveMessage | BakeMessage":
+    """``message`` if it names at most one kind of free set, within :data:`MAX_NET_POINTS`."""
+    total = sum(len(points) for points in (message.faces_free_points or {}).values())
+    if total > MAX_NET_POINTS:
+        raise ValueError(f"faces_free_points lists {total} control points, more than "
+                         f"the {MAX_NET_POINTS} one message may hold")
+    if message.free_points is not None and message.faces_free_points is not None:
+        raise ValueError("give free_points (one surface) or faces_free_points (a "
+                         "body's faces), not both")
+    return message
+
+
 class ResolveMessage(_Message):
     """Re-solve the modes with a new material, boundary and moving set: a box
     (``free_region``), control points listed ``[i, j]`` (``free_points``, what the page
@@ -101,14 +113,7 @@ class ResolveMessage(_Message):
 
     @model_validator(mode="after")
     def _bounded(self) -> "ResolveMessage":
-        total = sum(len(points) for points in (self.faces_free_points or {}).values())
-        if total > MAX_NET_POINTS:
-            raise ValueError(f"faces_free_points lists {total} control points, more than "
-                             f"the {MAX_NET_POINTS} one message may hold")
-        if self.free_points is not None and self.faces_free_points is not None:
-            raise ValueError("give free_points (one surface) or faces_free_points (a "
-                             "body's faces), not both")
-        return self
+        return _one_free_set(self)
 
 
 class CorrectionMessage(_Message):
@@ -163,15 +168,21 @@ def describe_error(exc: ValidationError) -> str:
 class BakeMessage(_Message):
     """Make the shape of modal state ``q`` (``3 k`` numbers, mode-major ``[q_1x, q_1y, q_1z,
     q_2x, …]``) on basis ``version`` the rest shape, with the free set ``free_points`` if
-    given (a pin)."""
+    given (a pin on one surface), or a body's ``faces_free_points`` (a pin on a body: its
+    painted set less the pinned point, keyed by the face numbers of basis ``version``)."""
 
     version: Annotated[Count, Field(ge=0)]
     q: Annotated[list[Annotated[Real, Field(ge=-1e12, le=1e12)]],
                  Field(min_length=3, max_length=3 * MAX_NET_POINTS)]
     #: the free set of the baked model (a pin: the set less the pinned control point, which
     #: stays where the bake put it); None keeps the free set
-    free_points: Annotated[list[tuple[NetIndex, NetIndex]],
-                           Field(max_length=MAX_NET_POINTS)] | None = None
+    free_points: NetPoints | None = None
+    #: a body's: each listed face's free set (a face not listed moves whole)
+    faces_free_points: FacesPoints | None = None
+
+    @model_validator(mode="after")
+    def _bounded(self) -> "BakeMessage":
+        return _one_free_set(self)
 
 
 class ExportMessage(_Message):

@@ -20,7 +20,8 @@ page shows it):
   header ``X-Sculpt-File-Name``, at most 16 MiB) → a new surface, answered like a
   re-solve without ``carry`` (:mod:`.upload`);
 - ``POST /api/bake``: ``{version, q}`` → the shape of modal state ``q`` becomes the rest
-  shape, modes solved again (answered like a re-solve, with ``baked: true``);
+  shape, modes solved again (answered like a re-solve, with ``baked: true``); a pin adds
+  the new free set, ``free_points`` (one surface) or ``faces_free_points`` (a body);
 - ``POST /api/undo``, ``POST /api/redo``: ``{version}`` → back to the basis before, or
   forward again (:mod:`.history`), answered ``{version}``.
 

@@ -10,7 +10,8 @@ A scenario of several CAD faces (``shape = "cad"``, ``faces = "all"``) opens as 
 modes are those of its :class:`~splinedeform.body.BodyModel`, sampled face by face
 (:mod:`.modal`); a grab lands on the face under the pointer, whose number the saved load
 names; bake and export keep every face (:mod:`.history`, :mod:`.shape_files`); the page
-paints each face's moving control points, ``boundary.faces_free_points`` (:mod:`.body_paint`).
+paints each face's moving control points, ``boundary.faces_free_points`` (:mod:`.body_paint`),
+and a pin takes one point of a face out of that set (a bake, :meth:`Session.bake`).
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ from ..errors import InputError, ScenarioError
 from ..scenario import build, free_region_mask, scenario_to_toml, with_overrides
 from ..scenario.spec import Scenario
 from .body_edges import boundary_edges, faces_override
-from .body_paint import body_free_mask, painted_overrides
+from .body_paint import body_free_mask, painted_overrides, pinned_body, point_classes
 from .carry import transfer
 from .correction import StaticCorrection, offline_data, static_correction
 from .export import _b64, payload
@@ -167,21 +168,29 @@ class Session:
 
     def bake(self, message: BakeMessage) -> None:
         """Make the shape of the modal state ``message.q`` the rest shape and re-solve
-        (:mod:`.history`); :attr:`transfer` maps the old modes onto the new ones."""
+        (:mod:`.history`); :attr:`transfer` maps the old modes onto the new ones. A pin
+        gives the new free set: ``free_points`` of one surface, ``faces_free_points`` of a
+        body (:func:`.body_paint.pinned_body`)."""
         with self._re_solving("baking"):
             with self._state_lock:
                 self._check_version(message.version)
                 basis, scenario = self.basis, self.scenario
             nets = baked_nets(basis, np.asarray(message.q, dtype=float))
+            # a pin: the free set less the pinned point (the wrong kind refused); a body's
+            # is applied before the bake, which renumbers its faces to the baked file's
+            pin = None if message.free_points is None and message.faces_free_points is None \
+                else painted_overrides(message, basis.is_body)
+            if pin is not None and basis.is_body:
+                scenario = pinned_body(scenario, basis, pin)
             folder = self.save_path.parent
             baked, path = baked_scenario(scenario, basis, nets, folder,
                                          f"{self.save_path.stem}-baked-{self._versions + 1}")
             try:
-                if message.free_points is not None:   # a pin: the set less the pinned point
-                    baked = with_overrides(baked, {
-                        "boundary.free_region": None,
-                        "boundary.free_points": [list(p) for p in message.free_points]},
-                        origin="sculpt page")
+                if pin is not None and not basis.is_body:
+                    baked = with_overrides(baked, {"boundary.free_region": None,
+                                                   "boundary.free_points":
+                                                   pin["boundary.free_points"]},
+                                           origin="sculpt page")
                 self._solve(baked)
             except ScenarioError as exc:
                 path.unlink(missing_ok=True)
@@ -233,8 +242,9 @@ class Session:
     def payload(self) -> dict[str, Any]:
         """The modal data (see :func:`.export.payload`) plus the control net, the current
         material and boundary, and what the server offers; a body's adds ``body`` (its
-        faces' numbers, unit and boundary edges with their presets, :mod:`.body_edges`),
-        whose free set is painted face by face (:mod:`.body_paint`)."""
+        faces' numbers, unit and boundary edges with their presets, :mod:`.body_edges`, and
+        ``classes``, the point of the body each net row is, int32), whose free set is
+        painted face by face (:mod:`.body_paint`)."""
         basis, model = self.basis, self.basis.model
         data = payload(basis)
         s = self.scenario
@@ -252,7 +262,8 @@ class Session:
             data.update(net_shape=[int(net_rest.shape[0]), 1], periodic=[False, False],
                         free_region=None, greville=[[], []], body={
                             "faces": face_numbers(basis), "units": basis.units,
-                            "edges": boundary_edges(s, model)})
+                            "edges": boundary_edges(s, model),
+                            "classes": _b64(point_classes(basis), "<i4")})
             data["domain"] = [float(basis.patches[0].basis_u.length),
                               float(basis.patches[0].basis_v.length)]
             return data

@@ -94,7 +94,8 @@
     }
     // a body: one preset for every boundary edge (an edge no other face meets), then each
     // edge on its own (edges.js); its free set is painted face by face (paint.js), with no
-    // free region (a box of one face's parameters) or pin
+    // free region (a box of one face's parameters); a pin holds a point of the face under
+    // the pointer (history.js)
     for (const edge of data.body ? ["u0"] : EDGES) {
       const label = document.createElement("label");
       label.innerHTML = '<span class="name"></span><select></select>';
@@ -123,8 +124,6 @@
       '<label><span class="name">v from</span><input id="region-v0" type="number" step="any"> to <input id="region-v1" type="number" step="any"></label>';
     boundaryBox.appendChild(box);
     box.style.display = data.body ? "none" : "";
-    grabMode.querySelector('option[value="pin"]').disabled = Boolean(data.body);
-    if (data.body && grabMode.value === "pin") grabMode.value = "spring";
     box.querySelectorAll("input[type=number]").forEach((input) => { input.style.width = "60px"; });
     document.getElementById("region-on").checked = Boolean(data.free_region);
     box.addEventListener("input", boxToMask);
@@ -325,6 +324,7 @@
     inside(n) { return !inside || Boolean(inside[n]); },
     nearestNet(n) { const at = sampleAt(n); return nearestNetPoint(at.u, at.v, at.face); },
     netFace(k) { const at = netFace(k); return at && { face: data.body ? data.body.faces[at.p] : at.p, i: at.i, j: at.j }; },
+    samePoint(k) { return samePoint(k); },
     get stillMask() { return Array.from(stillMask); },
     get grabView() { return grabEnds && { point: grabEnds.point.slice(), pointer: grabEnds.pointer && grabEnds.pointer.slice(),
                                           marker: grabMarker.visible, spring: springLine.visible }; },

@@ -25,7 +25,7 @@
       "pause": "stop or restart time (Space)",
       "reset": "back to rest: pushes forgotten",
       "speed": "how fast time runs: 0.05 … 3 times real time",
-      "grab-mode": "what a drag does: a spring from the grabbed point to the pointer, only its push along the surface normal, or pin the nearest control point where it is (also alt-click)",
+      "grab-mode": "what a drag does: a spring from the grabbed point to the pointer, only its push along the surface normal, or pin the nearest control point where it is (also alt-click; on a body, of the face under the pointer, held on every face that shares it)",
       "spring": "spring stiffness as a multiple of the grabbed point's own stiffness (1/flexibility): at 1 the point goes half-way to the pointer when it comes to rest",
       "show-net": "show the control net (its points move with the surface)",
       "colour": "colour the surface by the size of its displacement |d| (plasma), or plain",

@@ -73,12 +73,18 @@
   function undo() { return switchBasis("api/undo", undoStack, redoStack); }
   function redo() { return switchBasis("api/redo", redoStack, undoStack); }
   // bake; with `pinned` (a control point, row-major) also a pin: the free set less that
-  // point, which then stays where the bake put it (its displaced place) whatever is pulled
+  // point, which then stays where the bake put it (its displaced place) whatever is pulled.
+  // On a body the point is taken out of every face that has it (a merged interface's
+  // point is one point of the body) and the faces' sets are sent as faces_free_points.
   async function bake(pinned) {
     if (solving) return;
     const pinning = pinned !== undefined && pinned !== null;
-    let extra = {};
-    if (pinning) {
+    let extra = {}, rows = [];
+    if (pinning && data.body) {
+      extra = bodyPin(pinned);
+      if (!extra) return;
+      rows = samePoint(pinned);
+    } else if (pinning) {
       if (!freeMask[pinned] || stillMask[pinned]) {
         showMessage("control point " + netName(pinned) + " is held already", true);
         return;
@@ -100,8 +106,9 @@
       const reply = await post("api/bake", Object.assign({ version: data.version, q: Array.from(now) }, extra));
       remember(earlier);
       load(reply);
+      const also = rows.length > 1 ? " (held on every face that has it: " + rows.map(netName).join(", ") + ")" : "";
       progressBox.textContent = pinning
-        ? "pinned control point " + netName(pinned) + " where it is (shape baked in " + reply.solve_seconds + " s, " + K + " modes)"
+        ? "pinned control point " + netName(pinned) + " where it is" + also + " (shape baked in " + reply.solve_seconds + " s, " + K + " modes)"
         : "baked in " + reply.solve_seconds + " s: this shape is the rest shape (" + K + " modes)";
     } catch (err) {
       progressBox.textContent = "";
@@ -112,15 +119,40 @@
       showHistory();
     }
   }
+  // the message of a body's pin of net row k: every face's free set less that point (on
+  // each face that has it), or null with the refusal shown
+  function bodyPin(k) {
+    const rows = samePoint(k), name = netName(k);
+    if (!freeMask[k]) { showMessage("control point " + name + " is fixed already (not in the free set)", true); return null; }
+    if (stillMask[k]) {
+      const edge = rows.length > 1 ? "an edge preset or a neighbouring face" : "an edge preset";
+      showMessage("control point " + name + " is held already by " + edge + ": nothing to pin", true);
+      return null;
+    }
+    const mask = freeMask.slice();
+    rows.forEach((m) => { mask[m] = 0; });
+    const faces = facesFreePoints(mask), empty = Object.keys(faces).filter((face) => faces[face].length === 0);
+    if (empty.length) {
+      showMessage("pinning " + name + " would leave face " + empty.join(", face ") + " no free control point; " +
+                  "free more of its points first (a face's free set is never empty)", true);
+      return null;
+    }
+    return { faces_free_points: faces };
+  }
   function netName(k) {
+    if (data.body) {
+      const at = netFace(k), [fu, fv] = faceGreville(at.p);
+      return "[" + at.i + ", " + at.j + "] of face " + data.body.faces[at.p] +
+             " (u = " + fu[at.i].toPrecision(3) + ", v = " + fv[at.j].toPrecision(3) + ")";
+    }
     const nv = gV.length, i = Math.floor(k / nv), j = k % nv;
     return "[" + i + ", " + j + "] (u = " + gU[i].toPrecision(3) + ", v = " + gV[j].toPrecision(3) + ")";
   }
   // pin the control point nearest (Greville points, parameter domain) to sample n
+  // (a body's: the nearest of the face under the pointer, in that face's parameters)
   function pin(n) {
-    if (data.body) { showMessage("pinning a control point is for one surface; on a body, paint each face's free set instead"); return Promise.resolve(null); }
-    const { u: cu, v: cv } = sampleAt(n);
-    return bake(nearestNetPoint(cu, cv));
+    const { face: p, u: cu, v: cv } = sampleAt(n);
+    return bake(data.body ? nearestNetPoint(cu, cv, p) : nearestNetPoint(cu, cv));
   }
   document.getElementById("bake").addEventListener("click", () => { bake(); });
   undoButton.addEventListener("click", () => { undo(); });

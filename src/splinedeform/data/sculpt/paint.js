@@ -152,17 +152,28 @@
   function freeSet() {
     if (freeSource === "box") return { free_region: freeRegion() };
     if (freeMask.every((x) => x === 1)) return {};
-    if (data.body) {
-      const faces = {};
-      faceList.forEach((face, p) => {
-        const [nu, nv] = face.net, start = faceStart(p), points = [];
-        for (let k = 0; k < nu * nv; k++) if (freeMask[start + k]) points.push([Math.floor(k / nv), k % nv]);
-        if (points.length < nu * nv) faces[data.body.faces[p]] = points;
-      });
-      return { faces_free_points: faces };
-    }
+    if (data.body) return { faces_free_points: facesFreePoints(freeMask) };
     const nv = gV.length, points = [];
     for (let k = 0; k < NN; k++) if (freeMask[k]) points.push([Math.floor(k / nv), k % nv]);
     return { free_points: points };
   }
 
+  // a body's free set `mask` per face whose net is not all free, keyed by the file's face
+  // number: {"3": [[i, j], …]} (a face not listed moves whole)
+  function facesFreePoints(mask) {
+    const faces = {};
+    faceList.forEach((face, p) => {
+      const [nu, nv] = face.net, start = faceStart(p), points = [];
+      for (let k = 0; k < nu * nv; k++) if (mask[start + k]) points.push([Math.floor(k / nv), k % nv]);
+      if (points.length < nu * nv) faces[data.body.faces[p]] = points;
+    });
+    return faces;
+  }
+  // the net rows that are the same control point as row k: a body's faces meeting there
+  // (pointClass), else k alone
+  function samePoint(k) {
+    if (!pointClass) return [k];
+    const rows = [];
+    for (let m = 0; m < NN; m++) if (pointClass[m] === pointClass[k]) rows.push(m);
+    return rows;
+  }

@@ -43,6 +43,9 @@
   // the (ru, rv) grid for face p, and its control points the next nu·nv of the net; a single
   // surface is one face
   let faceList, faceRows;
+  // a body's point of each net row (sculpt/body_paint.py point_classes): rows of one class
+  // are one control point of the body, shared by the faces that meet there (null: one surface)
+  let pointClass = null;
   // trimmed faces (splinedeform/sculpt/trimmed.py): the points where the grid crosses the
   // trim loops follow the grids (samples ru·rv …); trimTriangles are the clipped mesh drawn,
   // inside[n] whether sample n lies in its face's trims (only those are grabbed)
@@ -62,6 +65,7 @@
     stillMask = decode(d.still_mask, Uint8Array);   // cannot move in the solved model
     freeSource = d.free_region ? "box" : "points";
     [gU, gV] = d.greville;
+    pointClass = d.body && d.body.classes ? decode(d.body.classes, Int32Array) : null;
   }
   unpack(data);
   // sample n: its face p (the file's face number of a body), and (u, v) on that face
