@@ -23,6 +23,9 @@ each), ``N = Σ n_u n_v``. The map ``d = T d_free`` is built in two steps:
    patches (one class) is therefore fixed when any one of them fixes it. As for a single
    surface (:func:`splinedeform.boundary.build_constraints`), a point that its edge
    condition determines from others (not a coefficient of its own) follows that condition.
+   A trimmed face's mask is left to its own map (:func:`trimmed_face_masks`,
+   :func:`~splinedeform.body.trimmed.with_trimmed_faces`): its points are merged with no
+   other face's, so they are held in that face alone.
 3. **Ties.** Where the energy bends, the tangent continuity across smooth conforming
    interfaces and C0 lines is imposed exactly too: ``T = T_b S E`` with
    ``range E = null(C T_b S)`` for the ties ``C d = 0`` of

@@ -100,13 +100,19 @@ def body_system(body: Body, material: Material,
                 fixed: Sequence[Any] | None = None) -> PlateBodySystem:
     """Assemble the plate of a body (module docstring; the parameters are
     :class:`splinedeform.BodyModel`'s, the options already checked; ``fixed``, one mask
-    per patch, fixes control points: :func:`~splinedeform.body.constraints.body_fixed_mask`).
+    per patch, fixes control points: :func:`~splinedeform.body.constraints.body_fixed_mask`
+    on the untrimmed patches, a trimmed face's mask
+    (:func:`~splinedeform.body.constraints.trimmed_face_masks`) taken by its own map in
+    :func:`~splinedeform.trim.model_matrices.trimmed_system`, the face then counted among
+    the held ones where it holds a point whose B-spline meets its region).
 
     Raises
     ------
     InputError
         A non-manifold edge or an interface not parametrised alike (:func:`refuse`), a
-        bad mask of fixed points, or a boundary that fixes every control point.
+        bad mask of fixed points (on a trimmed face also one that leaves its extension no
+        array of free inner B-splines, ``fixed[p]: face p is trimmed …``), or a boundary
+        that fixes every control point.
     """
     topology = body.topology
     refuse(topology)
