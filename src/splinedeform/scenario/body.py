@@ -343,7 +343,8 @@ def _at_face_masks(body: FileBody) -> Iterator[None]:
     except InputError as exc:
         patch = getattr(exc, "patch", None)
         if patch is not None and getattr(exc, "key", None) is None:
-            exc.key = f"boundary.faces_free_points.{body.faces[patch]}"  # type: ignore[attr-defined]
+            key = f"boundary.faces_free_points.{body.faces[patch]}"
+            exc.key = key  # type: ignore[attr-defined]
         raise
 
 
