@@ -132,20 +132,6 @@ def test_bad_masks_are_refused_naming_the_patch(fixed, words) -> None:
     assert words in str(info.value)
 
 
-def test_a_trimmed_face_takes_no_fixed_points() -> None:
-    from splinedeform.trim import CircleLoop, PolygonLoop, TrimDomain
-
-    circle = CircleLoop((0.5, 0.5), 0.3)
-    square = PolygonLoop([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-    plane = sd.shapes.plane(cells=(2, 2), degree=2, knots="open")
-    body = sd.Body([plane.with_trim(TrimDomain(circle)),
-                    plane.with_trim(TrimDomain(square, (circle,)))])
-    mask = np.zeros(plane.shape, dtype=bool)
-    mask[0, 0] = True
-    with pytest.raises(InputError, match=r"fixed\[1\]: patch 1 is a trimmed face"):
-        sd.BodyModel(body, MEMBRANE, fixed=[None, mask])
-
-
 # -- the scenario key boundary.faces_free_points ------------------------------------------
 CLAMPED = 'u0 = "clamped"\nu1 = "clamped"\nv0 = "clamped"\nv1 = "clamped"\n'
 PATCH = "[[2, 2], [2, 3], [3, 2], [3, 3]]"

@@ -233,20 +233,6 @@ def test_a_patch_held_whole_holds_its_neighbours_interface():
     assert np.abs(nets[1][4]).max() <= 1e-12 * scale
 
 
-def test_a_trimmed_face_of_a_shell_body_takes_no_fixed_points():
-    from splinedeform.trim import CircleLoop, PolygonLoop, TrimDomain
-
-    circle = CircleLoop((0.5, 0.5), 0.3)
-    square = PolygonLoop([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-    plane = sd.shapes.plane(cells=(2, 2), degree=2, knots="open")
-    body = sd.Body([plane.with_trim(TrimDomain(circle)),
-                    plane.with_trim(TrimDomain(square, (circle,)))])
-    mask = np.zeros(plane.shape + (3,), dtype=bool)
-    mask[0, 0, 2] = True
-    with pytest.raises(InputError, match=r"fixed\[1\]: patch 1 is a trimmed face"):
-        ShellModel(body, SHELL, "free", fixed=[None, mask])
-
-
 def test_an_untrimmed_patch_of_a_body_with_trimmed_faces_takes_held_points():
     # the left half untrimmed, the right one holed by a circle (coupled to it by the
     # iso-edge penalty, physics/shell_body_trimmed.py). Holding the left side's row 0
@@ -360,26 +346,3 @@ def test_bad_faces_free_points_of_a_shell_body_name_the_key_path(two_faces, tmp_
     with pytest.raises(ScenarioError) as info:
         build(load_scenario(path))
     assert where in str(info.value) and words in str(info.value)
-
-
-def test_faces_free_points_on_a_trimmed_face_is_refused_at_its_key(tmp_path):
-    pytest.importorskip("rhino3dm", reason="the 'cad' extra (rhino3dm) is not installed")
-    from splinedeform.export.body import write_body_3dm
-    from splinedeform.scenario import build, load_scenario
-    from splinedeform.trim import CircleLoop, PolygonLoop, TrimDomain
-
-    circle = CircleLoop((0.5, 0.5), 0.3)
-    square = PolygonLoop([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-    disc = sd.shapes.plane(cells=(3, 3), degree=3, knots="open")
-    ring = sd.shapes.plane(cells=(4, 4), degree=3, knots="open")
-    body = sd.Body([disc.with_trim(TrimDomain(circle)),
-                    ring.with_trim(TrimDomain(square, (circle,)))])
-    source = write_body_3dm(tmp_path / "two.3dm", list(body),
-                            [s.control_points for s in body], body=body)
-    folder = tmp_path / "run"
-    folder.mkdir()
-    path = shell_scenario(folder, source, "faces_free_points = {1 = [[1, 1]]}\n")
-    with pytest.raises(ScenarioError) as info:
-        build(load_scenario(path))
-    assert "boundary.faces_free_points.1" in str(info.value)
-    assert "face 1 is trimmed" in str(info.value)

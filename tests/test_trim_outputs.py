@@ -74,7 +74,7 @@ def test_refusals_name_the_problem():
         sd.Model(surface, membrane, boundary="pinned", physics="shell")
     with pytest.raises(InputError, match="rest = 'none'"):
         sd.Model(surface, membrane, boundary="pinned", rest="none")
-    with pytest.raises(InputError, match="fixed components"):
+    with pytest.raises(InputError, match="every control point is fixed"):
         sd.ShellModel(surface, sd.ShellMaterial(1.0, 0.3, 0.01, 1.0),
                       fixed=np.ones(surface.shape, bool))
     with pytest.raises(InputError, match="outside the trimmed region"):

@@ -101,8 +101,10 @@ def test_refusals_name_the_problem():
     with pytest.raises(sd.InputError, match="boundary.u0 must be one of"):
         ShellModel(holed, MATERIAL, {"u0": "diaphragm"})
     disc = plane.with_trim(TrimDomain(CircleLoop((0.5, 0.5), A)))
-    with pytest.raises(sd.InputError, match="fixed components"):
-        ShellModel(disc, MATERIAL, {"outer": "clamped"}, fixed=np.zeros(plane.shape, bool))
+    z_only = np.zeros(plane.shape + (3,), bool)
+    z_only[4, 4, 2] = True                # the three components follow one extension map
+    with pytest.raises(sd.InputError, match=r"point\(s\) \[4, 4\] hold some components only"):
+        ShellModel(disc, MATERIAL, {"outer": "clamped"}, fixed=z_only)
     with pytest.raises(sd.InputError, match="hole7"):
         ShellModel(disc, MATERIAL, {"hole7": "clamped"})
     quadratic = sd.shapes.plane(cells=(6, 6), degree=2, knots="uniform")

@@ -23,6 +23,9 @@ each), ``N = Σ n_u n_v``. The map ``d = T d_free`` is built in two steps:
    patches (one class) is therefore fixed when any one of them fixes it. As for a single
    surface (:func:`splinedeform.boundary.build_constraints`), a point that its edge
    condition determines from others (not a coefficient of its own) follows that condition.
+   A trimmed face's mask is left to its own map (:func:`trimmed_face_masks`,
+   :func:`~splinedeform.body.trimmed.with_trimmed_faces`): its points are merged with no
+   other face's, so they are held in that face alone.
 3. **Ties.** Where the energy bends, the tangent continuity across smooth conforming
    interfaces and C0 lines is imposed exactly too: ``T = T_b S E`` with
    ``range E = null(C T_b S)`` for the ties ``C d = 0`` of
@@ -142,8 +145,10 @@ def edge_rows(surface: Surface, edge: str) -> NDArray[np.int64]:
 
 def body_fixed_mask(patches: Sequence[Surface], fixed: Sequence[ArrayLike | None] | None,
                     components: bool = False) -> NDArray[np.bool_] | None:
-    """The body-wide mask of fixed control points: the patches' masks, row-major each,
-    patch after patch (``N = Σ n_u n_v`` values), or ``None`` where none fixes a point.
+    """The body-wide mask of fixed control points of the untrimmed patches: their masks,
+    row-major each, patch after patch (``N = Σ n_u n_v`` values, False on every trimmed
+    face, whose mask its own map takes: :func:`trimmed_face_masks`), or ``None`` where
+    none fixes a point.
 
     Parameters
     ----------
@@ -160,9 +165,58 @@ def body_fixed_mask(patches: Sequence[Surface], fixed: Sequence[ArrayLike | None
     ------
     InputError
         A count other than one per patch, or a mask of another shape than its patch's net
-        or not boolean, or one that holds a point of a trimmed face (whose map is its own,
-        :func:`~splinedeform.body.trimmed.with_trimmed_faces`), naming the patch.
+        or not boolean, naming the patch.
     """
+    checked = _checked_masks(patches, fixed, components)
+    if checked is None:
+        return None
+    per = 3 if components else 1
+    masks = []
+    for surface, mask in zip(patches, checked):
+        net = tuple(surface.shape)
+        if mask is None or surface.trim is not None:
+            masks.append(np.zeros(net[0] * net[1] * per, dtype=bool))
+            continue
+        if components and mask.shape == net:         # a whole point: its three components
+            mask = np.repeat(mask[..., None], 3, axis=-1)
+        masks.append(mask.ravel())
+    out = np.concatenate(masks)
+    return out if out.any() else None
+
+
+def trimmed_face_masks(patches: Sequence[Surface], fixed: Sequence[ArrayLike | None] | None,
+                       components: bool = False) -> dict[int, NDArray[np.bool_]]:
+    """The masks ``(n_u, n_v)`` of fixed control points of the trimmed faces, ``{face:
+    mask}`` for those with a point fixed, checked as :func:`body_fixed_mask` checks them.
+    A trimmed face's map is Höllig's extension of its own points
+    (:func:`~splinedeform.trim.holed.with_edges` takes the mask), the same for the three
+    components of the shell: a mask ``(n_u, n_v, 3)`` (``components``) must hold the three
+    components of a point alike.
+
+    Raises
+    ------
+    InputError
+        As :func:`body_fixed_mask`, and a per-component mask on a trimmed face that holds
+        some components of a point but not all, naming the face and the points.
+    """
+    from ..trim.shell_trimmed import point_mask
+
+    checked = _checked_masks(patches, fixed, components)
+    out: dict[int, NDArray[np.bool_]] = {}
+    for p, (surface, mask) in enumerate(zip(patches, checked or ())):
+        if mask is None or surface.trim is None or not mask.any():
+            continue
+        try:
+            out[p] = point_mask(surface, mask)
+        except InputError as exc:
+            raise InputError(f"fixed[{p}]: face {p} is trimmed: {exc}") from None
+    return out
+
+
+def _checked_masks(patches: Sequence[Surface], fixed: Sequence[ArrayLike | None] | None,
+                   components: bool) -> list[NDArray[np.bool_] | None] | None:
+    """``fixed`` as one boolean array (or None) per patch, its count, shapes and types
+    checked (:func:`body_fixed_mask`)."""
     if fixed is None:
         return None
     if isinstance(fixed, np.ndarray) or not isinstance(fixed, Sequence):
@@ -171,13 +225,12 @@ def body_fixed_mask(patches: Sequence[Surface], fixed: Sequence[ArrayLike | None
     if len(fixed) != len(patches):
         raise InputError(f"fixed has {len(fixed)} masks for a body of {len(patches)} "
                          "patches: give one per patch (None where nothing is fixed)")
-    per = 3 if components else 1
-    masks = []
+    out: list[NDArray[np.bool_] | None] = []
     for p, (surface, mask) in enumerate(zip(patches, fixed)):
-        net = tuple(surface.shape)
         if mask is None:
-            masks.append(np.zeros(net[0] * net[1] * per, dtype=bool))
+            out.append(None)
             continue
+        net = tuple(surface.shape)
         mask = np.asarray(mask)
         if mask.shape != net and not (components and mask.shape == net + (3,)):
             also = f" or, per component, {net + (3,)}" if components else ""
@@ -186,14 +239,8 @@ def body_fixed_mask(patches: Sequence[Surface], fixed: Sequence[ArrayLike | None
         if mask.dtype != bool:
             raise InputError(f"fixed[{p}]: the mask of patch {p} must be boolean, got dtype "
                              f"{mask.dtype}")
-        if mask.any() and surface.trim is not None:
-            raise InputError(f"fixed[{p}]: patch {p} is a trimmed face; fixed control points "
-                             "are taken on untrimmed patches only")
-        if components and mask.shape == net:         # a whole point: its three components
-            mask = np.repeat(mask[..., None], 3, axis=-1)
-        masks.append(mask.ravel())
-    out = np.concatenate(masks)
-    return out if out.any() else None
+        out.append(mask)
+    return out
 
 
 def merged_classes(patches: Sequence[Surface], topology: Topology) -> NDArray[np.int64]:

@@ -49,7 +49,13 @@ class BodyModel(Model):
         nothing fixed beyond its edges. A control point that several patches share (merged
         across a conforming interface, or on a pole) is fixed when any one of them fixes
         it. A point that its edge condition determines from others follows that condition.
-        Trimmed faces take no fixed points.
+        On a trimmed face the mask is taken by the face's own map, as a single trimmed
+        surface's (:func:`~splinedeform.trim.holed.with_edges`): a held inner B-spline
+        (an unknown of Höllig's extension) stays at rest, and so does a held outer one
+        (its coefficient no longer follows the inner ones; the other outer ones are tied
+        to free inner ones only), while a dead one (support outside the region) was at
+        rest already and holds nothing. No point of a trimmed face is merged with another
+        face's (trim curves are coupled by penalties), so it is held in its face alone.
     mass_matrix : {"consistent", "lumped"}
     rest : {"initial", "none"}
     physics : {"intrinsic", "parametric"}, default "intrinsic"

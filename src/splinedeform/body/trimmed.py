@@ -18,8 +18,9 @@ the body's map is ``T = T_untrimmed ⊕ E_p …`` (:func:`with_trimmed_faces`).
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import replace
-from typing import Any, Mapping, Sequence
+from typing import Any, Iterator, Mapping, Sequence
 
 import numpy as np
 import scipy.sparse as sp
@@ -230,3 +231,20 @@ def with_trimmed_faces(constraints: BodyConstraints, patches: Sequence[Surface],
     edges = {**constraints.edges, **loops}
     return replace(constraints, T=sp.hstack(blocks, format="csr"),
                    free_index=np.concatenate(first).astype(np.int64), edges=edges)
+
+
+@contextmanager
+def mask_of_face(p: int) -> Iterator[None]:
+    """Re-raise an :class:`~splinedeform.errors.InputError` that face ``p``'s mask of fixed
+    control points causes (marked ``fixed_points`` by
+    :func:`~splinedeform.trim.model_matrices.trimmed_system`) as ``fixed[p]: face p …``,
+    with ``patch = p`` for a scenario to name its key."""
+    try:
+        yield
+    except InputError as exc:
+        if not getattr(exc, "fixed_points", False):
+            raise
+        error = InputError(f"fixed[{p}]: face {p} is trimmed and its mask of fixed control "
+                           f"points cannot be taken: {exc}")
+        error.patch = p  # type: ignore[attr-defined]
+        raise error from None

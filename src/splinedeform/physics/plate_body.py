@@ -37,11 +37,12 @@ from scipy.sparse.linalg import splu
 from ..assembly import check_bending, patch_matrices
 from ..body.body import Body
 from ..body.constraints import (BodyConstraints, body_fixed_mask, boundary_presets,
-                                build_body_constraints)
+                                build_body_constraints, trimmed_face_masks)
 from ..body.interface import EDGES
 from ..body.loads import OnPatch, along_normal
 from ..body.trim_edges import edge_penalty
-from ..body.trimmed import edge_boundary, face_boundary, loop_presets, with_trimmed_faces
+from ..body.trimmed import (edge_boundary, face_boundary, loop_presets, mask_of_face,
+                            with_trimmed_faces)
 from ..errors import InputError
 from ..loads import Point
 from ..material import Material
@@ -99,13 +100,19 @@ def body_system(body: Body, material: Material,
                 fixed: Sequence[Any] | None = None) -> PlateBodySystem:
     """Assemble the plate of a body (module docstring; the parameters are
     :class:`splinedeform.BodyModel`'s, the options already checked; ``fixed``, one mask
-    per patch, fixes control points: :func:`~splinedeform.body.constraints.body_fixed_mask`).
+    per patch, fixes control points: :func:`~splinedeform.body.constraints.body_fixed_mask`
+    on the untrimmed patches, a trimmed face's mask
+    (:func:`~splinedeform.body.constraints.trimmed_face_masks`) taken by its own map in
+    :func:`~splinedeform.trim.model_matrices.trimmed_system`, the face then counted among
+    the held ones where it holds a point whose B-spline meets its region).
 
     Raises
     ------
     InputError
         A non-manifold edge or an interface not parametrised alike (:func:`refuse`), a
-        bad mask of fixed points, or a boundary that fixes every control point.
+        bad mask of fixed points (on a trimmed face also one that leaves its extension no
+        array of free inner B-splines, ``fixed[p]: face p is trimmed …``), or a boundary
+        that fixes every control point.
     """
     topology = body.topology
     refuse(topology)
@@ -119,14 +126,18 @@ def body_system(body: Body, material: Material,
     constraints = build_body_constraints(
         patches, topology, {k: "free" if k[0] in faces else v for k, v in presets.items()},
         bends(material), body_fixed_mask(patches, fixed))
-    systems = {p: trimmed_system(patches[p], material,
-                                 face_boundary(p, patches[p], presets, loops),
-                                 mass_matrix == "lumped", physics, rest=rest)
-               for p in sorted(faces)}
+    masks = trimmed_face_masks(patches, fixed)
+    systems = {}
+    for p in sorted(faces):
+        with mask_of_face(p):
+            systems[p] = trimmed_system(patches[p], material,
+                                        face_boundary(p, patches[p], presets, loops),
+                                        mass_matrix == "lumped", physics, masks.get(p), rest)
     if systems:
+        held = {p for p, s in systems.items() if s.constraints.has_fixed_points}
         constraints = replace(with_trimmed_faces(
             constraints, patches, {p: s.constraints for p, s in systems.items()}, loops),
-            edges={**presets, **loops})
+            edges={**presets, **loops}, fixed_patches=constraints.fixed_patches | held)
     if constraints.n_free == 0:
         error = InputError(f"no free coordinate: the boundary fixes every control point of "
                            f"the {len(patches)} patches; free an edge or refine them")

@@ -23,9 +23,14 @@ a crease costs nothing when it turns rigidly; :func:`~.coupling_curves.curve_pen
 ``(α, β) = C (E t, E t³/12) / ((1 − ν²) h)`` from the material and the element size
 ``h`` along the curve (:func:`~.coupling.penalty_factors`).
 
+A trimmed face's mask of fixed control points (``fixed`` of
+:class:`~splinedeform.physics.shell_model.ShellModel`) is taken by its own map
+(:func:`~splinedeform.trim.shell_trimmed.trimmed_shell`, as the plate's face takes it).
+
 The free rigid motions are those in ``range T`` on the control points the regions move
-(a trimmed face's dropped functions stay at rest), in each connected part of the body
-that no Nitsche term holds (:func:`body_motions`).
+and those a face's mask holds at rest (a trimmed face's dropped functions stay at rest
+and are no points of the shell), in each connected part of the body that no Nitsche term
+holds (:func:`body_motions`).
 """
 
 from __future__ import annotations
@@ -40,8 +45,9 @@ from scipy.sparse.csgraph import connected_components
 from ..body.body import Body
 from ..body.constraints import boundary_presets
 from ..body.trim_edges import edge_penalty, iso_stretches
-from ..body.trimmed import edge_boundary, face_boundary, loop_presets
+from ..body.trimmed import edge_boundary, face_boundary, loop_presets, mask_of_face
 from ..errors import InputError
+from ..trim.model_matrices import held_live, quadrature_of
 from ..trim.shell_trimmed import trimmed_shell
 from .coupling_curves import curve_penalty
 from .shell import ShellMaterial
@@ -53,24 +59,34 @@ Array = NDArray[np.float64]
 
 def trimmed_body_system(body: Body, material: ShellMaterial,
                         boundary: str | Mapping[Any, str] = "free",
-                        fixed: NDArray[np.bool_] | None = None) -> ShellBodySystem:
+                        fixed: NDArray[np.bool_] | None = None,
+                        face_fixed: Mapping[int, NDArray[np.bool_]] | None = None
+                        ) -> ShellBodySystem:
     """The shell of a body with trimmed faces (module docstring).
 
     ``boundary`` is one kind for every boundary edge and trim loop, or a mapping keyed
     ``(patch, edge)`` and ``(face, loop)`` (``"outer"``, ``"hole1"``, ``"outer.2"`` …) as
     :class:`splinedeform.BodyModel` takes it; a loop or trim edge shared with another face
     takes none (:func:`~splinedeform.body.trimmed.loop_presets`). ``fixed`` holds
-    components of the untrimmed patches as :func:`.shell_body.body_system` does (a mask
-    on a trimmed face is refused by :func:`~splinedeform.body.constraints.body_fixed_mask`:
-    its map is Höllig's extension, not its control points).
+    components of the untrimmed patches as :func:`.shell_body.body_system` does;
+    ``face_fixed`` (``{face: mask (n_u, n_v)}``,
+    :func:`~splinedeform.body.constraints.trimmed_face_masks`) the control points of
+    trimmed faces, taken by each face's own map
+    (:func:`~splinedeform.trim.shell_trimmed.trimmed_shell`). No control point of a
+    trimmed face is merged with another face's (penalties couple them), so a held one is
+    held in its face alone.
     """
     patches = body.patches
     faces = sorted(p for p, s in enumerate(patches) if s.trim is not None)
     loops = loop_presets(patches, body.trim_interfaces, boundary, body.edge_interfaces)
     presets = boundary_presets(edge_boundary(boundary, loops), body.topology, BODY_KINDS)
-    shells = {p: trimmed_shell(patches[p], material, face_boundary(p, patches[p], presets,
-                                                                   loops))
-              for p in faces}
+    face_fixed = face_fixed or {}
+    shells = {}
+    for p in faces:
+        with mask_of_face(p):
+            shells[p] = trimmed_shell(patches[p], material,
+                                      face_boundary(p, patches[p], presets, loops),
+                                      face_fixed.get(p))
     system = body_system(body, material, {k: v for k, v in presets.items()
                                           if k[0] not in shells},
                          given={p: (s.stiffness, s.mass) for p, s in shells.items()},
@@ -86,7 +102,17 @@ def trimmed_body_system(body: Body, material: ShellMaterial,
     T = with_face_maps(system.T, offsets, {p: s.T for p, s in shells.items()})
     held = {p for p, s in shells.items() if any(k != "free" for k in s.edges.values())}
     return ShellBodySystem(K.tocsr(), system.M, T, edges, offsets, system.ties, system.clamps,
-                           body_motions(body, T, offsets, held))
+                           body_motions(body, T, offsets, held, at_rest(body, face_fixed)))
+
+
+def at_rest(body: Body, face_fixed: Mapping[int, NDArray[np.bool_]]) -> NDArray[np.bool_]:
+    """The body's points (flat, patch after patch) that a trimmed face's mask holds and
+    whose B-splines meet its region (:func:`~splinedeform.trim.model_matrices.held_live`):
+    zero rows of ``T`` that are points of the shell, at rest."""
+    parts = [np.zeros(s.shape[0] * s.shape[1], dtype=bool) if p not in face_fixed else
+             held_live(s, quadrature_of(s).classes, face_fixed[p]).ravel()
+             for p, s in enumerate(body.patches)]
+    return np.concatenate(parts)
 
 
 def with_face_maps(T: sp.csr_matrix, offsets: NDArray[np.int64],
@@ -118,11 +144,12 @@ def with_face_maps(T: sp.csr_matrix, offsets: NDArray[np.int64],
 
 
 def body_motions(body: Body, T: sp.csr_matrix, offsets: NDArray[np.int64],
-                 held: set[int]) -> RigidMotions:
+                 held: set[int], fixed: NDArray[np.bool_] | None = None) -> RigidMotions:
     """The free rigid motions of the body (module docstring): those in ``range T`` on the
     control points of the connected parts without a face in ``held`` (a face whose loops
-    or edges Nitsche's terms hold), a trimmed face's moving ones only (its dropped
-    functions are no points of the shell; an untrimmed patch's held points are, at rest)."""
+    or edges Nitsche's terms hold), a trimmed face's moving ones and its points that its
+    mask holds (``fixed``, flat, :func:`at_rest`) only (its dropped functions are no points
+    of the shell; an untrimmed patch's held points are, at rest)."""
     n = len(body.patches)
     links = [(i.a, i.b) for i in body.topology.interfaces + body.trim_interfaces
              + body.edge_interfaces] or [(0, 0)]
@@ -133,6 +160,8 @@ def body_motions(body: Body, T: sp.csr_matrix, offsets: NDArray[np.int64],
     patch_of = np.searchsorted(offsets, np.arange(len(points)), side="right") - 1
     trimmed = np.array([s.trim is not None for s in body.patches])
     moving = (np.diff(T.indptr)[::3] > 0) | ~trimmed[patch_of]
+    if fixed is not None:
+        moving |= fixed
     chosen = np.flatnonzero(moving & np.isin(label[patch_of], list(free_parts)))
     if chosen.size == 0:
         return RigidMotions(np.zeros((T.shape[1], 0)), np.zeros((6, 0)))

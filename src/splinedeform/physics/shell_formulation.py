@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from ..body.body import Body
-from ..body.constraints import body_fixed_mask
+from ..body.constraints import body_fixed_mask, trimmed_face_masks
 from ..body.loads import surface_field
 from ..errors import InputError, SingularSystemError
 from ..solvers.system import Reduction
@@ -102,12 +102,15 @@ class ShellFormulation:
         if isinstance(surface, (Body, list, tuple)):
             self.body = surface if isinstance(surface, Body) else Body(surface)
             mask = body_fixed_mask(self.body.patches, fixed, components=True)
+            kind = "free" if boundary is None else boundary
             if any(s.trim is not None for s in self.body.patches):   # :mod:`.shell_body_trimmed`
-                from .shell_body_trimmed import trimmed_body_system as build
+                from .shell_body_trimmed import trimmed_body_system
+
+                system = trimmed_body_system(
+                    self.body, material, kind, fixed=mask,
+                    face_fixed=trimmed_face_masks(self.body.patches, fixed, components=True))
             else:
-                build = body_system
-            system = build(self.body, material, "free" if boundary is None else boundary,
-                           fixed=mask)
+                system = body_system(self.body, material, kind, fixed=mask)
             motions = system.motions
             self.patches: tuple[Surface, ...] | None = self.body.patches
             self.surface, self.offsets = None, system.offsets

@@ -86,8 +86,12 @@ class ShellModel(Model):
         Individual displacement components (or whole control points) that do not move.
         For a body a sequence of one such mask (or None) per patch, as
         :class:`~splinedeform.body.BodyModel`'s ``fixed``: a control point that patches
-        share (merged across a conforming interface) is held where any patch holds it;
-        a trimmed face takes none.
+        share (merged across a conforming interface) is held where any patch holds it.
+        A trimmed surface or face (its map Höllig's extension, ``T = E ⊗ I₃``) takes a
+        mask of whole points: ``(n_u, n_v)``, or per component with the three alike; a
+        held inner or outer B-spline's coefficient stays at rest, a dead one (support
+        outside the region) was at rest already
+        (:mod:`splinedeform.trim.shell_trimmed`).
     """
 
     mass_matrix = "consistent"

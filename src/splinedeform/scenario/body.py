@@ -8,8 +8,9 @@ and a :class:`~splinedeform.body.BodyModel`. What a body takes from a scenario:
   ``u0 = u1 = v0 = v1``, replaced edge by edge by ``[boundary.faces]``
   (``3 = {u0 = "clamped"}``, the file's face numbers; :func:`face_presets`); the moving
   control points of single faces by ``boundary.faces_free_points`` (``0 = [[i, j], ...]``,
-  all others of that face fixed; :func:`face_masks`), where ``free_region`` and
-  ``free_points`` are a single surface's;
+  all others of that face fixed; :func:`face_masks`; on a trimmed face too, its map
+  taking the mask, :func:`~splinedeform.trim.holed.with_edges`), where ``free_region``
+  and ``free_points`` are a single surface's;
 * ``surface.refine`` / ``surface.elevate``: every face alike, in its own u and v; where
   the counts differ in u and v, interfaces are made to conform again by exact elevation
   and knot insertion (:func:`refined_body`);
@@ -23,7 +24,8 @@ and a :class:`~splinedeform.body.BodyModel`. What a body takes from a scenario:
 
 from __future__ import annotations
 
-from typing import Any, Sequence
+from contextlib import contextmanager
+from typing import Any, Iterator, Sequence
 
 from ..body.body import Body
 from .schema_types import SHELL_EDGES
@@ -298,11 +300,6 @@ def face_masks(scenario: Scenario, body: FileBody) -> list[Any] | None:
         if patch is None:
             raise scenario.error(f"boundary.faces_free_points.{key}", f"face {key} is not in "
                                  f"this body, whose faces are {list(body.faces)}")
-        if body[patch].trim is not None:
-            raise scenario.error(f"boundary.faces_free_points.{key}", f"face {key} is trimmed: "
-                                 "its moving points are those its region covers, held by its "
-                                 "loops' conditions; fixed control points are taken on "
-                                 "untrimmed faces only")
         masks[patch] = moving_points_mask(scenario, points, body[patch].shape,
                                           f"boundary.faces_free_points.{key}",
                                           f"face {key}: its net")
@@ -328,14 +325,31 @@ def body_model(scenario: Scenario, body: FileBody) -> Any:
 
         with _located(scenario, "material"):
             shell = ShellMaterial(**scenario.material.shell())
-        with _located(scenario, "boundary"):
+        with _located(scenario, "boundary"), _at_face_masks(body):
             return ShellModel(body, shell, boundary, fixed=fixed)
     with _located(scenario, "material"):
         material = Material(**scenario.material.weights())
-    with _located(scenario, "boundary"):
+    with _located(scenario, "boundary"), _at_face_masks(body):
         return BodyModel(body, material, boundary=boundary,
                          mass_matrix=scenario.material.mass_matrix,
                          physics=scenario.material.physics, fixed=fixed)
+
+
+@contextmanager
+def _at_face_masks(body: FileBody) -> Iterator[None]:
+    """Put an error that a trimmed face's mask of fixed points causes (its ``patch``,
+    :func:`~splinedeform.body.trimmed.mask_of_face`) at ``boundary.faces_free_points.<face>``
+    (the file's face number)."""
+    from ..errors import InputError
+
+    try:
+        yield
+    except InputError as exc:
+        patch = getattr(exc, "patch", None)
+        if patch is not None and getattr(exc, "key", None) is None:
+            key = f"boundary.faces_free_points.{body.faces[patch]}"
+            exc.key = key  # type: ignore[attr-defined]
+        raise
 
 
 def on_faces(scenario: Scenario, body: Any, load: Any, index: int) -> Any:

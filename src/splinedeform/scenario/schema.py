@@ -151,7 +151,9 @@ class Boundary(_Table):
             "listed `[i, j]` as in `free_points` (row `i` along u, column `j` along v of that "
             "face's net, from 0); all other control points of a listed face are fixed at "
             "rest, a face not listed moves apart from its edges; a point that two faces "
-            "share is fixed when either fixes it"),
+            "share is fixed when either fixes it; on a trimmed face a fixed point whose "
+            "B-spline meets the region stays at rest (inner or outer), the others hold "
+            "nothing"),
         json_schema_extra={"doc_default": "none (all move)"})
     loops: Optional[dict[LoopKey, LoopPresets]] = Field(
         None, title='{outer = "clamped", ...}', description=(

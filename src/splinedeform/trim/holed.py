@@ -52,12 +52,24 @@ def with_edges(surface: Any, edges: dict[str, str], classes: np.ndarray,
     B-splines are tied to arrays of kept coefficients only, so ``E[K]`` never needs an
     eliminated one. ``fixed`` (a mask of the net, True: at rest) takes the fixed control
     points out of ``K`` as :func:`~splinedeform.boundary.build_constraints` does for an
-    untrimmed net: a fixed inner B-spline stays at rest, and so does a fixed outer one."""
+    untrimmed net: a fixed inner B-spline stays at rest, and so does a fixed outer one
+    (its coefficient is no longer the extension of the inner ones; the other outer ones
+    are tied to arrays of free inner ones only); a fixed dead one (its support outside the
+    region) was at rest already."""
     held = build_constraints(surface.basis_u, surface.basis_v, edges, fixed)
     kept = np.zeros(surface.shape, bool)
     kept.ravel()[held.free_index] = True
-    web = web_basis(classes, surface_degrees(surface), allowed=kept,
-                    knots=extension_knots(surface), weights=net_weights_of(surface))
+    try:
+        web = web_basis(classes, surface_degrees(surface), allowed=kept,
+                        knots=extension_knots(surface), weights=net_weights_of(surface))
+    except InputError:
+        if fixed is None or not np.any(fixed):
+            raise
+        n = surface_degrees(surface)
+        raise InputError(f"the control points left free hold no {n[0] + 1}×{n[1] + 1} array "
+                         "of inner B-splines (whose B-splines have a whole knot cell inside "
+                         "the region), to which the outer ones are tied: free more points "
+                         "or refine the net") from None
     inner = np.flatnonzero(web.inner.ravel())
     free = kept.ravel()[inner]
     E = web.extension.tocsr()[held.free_index]

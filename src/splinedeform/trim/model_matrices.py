@@ -55,7 +55,7 @@ from .holed import holed_quadrature, with_edges
 from .surface_trim import (extension_knots, holed_rectangle, net_weights_of, surface_degrees,
                            trim_grid)
 from .values import surface_values
-from .web import web_basis
+from .web import live_table, web_basis
 
 NITSCHE_FACTOR = 10.0
 """``β = NITSCHE_FACTOR (n + 1)³`` of the Nitsche penalties: above the trace-inverse
@@ -162,17 +162,32 @@ def trimmed_system(surface: Any, material: Material, boundary: str | Mapping[str
     if lumped:
         M = sp.diags(np.asarray(M.sum(axis=1)).ravel())
     mask = None if fixed is None else np.asarray(fixed, dtype=bool)
-    if rectangle or mask is not None:
+    if mask is not None:
+        try:
+            T, free_index = with_edges(surface, edges, quad.classes, mask)
+        except InputError as exc:       # marked: the mask is the cause (a body names its face)
+            exc.fixed_points = True  # type: ignore[attr-defined]
+            raise
+    elif rectangle:
         T, free_index = with_edges(surface, edges, quad.classes, mask)
     else:
         web = web_basis(quad.classes, surface_degrees(surface), knots=extension_knots(surface),
                         weights=net_weights_of(surface))
         T, free_index = web.extension.tocsr(), np.flatnonzero(web.inner.ravel())
-    pinned_points = bool(mask is not None and mask.any())
+    pinned_points = bool(mask is not None and held_live(surface, quad.classes, mask).any())
     constraints = Constraints(T, None, None, free_index, {**edges, **loops}, pinned_points)
     return TrimmedSystem(constraints, ((K + K.T) * 0.5).tocsr(), sp.csr_matrix(M),
                          _rigid_count(surface, material, bool(held) or pinned_points
                                       or set(edges.values()) != {"free"}, physics))
+
+
+def held_live(surface: Any, classes: NDArray[np.int64], mask: Any) -> NDArray[np.bool_]:
+    """The points of a mask of fixed control points (``(n_u, n_v)``, True: at rest) whose
+    B-splines meet the region (inner or outer, :func:`~.web.live_table`): those it holds.
+    A point whose B-spline is dead (its support outside the region) is at rest whatever
+    the mask says, and holds nothing."""
+    live = live_table(classes, surface_degrees(surface))
+    return np.asarray(mask, dtype=bool).reshape(live.shape) & live
 
 
 def _parametric_matrices(surface: Any, material: Material, quad: TrimQuadrature

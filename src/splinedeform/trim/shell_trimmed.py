@@ -41,8 +41,14 @@ coefficients at each point (:func:`~.energy_forms.penalty_scales`).
 The rectangle's edges ``u0 … v1`` of a holed rectangle (the outer loop is the parameter
 rectangle) take ``free``, ``pinned`` or ``clamped`` through the same Nitsche terms on the
 points of that loop (:func:`edge_nitsche`; the shell's other edge kinds of
-:mod:`splinedeform.physics.shell_edges` are not combined with the extension yet). Fixed
-components are refused.
+:mod:`splinedeform.physics.shell_edges` are not combined with the extension yet).
+
+**Fixed control points.** A mask of fixed points (``(n_u, n_v)``, or per component with
+the three components of each point alike) is taken as the plate's
+(:func:`~.holed.with_edges`): ``T = E_F ⊗ I₃`` with the extension ``E_F`` over the free
+inner B-splines, a held inner or outer B-spline's coefficient at rest, a held dead one
+(support outside the region) at rest already. Held components of a point but not all
+are refused: the three components follow one extension map.
 """
 
 from __future__ import annotations
@@ -53,14 +59,15 @@ from typing import Any, Mapping
 
 import numpy as np
 import scipy.sparse as sp
+from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..physics.shell import ShellMaterial, constitutive, strain_vectors
 from ..physics.shell_rigid import RigidMotions, free_rigid_motions
 from .energy_forms import Array, Form, Geometry, nitsche_matrix
 from .holed import with_edges
-from .model_matrices import (_cell_size, form_matrices, loop_conditions, loop_quadrature,
-                             nitsche_penalty, quadrature_of)
+from .model_matrices import (_cell_size, form_matrices, held_live, loop_conditions,
+                             loop_quadrature, nitsche_penalty, quadrature_of)
 from .surface_trim import (extension_knots, holed_rectangle, net_weights_of, surface_degrees,
                            trim_grid)
 from .web import web_basis
@@ -103,13 +110,16 @@ class TrimmedShell:
     motions: RigidMotions
 
 
-def rigid_motions(T: sp.csr_matrix, points: Array, holds: bool) -> RigidMotions:
+def rigid_motions(T: sp.csr_matrix, points: Array, holds: bool,
+                  at_rest: NDArray[np.bool_] | None = None) -> RigidMotions:
     """The free rigid motions: none where a held loop's penalty takes them, else those in
     ``range T`` on the control points the region moves (``T``'s nonzero rows; the others
-    stay at rest)."""
+    stay at rest) and on the fixed points ``at_rest`` (flat, live ones: zero rows of ``T``
+    that are points of the shell, :func:`~.model_matrices.held_live`)."""
     if holds:
         return RigidMotions(np.zeros((T.shape[1], 0)), np.zeros((6, 0)))
-    moving = np.flatnonzero(np.diff(T.indptr)[::3] > 0)
+    moving = np.diff(T.indptr)[::3] > 0
+    moving = np.flatnonzero(moving if at_rest is None else moving | at_rest)
     rows = (3 * moving[:, None] + np.arange(3)).ravel()
     return free_rigid_motions(T[rows], points.reshape(-1, 3)[moving])
 
@@ -117,14 +127,12 @@ def rigid_motions(T: sp.csr_matrix, points: Array, holds: bool) -> RigidMotions:
 def trimmed_shell(surface: Any, material: ShellMaterial,
                   boundary: str | Mapping[str, str] | None, fixed: Any = None) -> TrimmedShell:
     """The shell of a trimmed surface (module docstring); ``boundary`` names its loops
-    (``{"outer": "clamped", "hole1": "free"}``, or one preset for every loop)."""
+    (``{"outer": "clamped", "hole1": "free"}``, or one preset for every loop); ``fixed``
+    a mask of fixed control points (:func:`point_mask`, module docstring)."""
     degrees = surface_degrees(surface)
     if min(degrees) < 2:
         raise InputError("the Kirchhoff–Love shell needs degree >= 2 in u and v (curvatures)")
-    if fixed is not None:
-        raise InputError("a trimmed shell is held by its trim loops (boundary = {'outer': "
-                         "'clamped', …}); fixed components are not taken on a trimmed "
-                         "surface yet")
+    mask = None if fixed is None else point_mask(surface, fixed)
     edges, loops, held = loop_conditions(surface, "free" if boundary is None else boundary)
     rectangle = holed_rectangle(surface)
     kept = {e: k for e, k in edges.items() if k != "free"}
@@ -137,14 +145,41 @@ def trimmed_shell(surface: Any, material: ShellMaterial,
         K = K + edge_nitsche(surface, form, edges)
     M = sp.kron(mass, sp.identity(3))
     classes = quadrature_of(surface).classes
-    if rectangle:                         # its edges held by Nitsche's terms, not here
+    if mask is not None:                  # the edges held by Nitsche's terms, not here
+        try:
+            E, _ = with_edges(surface, {e: "free" for e in edges}, classes, mask)
+        except InputError as exc:         # marked: the mask is the cause (a body names its face)
+            exc.fixed_points = True  # type: ignore[attr-defined]
+            raise
+    elif rectangle:
         E, _ = with_edges(surface, {e: "free" for e in edges}, classes, None)
     else:
         E = web_basis(classes, degrees, knots=extension_knots(surface),
                       weights=net_weights_of(surface)).extension
     T = sp.kron(sp.csr_matrix(E), sp.identity(3), format="csr")
+    at_rest = None if mask is None else held_live(surface, classes, mask).ravel()
     return TrimmedShell(((K + K.T) * 0.5).tocsr(), M.tocsr(), T, {**edges, **loops},
-                        rigid_motions(T, surface.control_points, bool(held or kept)))
+                        rigid_motions(T, surface.control_points, bool(held or kept), at_rest))
+
+
+def point_mask(surface: Any, fixed: Any) -> NDArray[np.bool_]:
+    """A trimmed shell's mask of fixed control points ``(n_u, n_v)``: given so, or per
+    component ``(n_u, n_v, 3)`` holding the three components of each point alike (the
+    three follow one extension map, ``T = E ⊗ I₃``)."""
+    mask = np.asarray(fixed)
+    net = tuple(surface.shape)
+    if mask.shape not in (net, net + (3,)) or mask.dtype != bool:
+        raise InputError(f"a trimmed shell's fixed mask is boolean, of shape (n_u, n_v) = "
+                         f"{net} or {net + (3,)}, got {mask.shape} of dtype {mask.dtype}")
+    if mask.ndim == 3:
+        mixed = np.argwhere(mask.any(axis=-1) & ~mask.all(axis=-1))
+        if len(mixed):
+            listed = ", ".join(str(list(map(int, ij))) for ij in mixed[:4])
+            raise InputError("a trimmed shell's three displacement components follow one "
+                             "extension map: its mask holds a control point whole or not at "
+                             f"all; point(s) {listed} hold some components only")
+        mask = mask.all(axis=-1)
+    return mask
 
 
 def edge_nitsche(surface: Any, form: Form, edges: Mapping[str, str]) -> sp.csr_matrix:

@@ -61,6 +61,12 @@ def _support_any(mask: NDArray[np.bool_], degree: int | Degrees) -> NDArray[np.b
     return sliding_window_view(padded, (n1 + 1, n2 + 1)).any(axis=(-1, -2))
 
 
+def live_table(classes: NDArray[np.int64], degree: int | Degrees) -> NDArray[np.bool_]:
+    """The B-splines whose support meets ``Ω`` (inner or outer, not irrelevant): a table
+    over the B-spline indices. A coefficient outside it moves nothing of the region."""
+    return _support_any((classes == INSIDE) | (classes == CUT), degree)
+
+
 def lagrange_coefficients(target: NDArray[np.float64], degree: int) -> NDArray[np.float64]:
     """``L_a(t) = Π_{μ≠a} (t - μ)/(a - μ)`` for ``a = 0..n``; shape ``t.shape + (n+1,)``."""
     t = np.asarray(target, dtype=float)[..., None]
@@ -139,7 +145,7 @@ def web_basis(classes: NDArray[np.int64], degree: int | Degrees,
     for the trimmed region).
     """
     n = degrees_of(degree)
-    meets = _support_any((classes == INSIDE) | (classes == CUT), n)
+    meets = live_table(classes, n)
     inner = _support_any(classes == INSIDE, n)
     outer = meets & ~inner
     shape = inner.shape
