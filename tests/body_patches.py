@@ -74,3 +74,47 @@ def rhino3dm_box(folder, units: str, size=(1.0, 2.0, 3.0)):
     model.Objects.AddBrep(r3.Brep.CreateFromBox(r3.Box(r3.BoundingBox(0, 0, 0, *size))))
     assert model.Write(str(path), 7)
     return path
+
+
+# -- the unit square as two halves, and the same as a two-face .3dm with a scenario --------
+HALF_CELLS = 3
+N = HALF_CELLS + DEGREE   # each half: a 6 × 6 net
+ROWS = 2 * N - 1          # the single patch: 11 rows along u (the C0 line's row shared)
+
+
+def halves() -> list[Surface]:
+    """The unit square as two patches, the right one reversed in u (its u1 at x = 0.5)."""
+    return [flat_patch((0, 0.5), (0, 1), (HALF_CELLS, HALF_CELLS)),
+            flat_patch((0.5, 1), (0, 1), (HALF_CELLS, HALF_CELLS), reverse_u=True)]
+
+
+def single_row(patch: int, i: int) -> int:
+    """The row of the single patch (:func:`split_square`) of row ``i`` of ``patch``."""
+    return i if patch == 0 else ROWS - 1 - i
+
+
+def halves_3dm(path):
+    """The two halves as one Brep of two faces (face 0 the left half) written to ``path``."""
+    import splinedeform as sd
+    from splinedeform.export.body import write_body_3dm
+
+    patches = halves()
+    return write_body_3dm(path, patches, [s.control_points for s in patches],
+                          body=sd.Body(patches))
+
+
+def halves_scenario(folder, source, material: str, boundary: str,
+                    formats: str = '"json", "report"'):
+    """``folder/two.toml``: the ``.3dm`` ``source`` (copied beside it) under ``material``
+    (the lines of ``[material]``) and ``boundary`` (those of ``[boundary]``), a uniform
+    load ``(0, 0, -1)``, a static solve, the ``formats`` at resolution 5."""
+    import shutil
+
+    shutil.copy(source, folder / source.name)
+    path = folder / "two.toml"
+    path.write_text(f'[surface]\nshape = "cad"\npath = "{source.name}"\n'
+                    f'[material]\n{material}[boundary]\n{boundary}'
+                    '[[load]]\nkind = "uniform"\nforce = [0.0, 0.0, -1.0]\n'
+                    '[solve]\nkind = "static"\n'
+                    f'[output]\nformats = [{formats}]\nresolution = 5\n')
+    return path

@@ -25,24 +25,14 @@ import pytest
 import splinedeform as sd
 from splinedeform.errors import InputError
 
-from body_patches import flat_patch, split_square
+from body_patches import (N, ROWS, halves, halves_3dm, halves_scenario, single_row,
+                          split_square)
 
 MEMBRANE = sd.Material(w10=1.0, w01=1.0)
 LOAD = sd.Uniform((0.0, 0.0, -1.0))
 SAME = 1e-10      # same discrete space, another assembly order (module docstring)
-N = 6             # each half: 3 cubic spans per direction, a 6 × 6 net
-ROWS = 2 * N - 1  # the single patch: 11 rows along u (the C0 line's row shared)
 
 
-def halves() -> list[sd.Surface]:
-    """The unit square as two patches, the right one reversed in u (its u1 at x = 0.5)."""
-    return [flat_patch((0, 0.5), (0, 1), (3, 3)),
-            flat_patch((0.5, 1), (0, 1), (3, 3), reverse_u=True)]
-
-
-def single_row(patch: int, i: int) -> int:
-    """The row of the single patch of row ``i`` of ``patch``."""
-    return i if patch == 0 else ROWS - 1 - i
 
 
 def masks(free: dict[int, list[tuple[int, int]]]) -> list[np.ndarray]:
@@ -141,25 +131,12 @@ PATCH = "[[2, 2], [2, 3], [3, 2], [3, 3]]"
 def two_faces(tmp_path_factory):
     """The two halves as one Brep of two faces (face 0 the left half) in a ``.3dm``."""
     pytest.importorskip("rhino3dm", reason="the 'cad' extra (rhino3dm) is not installed")
-    from splinedeform.export.body import write_body_3dm
-
-    patches = halves()
-    return write_body_3dm(tmp_path_factory.mktemp("bodyfree") / "two.3dm", patches,
-                          [s.control_points for s in patches], body=sd.Body(patches))
+    return halves_3dm(tmp_path_factory.mktemp("bodyfree") / "two.3dm")
 
 
 def scenario_of(folder: Path, source: Path, boundary: str) -> Path:
-    import shutil
-
-    shutil.copy(source, folder / source.name)
-    path = folder / "two.toml"
-    path.write_text(f'[surface]\nshape = "cad"\npath = "{source.name}"\n'
-                    '[material]\nw10 = 1.0\nw01 = 1.0\n'
-                    f'[boundary]\n{boundary}'
-                    '[[load]]\nkind = "uniform"\nforce = [0.0, 0.0, -1.0]\n'
-                    '[solve]\nkind = "static"\n'
-                    '[output]\nformats = ["vtu", "json", "report"]\nresolution = 5\n')
-    return path
+    return halves_scenario(folder, source, "w10 = 1.0\nw01 = 1.0\n", boundary,
+                           '"vtu", "json", "report"')
 
 
 def test_faces_free_points_runs_and_moves_the_listed_points_only(two_faces, tmp_path):

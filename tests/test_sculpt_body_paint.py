@@ -98,11 +98,25 @@ def test_a_painted_face_moves_at_its_listed_points_only(served):
     assert np.abs(face_rows(session.basis, 0)[2, 3]).max() > MOVES * np.abs(session.basis.phi_net).max()
 
 
-def test_save_writes_the_painted_set_and_run_holds_the_same_points(served, tmp_path):
+def run_saved(path, text, folder, session) -> list[np.ndarray]:
+    """``splinedeform run`` of a saved scenario (its outputs cut to the net file, 5
+    frames): per face of the session's body the frames' displacement from rest."""
     from typer.testing import CliRunner
 
     from splinedeform import cli
 
+    path.write_text(text.replace('formats = ["report", "images", "viewer"]',
+                                 'formats = ["json"]'))
+    out = folder / "out"
+    result = CliRunner().invoke(cli.app, ["run", str(path), "-o", str(out), "--frames", "5"])
+    assert result.exit_code == 0, result.output
+    nets = json.loads(next(out.glob("*_nets.json")).read_text())["nets"]
+    rest = [s.control_points for s in session.basis.patches]
+    return [np.asarray(nets[str(f)]["control_points"]) - rest[f][None]
+            for f in range(len(rest))]
+
+
+def test_save_writes_the_painted_set_and_run_holds_the_same_points(served, tmp_path):
     client, session = served
     reply = resolve(client, {"0": PAINTED})
     assert reply.status_code == 200, reply.text
@@ -114,15 +128,7 @@ def test_save_writes_the_painted_set_and_run_holds_the_same_points(served, tmp_p
     assert scenario.raw["boundary"]["faces_free_points"] == {"0": PAINTED}
     built = build(scenario)
     assert built.model.n_free == session.basis.model.n_free
-    # splinedeform run of the saved file (its outputs cut to the net file, a few frames)
-    path.write_text(text.replace('formats = ["report", "images", "viewer"]',
-                                 'formats = ["json"]'))
-    out = tmp_path / "out"
-    result = CliRunner().invoke(cli.app, ["run", str(path), "-o", str(out), "--frames", "5"])
-    assert result.exit_code == 0, result.output
-    nets = json.loads(next(out.glob("*_nets.json")).read_text())["nets"]
-    rest = [s.control_points for s in session.basis.patches]
-    moved = [np.asarray(nets[str(f)]["control_points"]) - rest[f][None] for f in (0, 1)]
+    moved = run_saved(path, text, tmp_path, session)
     listed = np.zeros((N, N), bool)
     listed[tuple(np.array(PAINTED).T)] = True
     scale = max(np.abs(m).max() for m in moved)

@@ -13,15 +13,14 @@ moves.
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pytest
 
 pytest.importorskip("OCP", reason="the body's STEP shell needs OpenCASCADE (the extra 'step')")
 from sculpt_body_files import BODY, two_faces  # noqa: E402
 from sculpt_client import SHEET, serve_sheet  # noqa: E402 (skips without the extra)
-from test_sculpt_body_paint import MOVES, ZERO, face_rows, three_strips  # noqa: E402
+from test_sculpt_body_paint import (MOVES, ZERO, face_rows, run_saved,  # noqa: E402
+                                    three_strips)
 
 from splinedeform.scenario import load_scenario  # noqa: E402
 from splinedeform.sculpt.export import decode  # noqa: E402
@@ -123,10 +122,6 @@ def test_a_pin_keeps_the_painted_set_under_the_baked_files_face_numbers(tmp_path
 
 
 def test_save_writes_the_pin_and_run_holds_the_point(served, tmp_path):
-    from typer.testing import CliRunner
-
-    from splinedeform import cli
-
     client, session = served
     reply = pin(client, session, {"0": every_point_but(PIN)})
     assert reply.status_code == 200, reply.text
@@ -136,14 +131,7 @@ def test_save_writes_the_pin_and_run_holds_the_point(served, tmp_path):
     assert "faces_free_points = { 0 = [" in text
     scenario = load_scenario(path)
     assert scenario.raw["boundary"]["faces_free_points"] == {"0": every_point_but(PIN)}
-    path.write_text(text.replace('formats = ["report", "images", "viewer"]',
-                                 'formats = ["json"]'))
-    out = tmp_path / "out"
-    result = CliRunner().invoke(cli.app, ["run", str(path), "-o", str(out), "--frames", "5"])
-    assert result.exit_code == 0, result.output
-    nets = json.loads(next(out.glob("*_nets.json")).read_text())["nets"]
-    rest = [s.control_points for s in session.basis.patches]
-    moved = [np.asarray(nets[str(f)]["control_points"]) - rest[f][None] for f in (0, 1)]
+    moved = run_saved(path, text, tmp_path, session)
     scale = max(np.abs(m).max() for m in moved)
     assert scale > 0
     # the file's nets are decimal text: the pinned point is at rest to the digits written

@@ -21,7 +21,6 @@ compared to 1e-14 of the scale as a stated tolerance.
 from __future__ import annotations
 
 import json
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -32,26 +31,16 @@ from splinedeform.errors import InputError, ScenarioError
 from splinedeform.physics.shell import ShellMaterial
 from splinedeform.physics.shell_model import ShellModel
 
-from body_patches import flat_patch, split_square
+from body_patches import (N, ROWS, flat_patch, halves, halves_3dm, halves_scenario,
+                          single_row, split_square)
 
 SHELL = ShellMaterial(E=1.0e4, nu=0.3, thickness=0.05, density=1.0)
 BENDING = sd.Uniform((0.0, 0.0, -1.0))
 IN_PLANE = sd.Uniform((1.0, 0.5, 0.0))
 SAME = 1e-10      # same discrete space, another basis of it (module docstring)
 REST = 1e-14      # a zero row of T: exactly 0, stated as a tolerance of the scale
-N = 6             # each half: 3 cubic spans per direction, a 6 × 6 net
-ROWS = 2 * N - 1  # the single patch: 11 rows along u (the C0 line's row shared)
 
 
-def halves() -> list[sd.Surface]:
-    """The unit square as two patches, the right one reversed in u (its u1 at x = 0.5)."""
-    return [flat_patch((0, 0.5), (0, 1), (3, 3)),
-            flat_patch((0.5, 1), (0, 1), (3, 3), reverse_u=True)]
-
-
-def single_row(patch: int, i: int) -> int:
-    """The row of the single patch of row ``i`` of ``patch``."""
-    return i if patch == 0 else ROWS - 1 - i
 
 
 def solve_both(fixed: list[np.ndarray | None], single_fixed: np.ndarray, load: sd.Load
@@ -275,24 +264,12 @@ PATCH = "[[2, 2], [2, 3], [3, 2], [3, 3]]"
 def two_faces(tmp_path_factory):
     """The two halves as one Brep of two faces (face 0 the left half) in a ``.3dm``."""
     pytest.importorskip("rhino3dm", reason="the 'cad' extra (rhino3dm) is not installed")
-    from splinedeform.export.body import write_body_3dm
-
-    patches = halves()
-    return write_body_3dm(tmp_path_factory.mktemp("shellfixed") / "two.3dm", patches,
-                          [s.control_points for s in patches], body=sd.Body(patches))
+    return halves_3dm(tmp_path_factory.mktemp("shellfixed") / "two.3dm")
 
 
 def shell_scenario(folder: Path, source: Path, boundary: str) -> Path:
-    shutil.copy(source, folder / source.name)
-    path = folder / "two.toml"
-    path.write_text(f'[surface]\nshape = "cad"\npath = "{source.name}"\n'
-                    '[material]\nphysics = "shell"\nE = 1.0e4\nnu = 0.3\n'
-                    'thickness = 0.05\n'
-                    f'[boundary]\n{boundary}'
-                    '[[load]]\nkind = "uniform"\nforce = [0.0, 0.0, -1.0]\n'
-                    '[solve]\nkind = "static"\n'
-                    '[output]\nformats = ["json", "report"]\nresolution = 5\n')
-    return path
+    return halves_scenario(folder, source, "physics = \"shell\"\nE = 1.0e4\nnu = 0.3\n"
+                           "thickness = 0.05\n", boundary)
 
 
 def test_faces_free_points_of_a_shell_body_run_from_the_command_line(two_faces, tmp_path):
