@@ -24,6 +24,7 @@ from .cad import CAD_SUFFIXES, NurbsPatch, surface_from_patch
 from .cad_child import check_cad_file, read_in_child
 from .cad_faces import is_trimmed
 from .cad_join import file_edges, join_loose_faces, loose_faces
+from .cad_join_trims import join_trims
 from .cad_topology import Topology, body_topology
 from .errors import InputError, InputWarning
 
@@ -171,16 +172,21 @@ def body_of(path: Path, listing: dict[str, Any], chosen: list[int]
     topology = body_topology(patches, edges, kept)
     file_count = len(topology.interfaces)
     topology = join_loose_faces(surfaces, topology, loose)
+    topology = join_trims(surfaces, listing, kept, trimmed, topology)
     info = {"units": listing["units"], "faces": kept,
             "names": [listing["faces"][k].get("name") for k in kept],
             "reversed": [bool(listing["faces"][k].get("reversed")) for k in kept],
             "trimmed": trimmed, "skipped": skipped,
             "joined_by_geometry": [
                 {"face_a": kept[i.a], "edge_a": i.edge_a, "face_b": kept[i.b],
-                 "edge_b": i.edge_b} for i in topology.interfaces[file_count:]],
+                 "edge_b": i.edge_b} for i in topology.interfaces[file_count:]] + [
+                {"face_a": kept[a], "edge_a": ea, "face_b": kept[b], "edge_b": eb}
+                for a, ea, b, eb, whole in topology.trim_joins if whole],
             "partly_joined_by_geometry": [
                 {"face_a": kept[a], "edge_a": ea, "face_b": kept[b], "edge_b": eb}
-                for a, ea, b, eb in topology.stretches]}
+                for a, ea, b, eb in topology.stretches] + [
+                {"face_a": kept[a], "edge_a": ea, "face_b": kept[b], "edge_b": eb}
+                for a, ea, b, eb, whole in topology.trim_joins if not whole]}
     return surfaces, topology, info
 
 

@@ -76,10 +76,12 @@ def _joined(path: Path, data: dict[str, Any], faces: list[dict[str, Any]]
     be deformed."""
     from .cad_body import body_of
     from .cad_join import loose_faces
+    from .cad_join_trims import loose_trimmed
     from .errors import InputError
 
     trimmed = [f["face"] for f in faces if f.get("trimmed")]
-    if not loose_faces(data, range(len(faces)), trimmed):
+    every = range(len(faces))
+    if not (loose_faces(data, every, trimmed) or loose_trimmed(data, every, trimmed)):
         return None
     chosen = [f["face"] for f in faces if "error" not in f]
     try:
@@ -90,7 +92,7 @@ def _joined(path: Path, data: dict[str, Any], faces: list[dict[str, Any]]
         return None
     out = topology.as_dict()
     kept = info["faces"]
-    for item in out["interfaces"] + out.get("stretches", []):
+    for item in out["interfaces"] + out.get("stretches", []) + out.get("trim_joins", []):
         item["a"], item["b"] = kept[item["a"]], kept[item["b"]]
     return out
 
