@@ -8,7 +8,8 @@ each a deformable :class:`~splinedeform.surface.Surface`
 (:func:`splinedeform.cad.surface_from_patch`) and finds the interfaces between them from
 the file's edges (:func:`splinedeform.cad_topology.body_topology`), and those of the faces that the
 file joins to nothing (plain surfaces, STEP faces sewn to none) from the geometry
-(:mod:`splinedeform.cad_join`). A face that cannot
+(:mod:`splinedeform.cad_join`; trimmed ones along their trim edges,
+:mod:`splinedeform.cad_join_trims`). A face that cannot
 be deformed (unreadable, general weights on unclamped knots) is skipped, and ``info``
 says why; a trimmed face is taken untrimmed, with one warning line naming it.
 """
@@ -129,7 +130,10 @@ def read_body(path: str | os.PathLike, faces: FaceChoice = "all"
         :mod:`splinedeform.cad_join`), ``{"face_a", "edge_a", "face_b", "edge_b"}`` in
         file face numbers (the file's own interfaces come first in ``topology``), and
         ``partly_joined_by_geometry`` the sides of theirs that share only a stretch with
-        another (T-junctions, coupled along it by the body), likewise.
+        another (T-junctions, coupled along it by the body), likewise; both with the trim
+        edges of loose trimmed faces joined along another face's trim edge or side
+        (:mod:`splinedeform.cad_join_trims`; an edge ``hole1``, ``outer.2`` or ``u0``),
+        those that run along the whole of both edges in the first.
     """
     path = Path(path)
     listing = read_listing(path)

@@ -55,7 +55,8 @@ def read_faces(path: str | os.PathLike) -> dict[str, Any]:
     (:func:`splinedeform.cad_body.read_body`): with the interfaces and T-junction
     stretches found from the geometry (:mod:`splinedeform.cad_join`; the file's
     interfaces first), counted ``joined_by_geometry`` and ``partly_joined_by_geometry``,
-    the stretches listed as ``stretches``; face numbers are the file's."""
+    the stretches listed as ``stretches``, the trim edges of loose trimmed faces joined
+    (:mod:`splinedeform.cad_join_trims`) as ``trim_joins``; face numbers are the file's."""
     from .cad_body import patches_of, read_listing
     from .cad_topology import body_topology
 
