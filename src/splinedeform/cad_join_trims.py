@@ -25,6 +25,9 @@ sides, as :func:`splinedeform.cad_topology.body_topology` places the file's edge
 ``trim_edges.shared += |P_O|``, ``trim_edges.free −= |O|``, ``P_O`` the pairs with an edge
 in ``O``; ``joined_by_geometry += |P|`` and, for the pairs that do not run along the
 whole of both edges (stretches), ``partly_shared`` and ``partly_joined_by_geometry``.
+Where a stretch covers part of an edge, a sewn file has that edge split at the stretch's
+ends (the shared piece and the free ones, each an edge); here it stays one edge, coupled
+along the stretch, so ``boundary`` lacks the free pieces.
 """
 
 from __future__ import annotations
