@@ -243,3 +243,12 @@ def test_a_loose_clamped_plate_bends_as_its_sewn_twin(files, name, twin):
     if name != "tall":
         reference = CLAMPED_PLATE_CENTRE if name == "split" else RECTANGLE_CENTRE
         assert abs(scale / reference - 1) < (1e-3 if name == "split" else 1e-2)
+
+
+def test_validate_counts_the_trim_join_among_the_body_s_edges(files):
+    scenario = files["split"].with_name("split_validate.toml")
+    scenario.write_text(SCENARIO.replace("split.step", files["split"].name))
+    result = runner.invoke(cli.app, ["validate", str(scenario)])
+    assert result.exit_code == 0, result.output
+    assert "1 shared, 4 boundary" in result.output
+    assert "1 joined-by-geometry" in result.output
