@@ -16,6 +16,10 @@ the two bodies, clamped under a uniform load, must bend alike.
   to ``.3dm`` (a one-face Brep beside a plain surface);
 * **tall**: the same trimmed square beside the untrimmed ``[1, 2] × [-0.5, 1.5]``: the
   trim edge runs along the middle half of its side ``u0``, a stretch;
+* **solids**: the L prism and the drilled box of ``tests/test_body_trim_edges_cad.py``
+  (trimmed faces whose trim edges lie along untrimmed faces' sides, and along a seamed
+  cylinder's circles), each face copied with its own edges (``BRepBuilderAPI_Copy``)
+  into a compound: every count equals the solid's own;
 * **apart**: the same two faces with the untrimmed one lifted by 0.5, and two trimmed
   squares with a gap between them: nothing is joined.
 """
@@ -252,3 +256,57 @@ def test_validate_counts_the_trim_join_among_the_body_s_edges(files):
     assert result.exit_code == 0, result.output
     assert "1 shared, 4 boundary" in result.output
     assert "1 joined-by-geometry" in result.output
+
+
+def loose_copy(shape):
+    """A compound of copies of the faces of ``shape``, each with its own edges (the faces
+    as an exporter that writes each one alone writes them)."""
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS_Compound
+
+    builder, compound = BRep_Builder(), TopoDS_Compound()
+    builder.MakeCompound(compound)
+    faces = TopExp_Explorer(shape, TopAbs_FACE)
+    while faces.More():
+        builder.Add(compound, BRepBuilderAPI_Copy(faces.Current()).Shape())
+        faces.Next()
+    return compound
+
+
+def solids():
+    """The L prism and the drilled box (module docstring), as OpenCASCADE shapes."""
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon
+    from OCP.BRepPrimAPI import (BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder,
+                                 BRepPrimAPI_MakePrism)
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt, gp_Vec
+
+    polygon = BRepBuilderAPI_MakePolygon()
+    for x, y in [(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)]:
+        polygon.Add(gp_Pnt(x, y, 0))
+    polygon.Close()
+    base = BRepBuilderAPI_MakeFace(polygon.Wire()).Face()
+    prism = BRepPrimAPI_MakePrism(base, gp_Vec(0, 0, 1.0)).Shape()
+    box = BRepPrimAPI_MakeBox(2.0, 2.0, 1.0).Shape()
+    drill = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(1, 1, -0.5), gp_Dir(0, 0, 1)), 0.4, 2.0)
+    return {"prism": prism, "drilled": BRepAlgoAPI_Cut(box, drill.Shape()).Shape()}
+
+
+@pytest.mark.parametrize("name, joins", [("prism", (18, 4)), ("drilled", (14, 0))])
+def test_a_solid_written_face_by_face_counts_as_the_solid(tmp_path, name, joins):
+    from test_body_trim_edges_cad import write_step as write_shape
+
+    shape = solids()[name]
+    _, solid, _ = body(write_shape(shape, tmp_path / f"{name}_solid.step"))
+    _, topology, info = body(write_shape(loose_copy(shape), tmp_path / f"{name}.step"))
+    assert "joined_by_geometry" not in solid.counts
+    # every edge of the solid found again: the file's counts from its edges, the loose
+    # file's from the geometry (integers: exact), partly_shared included
+    assert {k: v for k, v in topology.counts.items() if "joined" not in k} == solid.counts
+    assert topology.trim_edges == solid.trim_edges
+    assert (topology.counts["joined_by_geometry"],
+            topology.counts.get("partly_joined_by_geometry", 0)) == joins
+    assert len(info["joined_by_geometry"]) + len(info["partly_joined_by_geometry"]) == joins[0]
