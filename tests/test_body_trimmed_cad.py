@@ -49,10 +49,12 @@ resolution = 17
 """
 
 
-def split_step(path, weights=None):
+def split_step(path, weights=None, sewn=True):
     """The square [0, 1]² as two faces of one B-spline plane: the disc and the rest; with
     ``weights`` (3 × 3) the plane is a biquadratic on the grid of poles ``(i/2, j/2, 0)``
-    with those NURBS weights (the same square, its parametrisation warped)."""
+    with those NURBS weights (the same square, its parametrisation warped). Sewn into one
+    shell (the circle one edge of both faces), or with ``sewn=False`` written as a
+    compound of the two faces, each with its own edges (joined by nothing in the file)."""
     from OCP.BRepBuilderAPI import (BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace,
                                     BRepBuilderAPI_MakeWire, BRepBuilderAPI_Sewing)
     from OCP.Geom import Geom_Plane, Geom_RectangularTrimmedSurface
@@ -85,12 +87,22 @@ def split_step(path, weights=None):
         fix = ShapeFix_Face(made.Face())                    # the pcurves on the surface
         fix.Perform()
         faces.append(fix.Face())
-    sewing = BRepBuilderAPI_Sewing(1e-6)
-    for face in faces:
-        sewing.Add(face)
-    sewing.Perform()
+    if sewn:
+        sewing = BRepBuilderAPI_Sewing(1e-6)
+        for face in faces:
+            sewing.Add(face)
+        sewing.Perform()
+        shape = sewing.SewedShape()
+    else:
+        from OCP.BRep import BRep_Builder
+        from OCP.TopoDS import TopoDS_Compound
+
+        builder, shape = BRep_Builder(), TopoDS_Compound()
+        builder.MakeCompound(shape)
+        for face in faces:
+            builder.Add(shape, face)
     writer = STEPControl_Writer()
-    writer.Transfer(sewing.SewedShape(), STEPControl_AsIs)
+    writer.Transfer(shape, STEPControl_AsIs)
     writer.Write(str(path))
 
 

@@ -8,7 +8,8 @@ each a deformable :class:`~splinedeform.surface.Surface`
 (:func:`splinedeform.cad.surface_from_patch`) and finds the interfaces between them from
 the file's edges (:func:`splinedeform.cad_topology.body_topology`), and those of the faces that the
 file joins to nothing (plain surfaces, STEP faces sewn to none) from the geometry
-(:mod:`splinedeform.cad_join`). A face that cannot
+(:mod:`splinedeform.cad_join`; trimmed ones along their trim edges,
+:mod:`splinedeform.cad_join_trims`). A face that cannot
 be deformed (unreadable, general weights on unclamped knots) is skipped, and ``info``
 says why; a trimmed face is taken untrimmed, with one warning line naming it.
 """
@@ -24,6 +25,7 @@ from .cad import CAD_SUFFIXES, NurbsPatch, surface_from_patch
 from .cad_child import check_cad_file, read_in_child
 from .cad_faces import is_trimmed
 from .cad_join import file_edges, join_loose_faces, loose_faces
+from .cad_join_trims import join_trims
 from .cad_topology import Topology, body_topology
 from .errors import InputError, InputWarning
 
@@ -128,7 +130,10 @@ def read_body(path: str | os.PathLike, faces: FaceChoice = "all"
         :mod:`splinedeform.cad_join`), ``{"face_a", "edge_a", "face_b", "edge_b"}`` in
         file face numbers (the file's own interfaces come first in ``topology``), and
         ``partly_joined_by_geometry`` the sides of theirs that share only a stretch with
-        another (T-junctions, coupled along it by the body), likewise.
+        another (T-junctions, coupled along it by the body), likewise; both with the trim
+        edges of loose trimmed faces joined along another face's trim edge or side
+        (:mod:`splinedeform.cad_join_trims`; an edge ``hole1``, ``outer.2`` or ``u0``),
+        those that run along the whole of both edges in the first.
     """
     path = Path(path)
     listing = read_listing(path)
@@ -171,16 +176,21 @@ def body_of(path: Path, listing: dict[str, Any], chosen: list[int]
     topology = body_topology(patches, edges, kept)
     file_count = len(topology.interfaces)
     topology = join_loose_faces(surfaces, topology, loose)
+    topology = join_trims(surfaces, listing, kept, trimmed, topology)
     info = {"units": listing["units"], "faces": kept,
             "names": [listing["faces"][k].get("name") for k in kept],
             "reversed": [bool(listing["faces"][k].get("reversed")) for k in kept],
             "trimmed": trimmed, "skipped": skipped,
             "joined_by_geometry": [
                 {"face_a": kept[i.a], "edge_a": i.edge_a, "face_b": kept[i.b],
-                 "edge_b": i.edge_b} for i in topology.interfaces[file_count:]],
+                 "edge_b": i.edge_b} for i in topology.interfaces[file_count:]] + [
+                {"face_a": kept[a], "edge_a": ea, "face_b": kept[b], "edge_b": eb}
+                for a, ea, b, eb, whole in topology.trim_joins if whole],
             "partly_joined_by_geometry": [
                 {"face_a": kept[a], "edge_a": ea, "face_b": kept[b], "edge_b": eb}
-                for a, ea, b, eb in topology.stretches]}
+                for a, ea, b, eb in topology.stretches] + [
+                {"face_a": kept[a], "edge_a": ea, "face_b": kept[b], "edge_b": eb}
+                for a, ea, b, eb, whole in topology.trim_joins if not whole]}
     return surfaces, topology, info
 
 

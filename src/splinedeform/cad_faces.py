@@ -55,7 +55,8 @@ def read_faces(path: str | os.PathLike) -> dict[str, Any]:
     (:func:`splinedeform.cad_body.read_body`): with the interfaces and T-junction
     stretches found from the geometry (:mod:`splinedeform.cad_join`; the file's
     interfaces first), counted ``joined_by_geometry`` and ``partly_joined_by_geometry``,
-    the stretches listed as ``stretches``; face numbers are the file's."""
+    the stretches listed as ``stretches``, the trim edges of loose trimmed faces joined
+    (:mod:`splinedeform.cad_join_trims`) as ``trim_joins``; face numbers are the file's."""
     from .cad_body import patches_of, read_listing
     from .cad_topology import body_topology
 
@@ -76,10 +77,12 @@ def _joined(path: Path, data: dict[str, Any], faces: list[dict[str, Any]]
     be deformed."""
     from .cad_body import body_of
     from .cad_join import loose_faces
+    from .cad_join_trims import loose_trimmed
     from .errors import InputError
 
     trimmed = [f["face"] for f in faces if f.get("trimmed")]
-    if not loose_faces(data, range(len(faces)), trimmed):
+    every = range(len(faces))
+    if not (loose_faces(data, every, trimmed) or loose_trimmed(data, every, trimmed)):
         return None
     chosen = [f["face"] for f in faces if "error" not in f]
     try:
@@ -90,7 +93,7 @@ def _joined(path: Path, data: dict[str, Any], faces: list[dict[str, Any]]
         return None
     out = topology.as_dict()
     kept = info["faces"]
-    for item in out["interfaces"] + out.get("stretches", []):
+    for item in out["interfaces"] + out.get("stretches", []) + out.get("trim_joins", []):
         item["a"], item["b"] = kept[item["a"]], kept[item["b"]]
     return out
 

@@ -65,22 +65,33 @@ class Topology:
         Sides of two faces that share only part of their length, found from the geometry
         where the file gives a face no edges (:func:`splinedeform.cad_join.join_loose_faces`):
         ``(a, edge_a, b, edge_b)``, coupled by the body along the stretch.
+    trim_joins : list of (int, str, int, str, bool)
+        Trim edges of loose trimmed faces found from the geometry along another face's
+        trim edge or side (:func:`splinedeform.cad_join_trims.join_loose_trims`):
+        ``(a, edge_a, b, edge_b, whole)``, an edge named as a boundary mapping names it
+        (``hole1``, ``outer.2``, ``u0``), ``whole`` where the two run along each other's
+        whole length; the body couples them along the curve
+        (:mod:`splinedeform.body.trimmed`, :mod:`splinedeform.body.trim_edges`).
     """
 
     interfaces: list[Interface] = field(default_factory=list)
     counts: dict[str, int] = field(default_factory=lambda: dict.fromkeys(EDGE_KINDS, 0))
     trim_edges: dict[str, int] = field(default_factory=lambda: {"shared": 0, "free": 0})
     stretches: list[tuple[int, str, int, str]] = field(default_factory=list)
+    trim_joins: list[tuple[int, str, int, str, bool]] = field(default_factory=list)
 
     def as_dict(self) -> dict[str, Any]:
         """Plain data (for JSON): the counts, one dict per interface and, where there are
-        any, one per stretch found from the geometry."""
+        any, one per stretch and one per trim join found from the geometry."""
         out = {**self.counts, "trim_edges": dict(self.trim_edges), "interfaces": [
             {"a": i.a, "edge_a": i.edge_a, "b": i.b, "edge_b": i.edge_b,
              "reversed": i.reversed, "conforming": i.conforming} for i in self.interfaces]}
         if self.stretches:
             out["stretches"] = [{"a": a, "edge_a": ea, "b": b, "edge_b": eb}
                                 for a, ea, b, eb in self.stretches]
+        if self.trim_joins:
+            out["trim_joins"] = [{"a": a, "edge_a": ea, "b": b, "edge_b": eb, "whole": w}
+                                 for a, ea, b, eb, w in self.trim_joins]
         return out
 
 
