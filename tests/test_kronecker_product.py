@@ -12,7 +12,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 import splinedeform as sd
-from splinedeform.modal_solve import kronecker_mass
+from splinedeform.spectrum import kronecker_mass
 from splinedeform.solvers.kronecker_product import KroneckerProduct, checked
 from splinedeform.solvers.sparse_eigen import BlockLanczos, factorise
 

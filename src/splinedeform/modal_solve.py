@@ -22,8 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import spectrum
 from .errors import InputError
 from .modal_solution import ModalSolution
-from .solvers import kronecker_product, modal_basis, mode_select
-from .solvers.kronecker_product import KroneckerProduct
+from .solvers import modal_basis, mode_select
 from .solvers.sparse_eigen import BlockLanczos
 from .solvers.analytic import ModalResponse
 from .solvers.rigid import UnresolvedSpectrum
@@ -47,7 +46,6 @@ DEFAULT_TIMES = 201
 """Without ``times=`` the modes are chosen for this many evenly spaced times on ``[0, t_end]``
 and, after each load jump, the time half their spacing later (:func:`default_times`)."""
 _POINTWISE: weakref.WeakKeyDictionary[Any, float] = weakref.WeakKeyDictionary()
-_MASS: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()
 ONE_OFF_TIMES = 16
 """Up to this many times given at the call, on a model with no Krylov space yet, the modes
 are computed from a space started from the load (:func:`_automatic_modes`)."""
@@ -200,7 +198,7 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
     # load (fewer solves), for this call alone; else the model's random-start space, kept
     # for further load cases
     one_off = krylov is None and times is not None and at.size <= ONE_OFF_TIMES
-    mass_product = kronecker_mass(model, M)
+    mass_product = spectrum.kronecker_mass(model, M)
     if krylov is None and not one_off:
         krylov = _KRYLOV[model] = BlockLanczos(K, M, mass_product=mass_product)
     gamma, beta, c_inf = physics.damping_rate, physics.rayleigh, pointwise_factor(model)
@@ -248,19 +246,6 @@ def _automatic_modes(model: Model, spatial: tuple[list, list], d0: Array, v0: Ar
         report["correction"] = correction
         report["times"] = at
     return report
-
-
-def kronecker_mass(model: Model, M: Any) -> KroneckerProduct | None:
-    """``M_r = μ Ĝ0u ⊗ Ĝ0v`` applied through its reduced 1-D factors
-    (:mod:`~splinedeform.solvers.kronecker_product`) where the model has them (tensor-product
-    constraints, a consistent mass) and they reproduce ``M_r``; else ``None``. Made once
-    per model."""
-    if model not in _MASS:
-        factors = getattr(model, "_factors", None)
-        _MASS[model] = None if factors is None or getattr(model, "mass_matrix", "") != \
-            "consistent" else kronecker_product.checked(
-                KroneckerProduct(factors.u[0], factors.v[0], model.material.mass), M)
-    return _MASS[model]
 
 
 def default_times(t_end: float, jump_times: list[float]) -> Array:

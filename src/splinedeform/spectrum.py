@@ -17,13 +17,15 @@ factors; this module gathers them from a :class:`~splinedeform.Model` and dispat
 from __future__ import annotations
 
 import time
+import weakref
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from .errors import InputError
-from .solvers import modal_basis, rigid
+from .solvers import kronecker_product, modal_basis, rigid
+from .solvers.kronecker_product import KroneckerProduct
 from .solvers.rigid import UnresolvedSpectrum
 from .solvers.system import KroneckerFactors
 
@@ -33,6 +35,7 @@ if TYPE_CHECKING:
 Array = NDArray[np.float64]
 
 
+_MASS: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()
 NO_FACTORS = ("a body of several patches, or a patch whose C0 lines are coupled, has no "
               "Kronecker factors")
 
@@ -154,6 +157,19 @@ def eigen_options(model: Model, check_spectrum: bool = True) -> dict[str, Any]:
     return options
 
 
+def kronecker_mass(model: Model, M: Any) -> KroneckerProduct | None:
+    """``M_r = μ Ĝ0u ⊗ Ĝ0v`` applied through its reduced 1-D factors
+    (:mod:`~splinedeform.solvers.kronecker_product`) where the model has them (tensor-product
+    constraints, a consistent mass) and they reproduce ``M_r``; else ``None``. Made once
+    per model."""
+    if model not in _MASS:
+        factors = getattr(model, "_factors", None)
+        _MASS[model] = None if factors is None or getattr(model, "mass_matrix", "") != \
+            "consistent" else kronecker_product.checked(
+                KroneckerProduct(factors.u[0], factors.v[0], model.material.mass), M)
+    return _MASS[model]
+
+
 def modal_basis_of(model: Model, eigensolver: str = "auto", modes: int | None = None,
                    omega_max: float | None = None, check_spectrum: bool = True
                    ) -> modal_basis.ModalBasis:
@@ -168,7 +184,8 @@ def modal_basis_of(model: Model, eigensolver: str = "auto", modes: int | None = 
     options = eigen_options(model, check_spectrum)
     if strategy == "sparse":
         basis: modal_basis.ModalBasis = modal_basis.sparse_basis(
-            K, M, modes, omega_max, model.rigid_modes, **options)
+            K, M, modes, omega_max, model.rigid_modes, **options,
+            mass_product=kronecker_mass(model, M))
     elif truncated:
         basis = modal_basis.truncate(modal_basis_of(model, eigensolver, None, None,
                                                     check_spectrum), modes, omega_max)

@@ -178,10 +178,12 @@ def _eigsh(K: sp.spmatrix, M: sp.spmatrix, k: int, shift: float, lu: Any) -> tup
 def sparse_basis(K: sp.spmatrix, M: sp.spmatrix, k: int | None = None,
                  omega_max: float | None = None, rigid: int | None = 0,
                  advice: str = DEFAULT_ADVICE, guard: str = "condition",
-                 order: NDArray[np.int64] | None = None) -> DenseBasis:
+                 order: NDArray[np.int64] | None = None, mass_product: Any | None = None
+                 ) -> DenseBasis:
     """Lowest modes by shift-invert Lanczos: without rigid modes and ``order`` the block
     Lanczos of :mod:`.sparse_eigen` on its factor of ``K`` (level-3 solves, one Krylov
-    space for every request), else ``eigsh`` with a sparse LU of ``K - σM``.
+    space for every request; ``mass_product``: its ``X ↦ M X``, e.g. through Kronecker
+    factors), else ``eigsh`` with a sparse LU of ``K - σM``.
 
     ``k`` modes, or all with ``ω <= omega_max`` (found by doubling the request). One mode more
     than kept is computed so that the first omitted frequency is known. Without rigid modes
@@ -203,7 +205,7 @@ def sparse_basis(K: sp.spmatrix, M: sp.spmatrix, k: int | None = None,
     block = not unconstrained and order is None
     lu = factorise(K) if block else stiffness_factorisation(K, shift, M, order)
     solve = None if unconstrained else lu.solve
-    krylov = BlockLanczos(K, M, lu) if block else None
+    krylov = BlockLanczos(K, M, lu, mass_product=mass_product) if block else None
 
     def pairs(count: int) -> tuple[Array, Array]:
         """The ``count`` lowest pairs (on one growing Krylov space with the block Lanczos)."""
