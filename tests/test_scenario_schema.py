@@ -152,3 +152,21 @@ def test_the_editor_example_of_the_docs_is_a_valid_scenario(validator):
         assert block.startswith("#:schema ")          # taplo reads it on the first line only
         assert not list(validator.iter_errors(tomllib.loads(block)))
         assert parse_scenario(block).solve.kind == "modes"
+
+
+def test_the_reference_writer_names_a_missing_file_and_rewrites_a_copy(tmp_path, capsys):
+    """``python -m splinedeform.scenario.reference FILE``: a file it cannot read is named
+    with exit code 2 and nothing written; a copy of the docs is rewritten whole, equal."""
+    from pathlib import Path
+
+    from splinedeform.scenario import reference
+
+    assert reference.main([str(tmp_path / "missing.md")]) == 2
+    assert "missing.md: Markdown file not found" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+    text = Path("docs/scenario.md").read_text(encoding="utf-8")
+    copy = tmp_path / "scenario.md"
+    copy.write_text(text, encoding="utf-8")
+    assert reference.main([str(copy)]) == 0
+    assert copy.read_text(encoding="utf-8") == text
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scenario.md"]    # no temporaries

@@ -107,10 +107,18 @@ def blocks(text: str) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Rewrite the reference blocks of the given Markdown files in place."""
+    """Rewrite the reference blocks of the given Markdown files in place (each written
+    whole or not at all); a file that cannot be read is named on stderr, exit code 2."""
+    from ..errors import InputError
+    from ..export.atomic import write_text
+
     for name in (argv if argv is not None else sys.argv[1:]) or ["docs/scenario.md"]:
         path = Path(name)
-        path.write_text(update(read_input_text(path, "Markdown file")), encoding="utf-8")
+        try:
+            write_text(path, update(read_input_text(path, "Markdown file")))
+        except InputError as error:
+            print(f"error: {error}", file=sys.stderr)
+            return 2
         print(f"wrote the key reference of {path}")
     return 0
 
