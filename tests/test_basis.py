@@ -147,7 +147,8 @@ def test_all_derivative_orders_equal_scipy_bsplines(kind, degree):
     x = np.random.default_rng(degree).uniform(0.0, length, 200)
     index, values = basis.nonzero_derivatives(x, degree)
     cell = basis.span(x)
-    np.testing.assert_array_equal(index, cell[:, None] + np.arange(degree + 1))
+    # indices (integers): equal when they differ by less than half a unit
+    assert np.abs(index - (cell[:, None] + np.arange(degree + 1))).max() < 0.5
     splines = BSpline(basis.knots, np.eye(basis.size), degree, extrapolate=False)
     for order in range(degree + 1):
         dense = np.take_along_axis(splines(x, nu=order), index, axis=1)
@@ -271,7 +272,10 @@ def test_matrix_is_sparse_with_the_dense_values():
     x = np.linspace(0.0, 1.0, 11)
     A = basis.matrix(x, 1)
     assert A.shape == (11, 8) and A.nnz <= 11 * 4
-    np.testing.assert_array_equal(A.toarray(), basis(x, 1))
+    dense = basis(x, 1)
+    # two evaluations of the same derivative (sparse matrix and dense call): a few roundings
+    # of values of size up to cells · degree / length = 15
+    assert np.abs(A.toarray() - dense).max() <= 1e-12 * max(np.abs(dense).max(), 1.0)
 
 
 # -- bad input ---------------------------------------------------------------------------

@@ -88,7 +88,9 @@ def test_a_painted_face_moves_at_its_listed_points_only(served):
     # compared exactly)
     free = decode(data["free_mask"], "u1").astype(bool)
     still = decode(data["still_mask"], "u1").astype(bool)
-    assert np.array_equal(free[:N * N].reshape(N, N), listed) and free[N * N:].all()
+    # flags as 0/1: equal when they differ by less than half a unit
+    assert np.abs(free[:N * N].reshape(N, N).astype(int) - listed.astype(int)).max() < 0.5
+    assert free[N * N:].all()
     assert not still[:N * N].reshape(N, N)[listed].any()
     assert still[:N * N].reshape(N, N)[~listed].all() and still[N * N:].reshape(N, N)[0].all()
     # nothing painted: every face moves again
@@ -200,7 +202,8 @@ def test_bake_keeps_the_painted_set_under_the_new_files_face_numbers(tmp_path):
     assert reply.status_code == 200, reply.text
     assert reply.json()["body"]["faces"] == [0, 1]
     assert session.scenario.raw["boundary"]["faces_free_points"] == {"1": PAINTED}
-    assert np.array_equal(decode(reply.json()["free_mask"], "u1"), before)
+    after = decode(reply.json()["free_mask"], "u1").astype(int)      # flags as 0/1
+    assert after.shape == before.shape and np.abs(after - before.astype(int)).max() < 0.5
     top = np.abs(session.basis.phi_net).max()
     kept = face_rows(session.basis, 1)
     listed = np.zeros((N, N), bool)

@@ -60,7 +60,8 @@ def test_painting_a_face_frees_its_points_and_the_server_solves_with_them(browse
         expect = np.zeros(2 * N * N, bool)
         expect[[i * N + j for i, j in PICKED]] = True
         expect[N * N:] = True
-        assert np.array_equal(mask, expect)                 # flags: compared exactly
+        # flags as 0/1: equal when they differ by less than half a unit
+        assert np.abs(mask.astype(int) - expect.astype(int)).max() < 0.5
         # what Apply sends: face 0's points; face 1, all free, is left out (it moves)
         assert page.evaluate("sculptState.freeSet()") == {"faces_free_points": {"0": PICKED}}
         info = page.inner_text("#paint-info")
@@ -71,7 +72,8 @@ def test_painting_a_face_frees_its_points_and_the_server_solves_with_them(browse
         assert page.evaluate("sculptState.errors") == []
         # the server's answer describes the same set: free_mask, and still_mask holding
         # every point of face 0 but the two picked
-        assert np.array_equal(np.array(page.evaluate("sculptState.freeMask"), bool), expect)
+        answer = np.array(page.evaluate("sculptState.freeMask"), bool).astype(int)
+        assert np.abs(answer - expect.astype(int)).max() < 0.5
         still = np.array(page.evaluate("sculptState.stillMask"), bool)
         assert not still[:N * N][expect[:N * N]].any() and still[:N * N][~expect[:N * N]].all()
         info = page.inner_text("#paint-info")

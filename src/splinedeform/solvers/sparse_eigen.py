@@ -256,7 +256,7 @@ class BlockLanczos:
         the normalisation, which at 64² took about as long as the orthogonalisation."""
         p = self.p
         V, MV = self.V[:, :p], self.MV[:, :p]
-        w = np.array(self.lu.solve(self.MV[:, p - 1]), dtype=float).ravel()
+        w = np.asarray(self.lu.solve(self.MV[:, p - 1]), dtype=float).ravel()
         self.solves += 1
         near = max(0, p - 2)                    # the last two vectors
         c = _gemv(1.0, MV[:, near:], w, trans=1)
