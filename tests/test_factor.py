@@ -40,6 +40,26 @@ def test_the_kronecker_ordering_has_the_closed_form_half_bandwidth():
     assert half_bandwidth(sp.identity(4, format="csr")) == 0
 
 
+@pytest.mark.parametrize("shape", [(40, 40), (30, 45), (45, 30)])
+def test_the_half_bandwidth_of_every_storage_is_the_largest_offset_of_its_entries(shape):
+    """Compressed storage with sorted indices reads only each column's (row's) first and
+    last index; unsorted, coordinate and rectangular matrices count every entry. The
+    expected value is ``max |i − j|`` over the coordinates (integers: exact)."""
+    rng = np.random.default_rng(3)
+    A = sp.random(*shape, density=0.08, random_state=rng, format="coo")
+    expected = int(np.abs(A.row - A.col).max())
+    for form in (A, A.tocsc(), A.tocsr()):
+        assert half_bandwidth(form) == expected
+    shuffled = A.tocsr()
+    order = np.concatenate([rng.permutation(np.arange(a, b))
+                            for a, b in zip(shuffled.indptr[:-1], shuffled.indptr[1:])])
+    shuffled = sp.csr_matrix((shuffled.data[order], shuffled.indices[order],
+                              shuffled.indptr), shape=shape)
+    shuffled.has_sorted_indices = False
+    assert half_bandwidth(shuffled) == expected
+    assert half_bandwidth(sp.csc_matrix(shape)) == 0      # no entries
+
+
 def test_auto_leaves_the_band_when_its_storage_is_too_large(monkeypatch):
     monkeypatch.setattr(factor, "BAND_BYTES", 0)
     monkeypatch.setattr(factor, "_cholmod", lambda: None)

@@ -98,8 +98,12 @@ def analytic(model: Model, forcing: Any, t_end: float, d0: Array, v0: Array,
     c = model.formulation.damping_rate + model.formulation.rayleigh * lam
     jumps = [(t_j, basis.project(F)) for t_j, F in spatial[0]]
     harmonics = [(w, phase, basis.project(F)) for w, phase, F in spatial[1]]
-    response = ModalResponse(lam, c, basis.project(M @ d0), basis.project(M @ v0),
-                             jumps, harmonics)
+    def initial(x: Array) -> Array:
+        """``Φᵀ M x`` (no products for a start from rest)."""
+        x = np.asarray(x, dtype=float)
+        return basis.project(M @ x) if np.any(x) else np.zeros((lam.size,) + x.shape[1:])
+
+    response = ModalResponse(lam, c, initial(d0), initial(v0), jumps, harmonics)
     correction, truncation = report.pop("correction", None), {}
     estimate, chosen_at = report.pop("estimate", None), report.pop("times", None)
     if not basis.complete:

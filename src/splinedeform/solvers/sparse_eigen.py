@@ -290,8 +290,8 @@ class BlockLanczos:
     def _ritz(self, want: int) -> tuple[Array, Array, Array]:
         """Ritz values ``ν`` (descending), vectors ``s`` and relative residuals."""
         p, lo = self.p, self.lo
-        H = self.H[:p, :p]
-        nu, S = np.linalg.eigh(np.triu(H) + np.triu(H, 1).T)
+        # the coefficients fill H's upper triangle (its columns): eigh reads that one
+        nu, S = np.linalg.eigh(self.H[:p, :p], UPLO="U")
         nu, S = nu[::-1], S[:, ::-1]
         assert self.next is not None
         Q, _, B = self.next
