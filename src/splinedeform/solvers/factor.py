@@ -157,20 +157,28 @@ def _banded(K: sp.spmatrix) -> Factorisation:
     copies nothing before ``dpbtrf`` factorises it in place (at 64² the copy of a C-ordered
     band cost a quarter of the factorisation).
     """
-    rows, columns, values = _entries(K)
-    upper = rows <= columns
-    rows, columns = rows[upper], columns[upper]
-    n = K.shape[0]
-    b = int((columns - rows).max()) if rows.size else 0
-    band = np.zeros((b + 1, n), order="F")
-    band[b + rows - columns, columns] = values[upper]
-    U = sla.cholesky_banded(band, overwrite_ab=True, lower=False, check_finite=False)
+    U = sla.cholesky_banded(band_storage(K), overwrite_ab=True, lower=False,
+                            check_finite=False)
 
     def solve(rhs: Array) -> Array:
         return sla.cho_solve_banded((U, False), np.asarray(rhs, dtype=float),
                                     check_finite=False)
 
     return Factorisation("banded", solve)
+
+
+def band_storage(K: sp.spmatrix, lower: bool = False) -> Array:
+    """One triangle of a symmetric ``K`` in LAPACK's band storage, Fortran order:
+    ``ab[b + i − j, j] = K_ij`` for ``i ≤ j`` (upper), ``ab[i − j, j] = K_ij`` for ``i ≥ j``
+    (``lower``), ``b`` the half bandwidth of that triangle."""
+    rows, columns, values = _entries(K)
+    keep = rows >= columns if lower else rows <= columns
+    rows, columns, values = rows[keep], columns[keep], values[keep]
+    offset = rows - columns if lower else columns - rows
+    b = int(offset.max()) if rows.size else 0
+    band = np.zeros((b + 1, K.shape[0]), order="F")
+    band[offset if lower else b - offset, columns] = values
+    return band
 
 
 def _superlu(K: sp.spmatrix) -> Factorisation:
