@@ -83,6 +83,10 @@ def test_alt_click_pins_a_point_of_a_face_and_a_shared_point_on_both(browser, tm
         assert [free[m] for m in rows] == [0, 0] and [still[m] for m in rows] == [1, 1]
         info = page.inner_text("#paint-info")
         assert info.startswith("69 of 72 control points free (green) (face 0: 34, face 1: 35)")
+        # two pins, one of them a point of two faces: two points drawn blue on three rows
+        assert ", 2 pinned (blue)" in info
+        pinned = page.evaluate("sculptState.pinnedMask")
+        assert [m for m, on in enumerate(pinned) if on] == sorted([k, *rows])
         # near the clamped edge u0 (rows 0 and 1 of face 0 held): refused on the page, nothing
         # sent (the sample picked at the edge's screen place may be its neighbour: row 0 or 1)
         alt_click(page, 0 * R + 3)

@@ -326,6 +326,8 @@
     netFace(k) { const at = netFace(k); return at && { face: data.body ? data.body.faces[at.p] : at.p, i: at.i, j: at.j }; },
     samePoint(k) { return samePoint(k); },
     get stillMask() { return Array.from(stillMask); },
+    get pinnedMask() { return Array.from(pinnedMask); },
+    netColor(k) { return netColors ? Array.from(netColors.array.slice(3 * k, 3 * k + 3)) : null; },
     get grabView() { return grabEnds && { point: grabEnds.point.slice(), pointer: grabEnds.pointer && grabEnds.pointer.slice(),
                                           marker: grabMarker.visible, spring: springLine.visible }; },
     get hud() { return hudBox.textContent; },

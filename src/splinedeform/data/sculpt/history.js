@@ -9,7 +9,7 @@
   function pageState() {
     return { data, q: Float64Array.from(q), v: Float64Array.from(v), f: Float64Array.from(f),
              t, tEvent, pushes: pushes.map((p) => Object.assign({}, p, { force: p.force.slice() })),
-             freeMask: freeMask.slice(), freeSource, freeEdited, carriedMotion,
+             freeMask: freeMask.slice(), pinnedMask: pinnedMask.slice(), freeSource, freeEdited, carriedMotion,
              corrections: new Map(corrections), lagged: copyLagged(lagged) };
   }
   function copyLagged(from) {
@@ -37,6 +37,7 @@
     t = state.t; tEvent = state.tEvent;
     pushes = state.pushes.map((p) => Object.assign({}, p, { force: p.force.slice() }));
     freeMask = state.freeMask.slice(); freeSource = state.freeSource; freeEdited = state.freeEdited;
+    pinnedMask = state.pinnedMask.slice();
     carriedMotion = state.carriedMotion;
     corrections.clear();
     state.corrections.forEach((c, k) => { if (c) corrections.set(k, c); });
@@ -91,6 +92,7 @@
       }
       const mask = freeMask.slice(), nv = gV.length, points = [];
       mask[pinned] = 0;
+      rows = [pinned];
       for (let k = 0; k < NN; k++) if (mask[k]) points.push([Math.floor(k / nv), k % nv]);
       extra = { free_points: points };
     }
@@ -106,6 +108,10 @@
       const reply = await post("api/bake", Object.assign({ version: data.version, q: Array.from(now) }, extra));
       remember(earlier);
       load(reply);
+      if (pinning) {                  // drawn blue from now on (paintNet)
+        rows.forEach((m) => { if (!freeMask[m]) pinnedMask[m] = 1; });
+        paintNet();
+      }
       const also = rows.length > 1 ? " (held on every face that has it: " + rows.map(netName).join(", ") + ")" : "";
       progressBox.textContent = pinning
         ? "pinned control point " + netName(pinned) + " where it is" + also + " (shape baked in " + reply.solve_seconds + " s, " + K + " modes)"

@@ -12,18 +12,25 @@
   const paintBox = document.getElementById("paint"), brushBox = document.getElementById("brush");
   const paintInfo = document.getElementById("paint-info");
   let painting = false;
-  // green: free and moving; orange: in the free set but held by an edge preset; grey: fixed
+  // green: free and moving; orange: in the free set but held by an edge preset; grey: fixed;
+  // blue: fixed by a pin on this page (a point freed again is no longer a pin)
   const FREE_RGB = [0.1, 0.62, 0.2], HELD_RGB = [0.85, 0.45, 0.1], FIXED_RGB = [0.55, 0.55, 0.58];
+  const PINNED_RGB = [0.15, 0.35, 0.95];
   function paintNet() {
     if (!netColors) return;
     const c = netColors.array;
     let count = 0, held = 0;
+    const pinnedRows = [];
     for (let k = 0; k < NN; k++) {
+      if (freeMask[k]) pinnedMask[k] = 0;
       const edge = freeMask[k] && stillMask[k] && !freeEdited;
-      const rgb = !freeMask[k] ? FIXED_RGB : edge ? HELD_RGB : FREE_RGB;
+      const rgb = !freeMask[k] ? (pinnedMask[k] ? PINNED_RGB : FIXED_RGB) : edge ? HELD_RGB : FREE_RGB;
       count += freeMask[k]; held += edge ? 1 : 0;
+      if (pinnedMask[k]) pinnedRows.push(k);
       c[3 * k] = rgb[0]; c[3 * k + 1] = rgb[1]; c[3 * k + 2] = rgb[2];
     }
+    // a body's point shared by several faces is one pin: count the points, not the rows
+    const pinned = pointClass ? new Set(pinnedRows.map((k) => pointClass[k])).size : pinnedRows.length;
     netColors.needsUpdate = true;
     const perFace = data.body ? faceList.map((face, p) => {
       const start = faceStart(p), size = face.net[0] * face.net[1];
@@ -32,6 +39,7 @@
     paintInfo.textContent = count + " of " + NN + " control points free (green)" +
       (perFace ? " (" + perFace + ")" : "") +
       (held ? ", " + held + " of them held by the edges" + (data.body ? " or a neighbouring face" : "") + " (orange)" : "") +
+      (pinned ? ", " + pinned + " pinned (blue)" : "") +
       (freeEdited ? ": not applied yet" : "");
     dirty = true;
   }

@@ -39,6 +39,9 @@
   // the free set (1 = free, row-major over the net, what Apply sends) and where it came from:
   // "box" (the u/v box of the panel), "points" (a list: the scenario's or painted)
   let freeMask, freeSource, gU, gV, stillMask;
+  // the rows pinned on this page (alt-click): fixed like painted ones, drawn apart; kept while
+  // the net keeps its size, cleared where a point is freed again (paintNet)
+  let pinnedMask = null;
   // the faces: a body's samples are face after face, rows p·faceRows … (p+1)·faceRows - 1 of
   // the (ru, rv) grid for face p, and its control points the next nu·nv of the net; a single
   // surface is one face
@@ -63,6 +66,7 @@
     NN = d.net_shape[0] * d.net_shape[1];
     freeMask = decode(d.free_mask, Uint8Array).slice();
     stillMask = decode(d.still_mask, Uint8Array);   // cannot move in the solved model
+    if (!pinnedMask || pinnedMask.length !== NN) pinnedMask = new Uint8Array(NN);
     freeSource = d.free_region ? "box" : "points";
     [gU, gV] = d.greville;
     pointClass = d.body && d.body.classes ? decode(d.body.classes, Int32Array) : null;
