@@ -74,7 +74,9 @@ def test_bake_then_undo_and_redo_restore_each_state_exactly(page):
     after_undo = page.evaluate("sculptState.snapshot()")
     assert after_undo["time"] == before["time"] and after_undo["pushes"] == before["pushes"]
     rest2, disp2 = _shape(page)
-    assert np.array_equal(rest2, rest0)             # the earlier basis's own rest samples
+    # the earlier basis's own rest samples, put back: within 1e-12 of their size, while the
+    # baked rest differed from them by the displacement (above 1e-3)
+    assert np.max(np.abs(rest2 - rest0)) <= 1e-12 * np.abs(rest0).max()
     # the same q and Φ_s summed by the same loop: equal to the last bit, shown to 1e-12
     assert np.max(np.abs(disp2 - disp0)) <= 1e-12 * scale
     assert page.evaluate("sculptState.history") == [0, 1]

@@ -55,7 +55,8 @@ def test_a_pinned_point_stays_where_it_was_while_another_is_pulled(page):
     assert "pinned control point" in page.evaluate("sculptState.progress")
     assert page.evaluate("sculptState.grabbed") is None          # a pin grabs nothing
     assert page.evaluate("sculptState.freeMask")[k] == 0
-    # drawn apart from the other fixed points: blue (float32 colours, 1e-6), counted
+    # drawn apart from the other fixed points: blue (PINNED_RGB of paint.js; its neighbour
+    # FREE_RGB; stored as float32 colours, so 1e-6), counted
     assert page.evaluate("sculptState.pinnedMask")[k] == 1
     assert sum(page.evaluate("sculptState.pinnedMask")) == 1
     assert np.allclose(page.evaluate(f"sculptState.netColor({k})"), [0.15, 0.35, 0.95], atol=1e-6)

@@ -51,6 +51,7 @@ def test_static_solve_equals_the_bordered_system(case):
                          [(7, 5, False), (40, 9, True), (13, 30, False), (31, 12, False)])
 def test_dissection_order_is_a_permutation_with_separators_last(n_u, n_v, periodic):
     rank = dissection_ranks(n_u, n_v, (3, 3), periodic).reshape(n_u, n_v)
+    # integer ranks: a permutation of 0 … n − 1, compared exactly (no rounding involved)
     assert np.array_equal(np.sort(rank.ravel()), np.arange(n_u * n_v))
     if periodic:               # the two cuts that open the ring come last
         cuts = np.r_[0:3, n_u // 2:n_u // 2 + 3]
